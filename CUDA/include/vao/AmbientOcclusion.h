@@ -1,0 +1,137 @@
+// Host interface of the VolumetricAO kernel library: no VTK, plain C++17.
+//
+// A volume is a block of voxels (x fastest) of any scalar type, read in place through a
+// stride (so one component of a multi-component array needs no converted copy). Results
+// are computed for a sub-region of that block; every neighbourhood is clipped to the
+// block, which the caller makes equal to the data set's whole extent (or to a piece
+// grown by the radius and clipped to the whole extent: the same thing for the region).
+#pragma once
+
+#include "vao/Estimators.h"
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+namespace vao
+{
+
+enum class ScalarType : int
+{
+  Int8,
+  UInt8,
+  Int16,
+  UInt16,
+  Int32,
+  UInt32,
+  Int64,
+  UInt64,
+  Float32,
+  Float64,
+};
+
+const char* scalarTypeName(ScalarType type);
+
+using Index3 = std::array<std::int64_t, 3>;
+
+struct VolumeView
+{
+  const void* data = nullptr; // first voxel's (chosen) component
+  ScalarType type = ScalarType::Float32;
+  Index3 dims = { 0, 0, 0 };
+  std::int64_t voxelStride = 1; // elements between consecutive voxels (components)
+
+  std::int64_t voxelCount() const { return dims[0] * dims[1] * dims[2]; }
+};
+
+/// Sub-block [begin, begin + size) of the volume for which results are written.
+struct Region
+{
+  Index3 begin = { 0, 0, 0 };
+  Index3 size = { 0, 0, 0 };
+
+  static Region whole(const VolumeView& volume) { return { { 0, 0, 0 }, volume.dims }; }
+  std::int64_t voxelCount() const { return size[0] * size[1] * size[2]; }
+};
+
+/// Half-widths of the box neighbourhood, in voxels, per axis.
+struct Radius
+{
+  int x = 0;
+  int y = 0;
+  int z = 0;
+};
+
+enum class QueryMode : int
+{
+  VoxelValue = 0,
+  IsoValue = 1,
+};
+
+struct AmbientOcclusionParameters
+{
+  Method method = Method::GaussianCdf;
+  Radius radius;
+  QueryMode queryMode = QueryMode::VoxelValue;
+  double isoValue = 0.0;
+  ErfMode erfMode = ErfMode::Exact;
+};
+
+/// How the work runs: thread count, progress in [0, 1] and cancellation. The callbacks are
+/// invoked on the calling thread only, so they may touch non-thread-safe state (VTK).
+struct Execution
+{
+  int threads = 0; // 0: every hardware thread
+  std::function<void(double)> progress;
+  std::function<bool()> abortRequested;
+};
+
+/// Output arrays of region.voxelCount() values, x fastest; a null pointer skips it.
+struct AmbientOcclusionOutput
+{
+  float* openness = nullptr;
+  float* variance = nullptr; // intensity variance of the box (Ruiz et al. section 4.2)
+};
+
+struct BoxStatisticsOutput
+{
+  double* count = nullptr;
+  double* mean = nullptr;
+  double* variance = nullptr;
+  double* minimum = nullptr;
+  double* maximum = nullptr;
+};
+
+/// Result of a kernel call: ok, or why not (bad arguments, cancelled).
+struct Status
+{
+  bool ok = true;
+  bool aborted = false;
+  std::string message;
+
+  static Status success() { return {}; }
+  static Status failure(std::string why) { return { false, false, std::move(why) }; }
+  static Status cancelled() { return { false, true, "cancelled" }; }
+};
+
+/// Checks the volume, region and radius; returns the first problem found.
+Status validate(const VolumeView& volume, const Region& region, const Radius& radius);
+
+/// Openness (and optionally the variance) of every voxel of the region.
+Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
+  const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
+  const Execution& execution = {});
+
+/// Count, mean, variance, minimum and maximum over each voxel's clipped box.
+Status computeBoxStatistics(const VolumeView& volume, const Region& region, const Radius& radius,
+  const BoxStatisticsOutput& output, const Execution& execution = {});
+
+/// Number of voxels that are NaN or infinite (always 0 for integer types); the index of the
+/// first one goes to firstIndex when not null.
+std::int64_t countNonFinite(const VolumeView& volume, std::int64_t* firstIndex = nullptr);
+
+/// Smallest and largest value of the volume (finite values assumed).
+std::array<double, 2> valueRange(const VolumeView& volume);
+
+} // namespace vao

@@ -1,0 +1,162 @@
+// The openness estimators of ../shared/METHODS.md, written once for host and device.
+//
+// Every function here is a pure formula on the statistics of one neighbourhood, so the
+// CPU fallback and (later) the CUDA kernels include this header and call the same code.
+// Openness O = P(v <= q) over the neighbourhood: 1 = fully open, 0 = fully occluded.
+#pragma once
+
+#include <cmath>
+
+#if defined(__CUDACC__)
+#define VAO_HD __host__ __device__ inline
+#else
+#define VAO_HD inline
+#endif
+
+namespace vao
+{
+
+enum class Method : int
+{
+  CdfReconstruction = 0,
+  GaussianCdf = 1,
+  Chebyshev = 2,
+  ExactBox = 3,
+  ExactSphere = 4,
+};
+
+enum class ErfMode : int
+{
+  Exact = 0,
+  Winitzki = 1,
+};
+
+/// True for the methods estimated from separable statistics (no O(R^3) reference).
+VAO_HD bool isSeparableMethod(Method method)
+{
+  return method == Method::CdfReconstruction || method == Method::GaussianCdf ||
+    method == Method::Chebyshev;
+}
+
+/// Statistics of one clipped box neighbourhood, as the estimators consume them.
+struct NeighbourhoodStats
+{
+  double mean;
+  double variance; // population variance E[v^2] - mean^2, clamped at 0
+  double minimum;
+  double maximum;
+};
+
+/// Relative threshold of the flat-neighbourhood rule: s2 <= kFlatEpsilon * max(1, mu^2).
+/// 1e-14 sits above double rounding of shifted sums and below the smallest variance a
+/// float32 volume can show (one ulp step in a box of 10^4 voxels at 1e6 is ~4e-7 of mu^2).
+constexpr double kFlatEpsilon = 1e-14;
+
+VAO_HD bool isFlatVariance(double mean, double variance)
+{
+  const double scale = mean * mean > 1.0 ? mean * mean : 1.0;
+  return variance <= kFlatEpsilon * scale;
+}
+
+/// The exact answer on a flat neighbourhood, which every estimator returns there.
+VAO_HD double flatOpenness(double query, double mean)
+{
+  return query >= mean ? 1.0 : 0.0;
+}
+
+VAO_HD double clamp01(double x)
+{
+  return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
+}
+
+/// Winitzki's closed-form approximation of erf (max abs error ~1.2e-4).
+VAO_HD double erfWinitzki(double x)
+{
+  constexpr double pi = 3.14159265358979323846;
+  constexpr double a = 8.0 * (pi - 3.0) / (3.0 * pi * (4.0 - pi));
+  const double x2 = x * x;
+  const double inner = 1.0 - exp(-x2 * (4.0 / pi + a * x2) / (1.0 + a * x2));
+  const double magnitude = sqrt(inner > 0.0 ? inner : 0.0);
+  return x < 0.0 ? -magnitude : magnitude;
+}
+
+/// Ruiz et al. section 3.2: O = t^beta with t = (q - vmin)/(vmax - vmin) and
+/// beta = (mu - vmin)/(vmax - mu). Flat when vmax == vmin.
+VAO_HD double opennessCdfReconstruction(double query, const NeighbourhoodStats& s)
+{
+  if (s.maximum <= s.minimum)
+  {
+    return flatOpenness(query, s.mean);
+  }
+  const double t = (query - s.minimum) / (s.maximum - s.minimum);
+  if (t >= 1.0)
+  {
+    return 1.0;
+  }
+  if (t <= 0.0)
+  {
+    return 0.0;
+  }
+  // The mean comes from rounded sums and may stray a hair outside [vmin, vmax].
+  const double mean = s.mean < s.minimum ? s.minimum : (s.mean > s.maximum ? s.maximum : s.mean);
+  if (mean >= s.maximum)
+  {
+    return 0.0; // beta -> infinity: t^beta -> 0 for t < 1
+  }
+  const double beta = (mean - s.minimum) / (s.maximum - mean);
+  return pow(t, beta);
+}
+
+/// Ruiz et al. section 3.3: O = (1 + erf((q - mu) / sqrt(2 s2))) / 2.
+VAO_HD double opennessGaussianCdf(double query, const NeighbourhoodStats& s, ErfMode erfMode)
+{
+  if (isFlatVariance(s.mean, s.variance))
+  {
+    return flatOpenness(query, s.mean);
+  }
+  const double z = (query - s.mean) / sqrt(2.0 * s.variance);
+  const double e = erfMode == ErfMode::Winitzki ? erfWinitzki(z) : erf(z);
+  return clamp01(0.5 * (1.0 + e));
+}
+
+/// Cantelli's one-tailed bound on the occluder fraction P(v >= q), as METHODS.md fixes it:
+/// p_max = 1 if q <= mu, else s2 / (s2 + (q - mu)^2); O = 1 - p_max <= P(v <= q).
+VAO_HD double opennessChebyshev(double query, const NeighbourhoodStats& s)
+{
+  if (isFlatVariance(s.mean, s.variance))
+  {
+    return flatOpenness(query, s.mean);
+  }
+  if (query <= s.mean)
+  {
+    return 0.0;
+  }
+  const double d = query - s.mean;
+  return clamp01(1.0 - s.variance / (s.variance + d * d));
+}
+
+/// Dispatch for the separable methods (the exact references count voxels instead).
+VAO_HD double opennessFromStats(
+  Method method, double query, const NeighbourhoodStats& s, ErfMode erfMode)
+{
+  switch (method)
+  {
+    case Method::CdfReconstruction:
+      return opennessCdfReconstruction(query, s);
+    case Method::Chebyshev:
+      return opennessChebyshev(query, s);
+    case Method::GaussianCdf:
+    default:
+      return opennessGaussianCdf(query, s, erfMode);
+  }
+}
+
+/// Number of voxels of a window of half-width r around i, clipped to [0, n).
+VAO_HD long long clippedWindowCount(long long i, long long r, long long n)
+{
+  const long long lo = i - r < 0 ? 0 : i - r;
+  const long long hi = i + r > n - 1 ? n - 1 : i + r;
+  return hi - lo + 1;
+}
+
+} // namespace vao

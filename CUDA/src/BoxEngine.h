@@ -1,0 +1,378 @@
+// The separable box statistics, streamed slice by slice along z.
+//
+// Sums: each thread owns a chunk of output slices and keeps the 3-D box sums of v and v^2
+// for the current slice as a plane. Moving to the next slice adds the 2-D box sum of the
+// slice that enters the window and subtracts the one that leaves; both are done in one
+// x/y pass over the difference of the two slices (box sums are linear). Per voxel and
+// slice this is O(1) whatever the radius, and only the input is read from memory and the
+// output written: the planes stay in cache.
+//
+// Minimum and maximum (needed by CDF Reconstruction and the statistics) are not
+// invertible, so they take three van Herk passes (x and y per slice, then z per row).
+#pragma once
+
+#include "Parallel.h"
+#include "SlidingExtremum.h"
+#include "VolumeAccess.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+namespace vao
+{
+namespace detail
+{
+
+/// Region geometry shared by the passes: spans read along each axis.
+struct BoxGeometry
+{
+  Index3 dims;
+  Region region;
+  Radius radius;
+  AxisSpan xs, ys, zs;
+
+  BoxGeometry(const Index3& volumeDims, const Region& outputRegion, const Radius& r)
+    : dims(volumeDims)
+    , region(outputRegion)
+    , radius(r)
+    , xs(readSpan(outputRegion.begin[0], outputRegion.size[0], r.x, volumeDims[0]))
+    , ys(readSpan(outputRegion.begin[1], outputRegion.size[1], r.y, volumeDims[1]))
+    , zs(readSpan(outputRegion.begin[2], outputRegion.size[2], r.z, volumeDims[2]))
+  {
+  }
+
+  std::int64_t planeSize() const { return region.size[0] * region.size[1]; }
+  /// Clipped window sizes along x and y of every region column and row.
+  std::vector<double> windowCounts(int axis) const
+  {
+    const int r = axis == 0 ? radius.x : (axis == 1 ? radius.y : radius.z);
+    std::vector<double> counts(static_cast<std::size_t>(region.size[axis]));
+    for (std::int64_t i = 0; i < region.size[axis]; ++i)
+    {
+      counts[i] = static_cast<double>(clippedWindowCount(region.begin[axis] + i, r, dims[axis]));
+    }
+    return counts;
+  }
+};
+
+/// Box sums of (v - shift) and (v - shift)^2 for one slice of the region at a time.
+template <class T>
+class MomentPlanes
+{
+public:
+  using Acc = typename MomentTraits<T>::Accumulator;
+
+  MomentPlanes(const TypedVolume<T>& volume, const BoxGeometry& geometry, Acc shift)
+    : Volume(volume)
+    , Geo(geometry)
+    , Shift(shift)
+    , Sum(geometry.planeSize())
+    , SumSquares(geometry.planeSize())
+    , Row1(geometry.xs.size() + 1)
+    , Row2(geometry.xs.size() + 1)
+    , XBox1(geometry.ys.size() * geometry.region.size[0])
+    , XBox2(geometry.ys.size() * geometry.region.size[0])
+    , Run1(geometry.region.size[0])
+    , Run2(geometry.region.size[0])
+  {
+  }
+
+  /// Sets the planes to the box sums of output slice z (window clipped to the volume).
+  void startAt(std::int64_t z)
+  {
+    std::fill(this->Sum.begin(), this->Sum.end(), Acc(0));
+    std::fill(this->SumSquares.begin(), this->SumSquares.end(), Acc(0));
+    const std::int64_t lo = std::max<std::int64_t>(0, z - this->Geo.radius.z);
+    const std::int64_t hi = std::min<std::int64_t>(this->Geo.dims[2] - 1, z + this->Geo.radius.z);
+    for (std::int64_t s = lo; s <= hi; ++s)
+    {
+      this->addSliceDifference(s, -1);
+    }
+  }
+
+  /// Moves the planes from output slice z to z + 1.
+  void advanceFrom(std::int64_t z)
+  {
+    const std::int64_t entering = z + this->Geo.radius.z + 1;
+    const std::int64_t leaving = z - this->Geo.radius.z;
+    this->addSliceDifference(
+      entering < this->Geo.dims[2] ? entering : -1, leaving >= 0 ? leaving : -1);
+  }
+
+  const Acc* sum() const { return this->Sum.data(); }
+  const Acc* sumSquares() const { return this->SumSquares.data(); }
+
+private:
+  /// Adds the 2-D box sums of slice `entering` and subtracts those of `leaving` (-1: none).
+  void addSliceDifference(std::int64_t entering, std::int64_t leaving)
+  {
+    if (entering < 0 && leaving < 0)
+    {
+      return;
+    }
+    const std::int64_t nx = this->Geo.region.size[0];
+    for (std::int64_t y = this->Geo.ys.lo; y < this->Geo.ys.hi; ++y)
+    {
+      this->boxRowDifference(y, entering, leaving);
+    }
+    this->accumulateColumns(this->XBox1.data(), this->Sum.data(), this->Run1.data(), nx);
+    this->accumulateColumns(this->XBox2.data(), this->SumSquares.data(), this->Run2.data(), nx);
+  }
+
+  /// x box sums of one row of (entering - leaving), stored at XBox[y - ys.lo].
+  void boxRowDifference(std::int64_t y, std::int64_t entering, std::int64_t leaving)
+  {
+    const std::int64_t span = this->Geo.xs.size();
+    const std::int64_t stride = this->Volume.stride;
+    Acc* p1 = this->Row1.data();
+    Acc* p2 = this->Row2.data();
+    const T* in = entering >= 0 ? this->Volume.row(y, entering) + this->Geo.xs.lo * stride : nullptr;
+    const T* out = leaving >= 0 ? this->Volume.row(y, leaving) + this->Geo.xs.lo * stride : nullptr;
+    // Prefix sums of the difference row; p[i] = sum of the first i values.
+    p1[0] = 0;
+    p2[0] = 0;
+    for (std::int64_t i = 0; i < span; ++i)
+    {
+      const Acc a = in ? static_cast<Acc>(in[i * stride]) - this->Shift : Acc(0);
+      const Acc b = out ? static_cast<Acc>(out[i * stride]) - this->Shift : Acc(0);
+      p1[i + 1] = p1[i] + (a - b);
+      p2[i + 1] = p2[i] + (a * a - b * b);
+    }
+    const std::int64_t nx = this->Geo.region.size[0];
+    const std::int64_t r = this->Geo.radius.x;
+    const std::int64_t x0 = this->Geo.region.begin[0] - this->Geo.xs.lo; // first output in span
+    Acc* box1 = this->XBox1.data() + (y - this->Geo.ys.lo) * nx;
+    Acc* box2 = this->XBox2.data() + (y - this->Geo.ys.lo) * nx;
+    for (std::int64_t i = 0; i < nx; ++i)
+    {
+      const std::int64_t lo = std::max<std::int64_t>(0, x0 + i - r);
+      const std::int64_t hi = std::min<std::int64_t>(span, x0 + i + r + 1);
+      box1[i] = p1[hi] - p1[lo];
+      box2[i] = p2[hi] - p2[lo];
+    }
+  }
+
+  /// plane[y] += sum of the x-box rows in y's clipped window, by a running sum over rows.
+  void accumulateColumns(const Acc* xbox, Acc* plane, Acc* run, std::int64_t nx)
+  {
+    const std::int64_t r = this->Geo.radius.y;
+    const std::int64_t ny = this->Geo.dims[1];
+    const std::int64_t y0 = this->Geo.region.begin[1];
+    const std::int64_t yLo = this->Geo.ys.lo;
+    std::fill(run, run + nx, Acc(0));
+    for (std::int64_t y = std::max<std::int64_t>(0, y0 - r); y <= std::min(ny - 1, y0 + r); ++y)
+    {
+      const Acc* src = xbox + (y - yLo) * nx;
+      for (std::int64_t i = 0; i < nx; ++i)
+      {
+        run[i] += src[i];
+      }
+    }
+    for (std::int64_t row = 0; row < this->Geo.region.size[1]; ++row)
+    {
+      Acc* dst = plane + row * nx;
+      for (std::int64_t i = 0; i < nx; ++i)
+      {
+        dst[i] += run[i];
+      }
+      const std::int64_t y = y0 + row;
+      const std::int64_t entering = y + r + 1;
+      const std::int64_t leaving = y - r;
+      if (entering < ny)
+      {
+        const Acc* src = xbox + (entering - yLo) * nx;
+        for (std::int64_t i = 0; i < nx; ++i)
+        {
+          run[i] += src[i];
+        }
+      }
+      if (leaving >= 0)
+      {
+        const Acc* src = xbox + (leaving - yLo) * nx;
+        for (std::int64_t i = 0; i < nx; ++i)
+        {
+          run[i] -= src[i];
+        }
+      }
+    }
+  }
+
+  const TypedVolume<T>& Volume;
+  const BoxGeometry& Geo;
+  Acc Shift;
+  std::vector<Acc> Sum, SumSquares;
+  std::vector<Acc> Row1, Row2;
+  std::vector<Acc> XBox1, XBox2;
+  std::vector<Acc> Run1, Run2;
+};
+
+/// The shift subtracted before squaring: integral (keeps int64 sums exact) or not.
+template <class T>
+typename MomentTraits<T>::Accumulator momentShift(const TypedVolume<T>& volume)
+{
+  const double mean = sampledMean(volume);
+  if (MomentTraits<T>::exactInteger)
+  {
+    return static_cast<typename MomentTraits<T>::Accumulator>(std::llround(mean));
+  }
+  return static_cast<typename MomentTraits<T>::Accumulator>(mean);
+}
+
+/// Per-slice view handed to the consumer of the moments: everything needed to turn the
+/// sums of slice z into statistics.
+template <class T>
+struct MomentSlice
+{
+  using Acc = typename MomentTraits<T>::Accumulator;
+  std::int64_t z;         // output slice, volume coordinates
+  const Acc* sum;         // region plane, x fastest
+  const Acc* sumSquares;  //
+  double shift;           // add to sum / count to get the mean
+  double countZ;          // clipped window size along z
+};
+
+/// Mean and variance from the shifted sums of one box of `count` voxels.
+template <class Acc>
+inline void momentsToMeanVariance(Acc sum, Acc sumSquares, double count, double shift,
+  double& mean, double& variance)
+{
+  const double m1 = static_cast<double>(sum) / count;
+  const double v = static_cast<double>(sumSquares) / count - m1 * m1;
+  mean = m1 + shift;
+  variance = v > 0.0 ? v : 0.0;
+}
+
+/// Streams the moment planes of every region slice to consume(slice) on worker threads;
+/// each thread takes a contiguous chunk of slices. Returns false when cancelled.
+template <class T, class Consume>
+bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
+  const Execution& execution, Consume&& consume)
+{
+  const auto shift = momentShift(volume);
+  const int threads = resolveThreadCount(execution.threads);
+  const std::int64_t nz = geometry.region.size[2];
+  LoopControl control(execution, nz);
+  parallelChunks(
+    nz, threads,
+    [&](std::int64_t begin, std::int64_t end, bool caller) {
+      MomentPlanes<T> planes(volume, geometry, shift);
+      for (std::int64_t k = begin; k < end; ++k)
+      {
+        const std::int64_t z = geometry.region.begin[2] + k;
+        if (k == begin)
+        {
+          planes.startAt(z);
+        }
+        else
+        {
+          planes.advanceFrom(z - 1);
+        }
+        MomentSlice<T> slice{ z, planes.sum(), planes.sumSquares(), static_cast<double>(shift),
+          static_cast<double>(clippedWindowCount(z, geometry.radius.z, geometry.dims[2])) };
+        consume(slice);
+        if (!control.advance(1, caller))
+        {
+          return;
+        }
+      }
+    },
+    threads);
+  return !control.stopped();
+}
+
+/// Box minimum and maximum of every region voxel, as region-sized arrays of T.
+template <class T>
+struct BoxExtrema
+{
+  std::vector<T> minimum;
+  std::vector<T> maximum;
+};
+
+/// Three van Herk passes: x then y within each slice the region reads (into planes of
+/// region width), then z along each region row. Progress: slices, then rows.
+template <class T>
+bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry,
+  const Execution& execution, BoxExtrema<T>& result)
+{
+  const Region& region = geometry.region;
+  const std::int64_t nx = region.size[0];
+  const std::int64_t plane = geometry.planeSize();
+  const std::int64_t slices = geometry.zs.size();
+  std::vector<T> planeMin(static_cast<std::size_t>(slices * plane));
+  std::vector<T> planeMax(static_cast<std::size_t>(slices * plane));
+  const int threads = resolveThreadCount(execution.threads);
+  LoopControl control(execution, slices + region.size[1]);
+
+  parallelChunks(
+    slices, threads,
+    [&](std::int64_t begin, std::int64_t end, bool caller) {
+      const std::int64_t span = geometry.xs.size();
+      const std::int64_t rows = geometry.ys.size();
+      std::vector<T> row(static_cast<std::size_t>(span));
+      std::vector<T> xMin(static_cast<std::size_t>(rows * nx));
+      std::vector<T> xMax(static_cast<std::size_t>(rows * nx));
+      ExtremumScratch<T> scratch;
+      for (std::int64_t s = begin; s < end && !control.stopped(); ++s)
+      {
+        const std::int64_t z = geometry.zs.lo + s;
+        for (std::int64_t j = 0; j < rows; ++j)
+        {
+          const T* src = volume.row(geometry.ys.lo + j, z) + geometry.xs.lo * volume.stride;
+          for (std::int64_t i = 0; i < span; ++i)
+          {
+            row[i] = src[i * volume.stride];
+          }
+          const std::int64_t x0 = region.begin[0] - geometry.xs.lo;
+          slidingExtremum(row.data(), span, 1, geometry.radius.x, x0, nx, &xMin[j * nx], scratch, MinOp{});
+          slidingExtremum(row.data(), span, 1, geometry.radius.x, x0, nx, &xMax[j * nx], scratch, MaxOp{});
+        }
+        const std::int64_t y0 = region.begin[1] - geometry.ys.lo;
+        slidingExtremum(xMin.data(), rows, nx, geometry.radius.y, y0, region.size[1],
+          &planeMin[s * plane], scratch, MinOp{});
+        slidingExtremum(xMax.data(), rows, nx, geometry.radius.y, y0, region.size[1],
+          &planeMax[s * plane], scratch, MaxOp{});
+        control.advance(1, caller);
+      }
+    },
+    threads);
+  if (control.stopped())
+  {
+    return false;
+  }
+
+  result.minimum.resize(static_cast<std::size_t>(region.voxelCount()));
+  result.maximum.resize(static_cast<std::size_t>(region.voxelCount()));
+  parallelChunks(
+    region.size[1], threads,
+    [&](std::int64_t begin, std::int64_t end, bool caller) {
+      std::vector<T> lanes(static_cast<std::size_t>(slices * nx));
+      std::vector<T> out(static_cast<std::size_t>(region.size[2] * nx));
+      ExtremumScratch<T> scratch;
+      const std::int64_t z0 = region.begin[2] - geometry.zs.lo;
+      for (std::int64_t y = begin; y < end && !control.stopped(); ++y)
+      {
+        auto zPass = [&](const std::vector<T>& source, std::vector<T>& target, auto op) {
+          for (std::int64_t s = 0; s < slices; ++s)
+          {
+            const T* src = source.data() + s * plane + y * nx;
+            std::copy(src, src + nx, &lanes[s * nx]);
+          }
+          slidingExtremum(lanes.data(), slices, nx, geometry.radius.z, z0, region.size[2],
+            out.data(), scratch, op);
+          for (std::int64_t k = 0; k < region.size[2]; ++k)
+          {
+            std::copy(&out[k * nx], &out[k * nx] + nx, target.data() + k * plane + y * nx);
+          }
+        };
+        zPass(planeMin, result.minimum, MinOp{});
+        zPass(planeMax, result.maximum, MaxOp{});
+        control.advance(1, caller);
+      }
+    },
+    threads);
+  return !control.stopped();
+}
+
+} // namespace detail
+} // namespace vao

@@ -1,0 +1,113 @@
+// Typed access to a VolumeView, the scalar-type dispatch and the exact-accumulation traits.
+#pragma once
+
+#include "vao/AmbientOcclusion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <type_traits>
+
+namespace vao
+{
+namespace detail
+{
+
+/// Calls f(T{}) with T the C++ type of `type`.
+template <class F>
+auto dispatchScalarType(ScalarType type, F&& f)
+{
+  switch (type)
+  {
+    case ScalarType::Int8:
+      return f(std::int8_t{});
+    case ScalarType::UInt8:
+      return f(std::uint8_t{});
+    case ScalarType::Int16:
+      return f(std::int16_t{});
+    case ScalarType::UInt16:
+      return f(std::uint16_t{});
+    case ScalarType::Int32:
+      return f(std::int32_t{});
+    case ScalarType::UInt32:
+      return f(std::uint32_t{});
+    case ScalarType::Int64:
+      return f(std::int64_t{});
+    case ScalarType::UInt64:
+      return f(std::uint64_t{});
+    case ScalarType::Float64:
+      return f(double{});
+    case ScalarType::Float32:
+    default:
+      return f(float{});
+  }
+}
+
+/// Sums of v and v^2 are exact in int64 for types of up to 16 bits (after an integer shift,
+/// |v - K|^2 < 2^32, so 2^31 voxels fit); wider types accumulate in double after a shift
+/// by a representative value, which removes the catastrophic cancellation of E[v^2] - mu^2.
+template <class T>
+struct MomentTraits
+{
+  static constexpr bool exactInteger = std::is_integral<T>::value && sizeof(T) <= 2;
+  using Accumulator = typename std::conditional<exactInteger, std::int64_t, double>::type;
+};
+
+/// Read-only typed view of the volume: value(x, y, z) with the voxel stride applied.
+template <class T>
+struct TypedVolume
+{
+  const T* data;
+  Index3 dims;
+  std::int64_t stride;
+
+  explicit TypedVolume(const VolumeView& view)
+    : data(static_cast<const T*>(view.data))
+    , dims(view.dims)
+    , stride(view.voxelStride)
+  {
+  }
+
+  std::int64_t index(std::int64_t x, std::int64_t y, std::int64_t z) const
+  {
+    return (z * dims[1] + y) * dims[0] + x;
+  }
+  T value(std::int64_t x, std::int64_t y, std::int64_t z) const
+  {
+    return data[index(x, y, z) * stride];
+  }
+  /// Pointer to the start of row (y, z); consecutive voxels are `stride` elements apart.
+  const T* row(std::int64_t y, std::int64_t z) const { return data + index(0, y, z) * stride; }
+};
+
+/// Mean of up to ~65k evenly spaced voxels: the shift that keeps squared sums small.
+template <class T>
+double sampledMean(const TypedVolume<T>& volume)
+{
+  const std::int64_t n = volume.dims[0] * volume.dims[1] * volume.dims[2];
+  const std::int64_t step = std::max<std::int64_t>(1, n / 65536);
+  double sum = 0.0;
+  std::int64_t count = 0;
+  for (std::int64_t i = 0; i < n; i += step, ++count)
+  {
+    sum += static_cast<double>(volume.data[i * volume.stride]);
+  }
+  return count > 0 ? sum / count : 0.0;
+}
+
+/// The clipped span [lo, hi) of input indices that the region [begin, begin + size)
+/// reads along one axis of n voxels with half-width r.
+struct AxisSpan
+{
+  std::int64_t lo;
+  std::int64_t hi;
+  std::int64_t size() const { return hi - lo; }
+};
+
+inline AxisSpan readSpan(std::int64_t begin, std::int64_t size, std::int64_t r, std::int64_t n)
+{
+  return { std::max<std::int64_t>(0, begin - r), std::min<std::int64_t>(n, begin + size + r) };
+}
+
+} // namespace detail
+} // namespace vao

@@ -1,0 +1,206 @@
+// The separable box statistics against a brute-force reference.
+#include "TestVolumes.h"
+
+#include <gtest/gtest.h>
+
+using namespace vaotest;
+
+namespace
+{
+
+struct StatsArrays
+{
+  std::vector<double> count, mean, variance, minimum, maximum;
+  explicit StatsArrays(std::int64_t n)
+    : count(n), mean(n), variance(n), minimum(n), maximum(n)
+  {
+  }
+  vao::BoxStatisticsOutput output()
+  {
+    return { count.data(), mean.data(), variance.data(), minimum.data(), maximum.data() };
+  }
+};
+
+bool closeRelative(double a, double b, double tolerance)
+{
+  return std::abs(a - b) <= tolerance * std::max(1.0, std::abs(b));
+}
+
+/// Checks every voxel of `region` against brute force: min/max exact, the rest to 1e-9.
+template <class T>
+void expectStatsMatchBruteForce(const std::vector<T>& v, const vao::Index3& dims,
+  const vao::Radius& r, const vao::Region& region, int threads)
+{
+  StatsArrays got(region.voxelCount());
+  vao::Execution execution;
+  execution.threads = threads;
+  const vao::Status status =
+    vao::computeBoxStatistics(viewOf(v, dims), region, r, got.output(), execution);
+  ASSERT_TRUE(status.ok) << status.message;
+  std::int64_t k = 0, failures = 0;
+  for (std::int64_t z = region.begin[2]; z < region.begin[2] + region.size[2]; ++z)
+    for (std::int64_t y = region.begin[1]; y < region.begin[1] + region.size[1]; ++y)
+      for (std::int64_t x = region.begin[0]; x < region.begin[0] + region.size[0]; ++x, ++k)
+      {
+        const ReferenceStats ref = bruteForceStats(v, dims, r, x, y, z);
+        const bool ok = got.count[k] == ref.count && got.minimum[k] == ref.minimum &&
+          got.maximum[k] == ref.maximum && closeRelative(got.mean[k], ref.mean, 1e-9) &&
+          closeRelative(got.variance[k], ref.variance, 1e-9);
+        if (!ok && failures++ < 5)
+        {
+          ADD_FAILURE() << "voxel (" << x << "," << y << "," << z << ") radius (" << r.x << ","
+                        << r.y << "," << r.z << "): count " << got.count[k] << " vs " << ref.count
+                        << ", mean " << got.mean[k] << " vs " << ref.mean << ", variance "
+                        << got.variance[k] << " vs " << ref.variance << ", min " << got.minimum[k]
+                        << " vs " << ref.minimum << ", max " << got.maximum[k] << " vs "
+                        << ref.maximum;
+        }
+      }
+  EXPECT_EQ(failures, 0);
+}
+
+template <class T>
+class BoxStatisticsTyped : public ::testing::Test
+{
+};
+
+using ScalarTypes = ::testing::Types<std::int8_t, std::uint8_t, std::int16_t, std::uint16_t,
+  std::int32_t, std::uint32_t, std::int64_t, std::uint64_t, float, double>;
+TYPED_TEST_SUITE(BoxStatisticsTyped, ScalarTypes);
+
+TYPED_TEST(BoxStatisticsTyped, IsotropicRadiiZeroToSixOnOddVolume)
+{
+  const vao::Index3 dims = { 17, 11, 9 };
+  const double lo = std::is_signed<TypeParam>::value ? -100 : 0;
+  const auto v = randomVolume<TypeParam>(dims, lo, lo + 120, 7);
+  for (int r = 0; r <= 6; ++r)
+  {
+    SCOPED_TRACE(r);
+    expectStatsMatchBruteForce(v, dims, { r, r, r }, vao::Region::whole(viewOf(v, dims)), 2);
+  }
+}
+
+TYPED_TEST(BoxStatisticsTyped, AnisotropicRadiiAndRadiiLargerThanTheVolume)
+{
+  const vao::Index3 dims = { 13, 7, 10 };
+  const auto v = randomVolume<TypeParam>(dims, 0, 90, 11);
+  const vao::Radius radii[] = { { 1, 0, 2 }, { 3, 1, 0 }, { 0, 5, 1 }, { 20, 2, 4 }, { 2, 30, 40 },
+    { 50, 50, 50 } };
+  for (const auto& r : radii)
+  {
+    SCOPED_TRACE(testing::Message() << r.x << "," << r.y << "," << r.z);
+    expectStatsMatchBruteForce(v, dims, r, vao::Region::whole(viewOf(v, dims)), 3);
+  }
+}
+
+TEST(BoxStatistics, SubRegionsAndThreadCounts)
+{
+  const vao::Index3 dims = { 19, 15, 21 };
+  const auto v = randomVolume<std::int16_t>(dims, -1000, 1500, 3);
+  const vao::Region regions[] = { { { 3, 2, 5 }, { 9, 7, 11 } }, { { 0, 14, 0 }, { 19, 1, 21 } },
+    { { 18, 0, 20 }, { 1, 15, 1 } } };
+  for (const auto& region : regions)
+    for (int threads : { 1, 2, 5 })
+      expectStatsMatchBruteForce(v, dims, { 4, 2, 3 }, region, threads);
+}
+
+TEST(BoxStatistics, ReadsOneComponentThroughTheStride)
+{
+  const vao::Index3 dims = { 9, 8, 7 };
+  const auto scalar = randomVolume<float>(dims, -5, 5, 5);
+  std::vector<float> interleaved(scalar.size() * 3, 1e30f);
+  for (std::size_t i = 0; i < scalar.size(); ++i)
+    interleaved[3 * i + 1] = scalar[i];
+  const vao::Radius r{ 2, 3, 1 };
+  const auto region = vao::Region::whole(viewOf(scalar, dims));
+  StatsArrays a(region.voxelCount()), b(region.voxelCount());
+  ASSERT_TRUE(vao::computeBoxStatistics(viewOf(scalar, dims), region, r, a.output()).ok);
+  vao::VolumeView strided = viewOf(interleaved, dims, 3);
+  strided.data = interleaved.data() + 1;
+  ASSERT_TRUE(vao::computeBoxStatistics(strided, region, r, b.output()).ok);
+  EXPECT_EQ(a.mean, b.mean);
+  EXPECT_EQ(a.variance, b.variance);
+  EXPECT_EQ(a.minimum, b.minimum);
+  EXPECT_EQ(a.maximum, b.maximum);
+}
+
+/// Catastrophic cancellation: large offsets with small local deviations.
+template <class T>
+void expectVarianceOfOffsetNoise(double offset, double amplitude, bool integerNoise)
+{
+  const vao::Index3 dims = { 31, 29, 27 };
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> noise(-amplitude, amplitude);
+  std::vector<T> v(dims[0] * dims[1] * dims[2]);
+  for (auto& value : v)
+    value = static_cast<T>(offset + (integerNoise ? std::round(noise(rng)) : noise(rng)));
+  const vao::Radius r{ 5, 5, 5 };
+  const auto region = vao::Region::whole(viewOf(v, dims));
+  StatsArrays got(region.voxelCount());
+  ASSERT_TRUE(vao::computeBoxStatistics(viewOf(v, dims), region, r, got.output()).ok);
+  double worst = 0;
+  std::int64_t k = 0;
+  for (std::int64_t z = 0; z < dims[2]; z += 3)
+    for (std::int64_t y = 0; y < dims[1]; y += 2)
+      for (std::int64_t x = 0; x < dims[0]; ++x)
+      {
+        k = (z * dims[1] + y) * dims[0] + x;
+        const auto ref = bruteForceStats(v, dims, r, x, y, z);
+        worst = std::max(worst, std::abs(got.variance[k] - ref.variance));
+        ASSERT_GT(ref.variance, 0.1);
+      }
+  EXPECT_LE(worst, 1e-3) << "worst absolute variance error";
+}
+
+TEST(BoxStatisticsPrecision, Int16At30000WithNoiseOfTwo)
+{
+  expectVarianceOfOffsetNoise<std::int16_t>(30000, 2, true);
+}
+
+TEST(BoxStatisticsPrecision, FloatAtOneMillionWithUnitDeviations)
+{
+  expectVarianceOfOffsetNoise<float>(1e6, 1.5, false);
+}
+
+TEST(BoxStatisticsPrecision, DoubleAtOneBillionWithUnitDeviations)
+{
+  expectVarianceOfOffsetNoise<double>(1e9, 1.5, false);
+}
+
+TEST(BoxStatisticsValidation, RejectsBadArguments)
+{
+  const vao::Index3 dims = { 5, 5, 5 };
+  const auto v = randomVolume<float>(dims, 0, 1, 1);
+  StatsArrays out(125);
+  const auto whole = vao::Region::whole(viewOf(v, dims));
+  EXPECT_FALSE(vao::computeBoxStatistics(viewOf(v, dims), whole, { -1, 1, 1 }, out.output()).ok);
+  EXPECT_FALSE(vao::computeBoxStatistics(viewOf(v, { 0, 5, 5 }), whole, { 1, 1, 1 }, out.output()).ok);
+  vao::Region outside{ { 3, 0, 0 }, { 5, 5, 5 } };
+  EXPECT_FALSE(vao::computeBoxStatistics(viewOf(v, dims), outside, { 1, 1, 1 }, out.output()).ok);
+  vao::VolumeView null = viewOf(v, dims);
+  null.data = nullptr;
+  EXPECT_FALSE(vao::computeBoxStatistics(null, whole, { 1, 1, 1 }, out.output()).ok);
+}
+
+TEST(BoxStatisticsExecution, HonoursCancellationAndReportsProgress)
+{
+  const vao::Index3 dims = { 20, 20, 40 };
+  const auto v = randomVolume<std::uint8_t>(dims, 0, 255, 9);
+  StatsArrays out(dims[0] * dims[1] * dims[2]);
+  std::vector<double> progress;
+  vao::Execution execution;
+  execution.threads = 2;
+  execution.progress = [&](double p) { progress.push_back(p); };
+  const auto whole = vao::Region::whole(viewOf(v, dims));
+  ASSERT_TRUE(vao::computeBoxStatistics(viewOf(v, dims), whole, { 2, 2, 2 }, out.output(), execution).ok);
+  ASSERT_FALSE(progress.empty());
+  EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
+  EXPECT_LE(progress.back(), 1.0);
+  execution.abortRequested = [] { return true; };
+  const vao::Status status =
+    vao::computeBoxStatistics(viewOf(v, dims), whole, { 2, 2, 2 }, out.output(), execution);
+  EXPECT_FALSE(status.ok);
+  EXPECT_TRUE(status.aborted);
+}
+
+} // namespace

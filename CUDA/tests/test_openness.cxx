@@ -1,0 +1,185 @@
+// computeAmbientOcclusion end to end on random volumes: the exact references against an
+// independent brute force, the separable estimators against the formulas applied to
+// brute-force statistics, the properties of METHODS.md, and decomposition invariance.
+#include "TestVolumes.h"
+
+#include <gtest/gtest.h>
+
+using namespace vaotest;
+
+namespace
+{
+
+using vao::Method;
+
+std::vector<float> openness(const vao::VolumeView& view, const vao::Region& region, Method method,
+  vao::Radius r, vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0,
+  vao::ErfMode erf = vao::ErfMode::Exact, std::vector<float>* variance = nullptr)
+{
+  std::vector<float> out(region.voxelCount(), -1.0f);
+  vao::AmbientOcclusionParameters p;
+  p.method = method;
+  p.radius = r;
+  p.queryMode = query;
+  p.isoValue = iso;
+  p.erfMode = erf;
+  vao::AmbientOcclusionOutput output{ out.data(), nullptr };
+  if (variance)
+  {
+    variance->assign(region.voxelCount(), -1.0f);
+    output.variance = variance->data();
+  }
+  const vao::Status status = vao::computeAmbientOcclusion(view, region, p, output);
+  EXPECT_TRUE(status.ok) << status.message;
+  return out;
+}
+
+template <class T>
+void expectMatchesBruteForce(const std::vector<T>& v, const vao::Index3& dims, vao::Radius r,
+  vao::QueryMode query, double iso)
+{
+  const auto view = viewOf(v, dims);
+  const auto whole = vao::Region::whole(view);
+  std::vector<float> variance;
+  const auto exactBox = openness(view, whole, Method::ExactBox, r, query, iso);
+  const auto exactSphere = openness(view, whole, Method::ExactSphere, r, query, iso);
+  const auto cdf = openness(view, whole, Method::CdfReconstruction, r, query, iso);
+  const auto gauss = openness(view, whole, Method::GaussianCdf, r, query, iso, vao::ErfMode::Exact, &variance);
+  const auto winitzki = openness(view, whole, Method::GaussianCdf, r, query, iso, vao::ErfMode::Winitzki);
+  const auto cheb = openness(view, whole, Method::Chebyshev, r, query, iso);
+  std::int64_t k = 0, failures = 0;
+  for (std::int64_t z = 0; z < dims[2]; ++z)
+    for (std::int64_t y = 0; y < dims[1]; ++y)
+      for (std::int64_t x = 0; x < dims[0]; ++x, ++k)
+      {
+        const double q = query == vao::QueryMode::IsoValue ? iso : double(v[k]);
+        const auto ref = bruteForceStats(v, dims, r, x, y, z);
+        const vao::NeighbourhoodStats s{ ref.mean, ref.variance, ref.minimum, ref.maximum };
+        const double expected[] = { bruteForceOpenness(v, dims, r, x, y, z, q, false),
+          bruteForceOpenness(v, dims, r, x, y, z, q, true),
+          vao::opennessCdfReconstruction(q, s), vao::opennessGaussianCdf(q, s, vao::ErfMode::Exact),
+          vao::opennessGaussianCdf(q, s, vao::ErfMode::Winitzki), vao::opennessChebyshev(q, s) };
+        const float got[] = { exactBox[k], exactSphere[k], cdf[k], gauss[k], winitzki[k], cheb[k] };
+        for (int m = 0; m < 6; ++m)
+        {
+          if (std::abs(got[m] - expected[m]) > 2e-6 && failures++ < 8)
+            ADD_FAILURE() << "estimator " << m << " at (" << x << "," << y << "," << z << "): " << got[m]
+                          << " vs " << expected[m];
+          EXPECT_GE(got[m], 0.0f);
+          EXPECT_LE(got[m], 1.0f);
+        }
+        if (std::abs(variance[k] - ref.variance) > 1e-6 * std::max(1.0, ref.variance) && failures++ < 8)
+          ADD_FAILURE() << "variance at " << k << ": " << variance[k] << " vs " << ref.variance;
+        // Cantelli bound: Chebyshev never exceeds the exact box openness.
+        if (cheb[k] > exactBox[k] + 1e-6f && failures++ < 8)
+          ADD_FAILURE() << "Chebyshev above Exact Box at " << k;
+      }
+  EXPECT_EQ(failures, 0);
+}
+
+TEST(Openness, EveryMethodMatchesBruteForceOnRandomVolumes)
+{
+  const vao::Index3 dims = { 17, 11, 9 };
+  const auto v8 = randomVolume<std::uint8_t>(dims, 0, 6, 21); // few values: ties and flat boxes
+  const auto v16 = randomVolume<std::int16_t>(dims, -1024, 1600, 22);
+  const auto vf = randomVolume<float>(dims, -1, 1, 23);
+  for (int r = 0; r <= 4; ++r)
+  {
+    SCOPED_TRACE(r);
+    expectMatchesBruteForce(v8, dims, { r, r, r }, vao::QueryMode::VoxelValue, 0);
+    expectMatchesBruteForce(v16, dims, { r, r, r }, vao::QueryMode::VoxelValue, 0);
+    expectMatchesBruteForce(vf, dims, { r, r, r }, vao::QueryMode::IsoValue, 0.25);
+  }
+  expectMatchesBruteForce(v16, dims, { 3, 1, 2 }, vao::QueryMode::IsoValue, 100.0);
+  expectMatchesBruteForce(v8, dims, { 0, 4, 1 }, vao::QueryMode::VoxelValue, 0);
+  expectMatchesBruteForce(v16, dims, { 30, 30, 30 }, vao::QueryMode::VoxelValue, 0);
+}
+
+TEST(Openness, ExactSphereIsTheInscribedEllipsoid)
+{
+  // A single bright voxel at the centre; count how many voxels of the sphere around a
+  // dark corner voxel see it: none at the corner of the box, so box and sphere differ.
+  const vao::Index3 dims = { 11, 11, 11 };
+  std::vector<float> v(11 * 11 * 11, 0.0f);
+  v[(5 * 11 + 5) * 11 + 5] = 1.0f;
+  const auto view = viewOf(v, dims);
+  const vao::Region corner{ { 2, 2, 2 }, { 1, 1, 1 } };
+  const vao::Region face{ { 5, 5, 2 }, { 1, 1, 1 } };
+  // The box of radius 3 around (2,2,2), clipped to 6^3 voxels, contains (5,5,5); the
+  // sphere does not (distance 5.2 > 3).
+  EXPECT_FLOAT_EQ(openness(view, corner, Method::ExactBox, { 3, 3, 3 })[0], 1.0f - 1.0f / 216);
+  EXPECT_FLOAT_EQ(openness(view, corner, Method::ExactSphere, { 3, 3, 3 })[0], 1.0f);
+  // Along the axis at distance 3 it is on the sphere's surface: included.
+  const float sphere = openness(view, face, Method::ExactSphere, { 3, 3, 3 })[0];
+  EXPECT_LT(sphere, 1.0f);
+}
+
+template <class T>
+void expectPieceEqualsWhole(const std::vector<T>& v, const vao::Index3& dims, Method method,
+  vao::Radius r, float tolerance)
+{
+  // A distributed run hands each rank its piece grown by the radius and clipped to the
+  // whole extent; the piece's results must be those of the whole volume.
+  const auto view = viewOf(v, dims);
+  const auto whole = openness(view, vao::Region::whole(view), method, r);
+  const vao::Region piece{ { 4, 0, 6 }, { 7, dims[1], 5 } };
+  const vao::Index3 lo = { std::max<std::int64_t>(0, piece.begin[0] - r.x), 0,
+    std::max<std::int64_t>(0, piece.begin[2] - r.z) };
+  const vao::Index3 hi = { std::min(dims[0], piece.begin[0] + piece.size[0] + r.x), dims[1],
+    std::min(dims[2], piece.begin[2] + piece.size[2] + r.z) };
+  const vao::Index3 cropDims = { hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2] };
+  std::vector<T> crop;
+  for (std::int64_t z = lo[2]; z < hi[2]; ++z)
+    for (std::int64_t y = lo[1]; y < hi[1]; ++y)
+      for (std::int64_t x = lo[0]; x < hi[0]; ++x)
+        crop.push_back(v[(z * dims[1] + y) * dims[0] + x]);
+  const vao::Region inCrop{ { piece.begin[0] - lo[0], 0, piece.begin[2] - lo[2] }, piece.size };
+  const auto part = openness(viewOf(crop, cropDims), inCrop, method, r);
+  std::int64_t k = 0;
+  for (std::int64_t z = piece.begin[2]; z < piece.begin[2] + piece.size[2]; ++z)
+    for (std::int64_t y = 0; y < dims[1]; ++y)
+      for (std::int64_t x = piece.begin[0]; x < piece.begin[0] + piece.size[0]; ++x, ++k)
+        ASSERT_NEAR(part[k], whole[(z * dims[1] + y) * dims[0] + x], tolerance) << x << "," << y << "," << z;
+}
+
+TEST(Openness, APieceGrownByTheRadiusGivesTheWholeVolumesNumbers)
+{
+  const vao::Index3 dims = { 15, 9, 17 };
+  const auto v16 = randomVolume<std::int16_t>(dims, -500, 500, 31);
+  const auto vd = randomVolume<double>(dims, 1e6, 1e6 + 10, 32);
+  for (auto method : { Method::CdfReconstruction, Method::GaussianCdf, Method::Chebyshev, Method::ExactBox, Method::ExactSphere })
+  {
+    expectPieceEqualsWhole(v16, dims, method, { 3, 2, 4 }, 0.0f);
+    expectPieceEqualsWhole(vd, dims, method, { 2, 3, 3 }, 1e-6f);
+  }
+}
+
+TEST(Openness, RejectsNonFiniteIsoValue)
+{
+  const vao::Index3 dims = { 4, 4, 4 };
+  const auto v = randomVolume<float>(dims, 0, 1, 1);
+  std::vector<float> out(64);
+  vao::AmbientOcclusionParameters p;
+  p.radius = { 1, 1, 1 };
+  p.queryMode = vao::QueryMode::IsoValue;
+  p.isoValue = std::nan("");
+  const auto status = vao::computeAmbientOcclusion(viewOf(v, dims), vao::Region::whole(viewOf(v, dims)), p, { out.data(), nullptr });
+  EXPECT_FALSE(status.ok);
+}
+
+TEST(Openness, CountsNonFiniteVoxels)
+{
+  const vao::Index3 dims = { 4, 4, 4 };
+  auto v = randomVolume<float>(dims, 0, 1, 1);
+  EXPECT_EQ(vao::countNonFinite(viewOf(v, dims)), 0);
+  v[17] = std::nanf("");
+  v[40] = INFINITY;
+  std::int64_t first = -1;
+  EXPECT_EQ(vao::countNonFinite(viewOf(v, dims), &first), 2);
+  EXPECT_EQ(first, 17);
+  const auto range = vao::valueRange(viewOf(randomVolume<std::int16_t>(dims, -5, 7, 2), dims));
+  EXPECT_GE(range[0], -5);
+  EXPECT_LE(range[1], 7);
+}
+
+} // namespace
