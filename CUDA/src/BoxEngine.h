@@ -44,13 +44,13 @@ struct BoxGeometry
 
   std::int64_t planeSize() const { return region.size[0] * region.size[1]; }
   /// Clipped window sizes along x and y of every region column and row.
-  std::vector<double> windowCounts(int axis) const
+  std::vector<std::int64_t> windowCounts(int axis) const
   {
     const int r = axis == 0 ? radius.x : (axis == 1 ? radius.y : radius.z);
-    std::vector<double> counts(static_cast<std::size_t>(region.size[axis]));
+    std::vector<std::int64_t> counts(static_cast<std::size_t>(region.size[axis]));
     for (std::int64_t i = 0; i < region.size[axis]; ++i)
     {
-      counts[i] = static_cast<double>(clippedWindowCount(region.begin[axis] + i, r, dims[axis]));
+      counts[i] = clippedWindowCount(region.begin[axis] + i, r, dims[axis]);
     }
     return counts;
   }
@@ -207,16 +207,17 @@ private:
   std::vector<Acc> Run1, Run2;
 };
 
-/// The shift subtracted before squaring: integral (keeps int64 sums exact) or not.
+/// The value subtracted before squaring: none for exact integer sums (so the sums, and
+/// everything after them, do not depend on which piece of the volume a run holds), a
+/// sampled mean for double sums.
 template <class T>
 typename MomentTraits<T>::Accumulator momentShift(const TypedVolume<T>& volume)
 {
-  const double mean = sampledMean(volume);
   if (MomentTraits<T>::exactInteger)
   {
-    return static_cast<typename MomentTraits<T>::Accumulator>(std::llround(mean));
+    return 0;
   }
-  return static_cast<typename MomentTraits<T>::Accumulator>(mean);
+  return static_cast<typename MomentTraits<T>::Accumulator>(sampledMean(volume));
 }
 
 /// Per-slice view handed to the consumer of the moments: everything needed to turn the
@@ -229,18 +230,20 @@ struct MomentSlice
   const Acc* sum;         // region plane, x fastest
   const Acc* sumSquares;  //
   double shift;           // add to sum / count to get the mean
-  double countZ;          // clipped window size along z
+  std::int64_t countZ;    // clipped window size along z
 };
 
-/// Mean and variance from the shifted sums of one box of `count` voxels.
-template <class Acc>
-inline void momentsToMeanVariance(Acc sum, Acc sumSquares, double count, double shift,
+/// Mean and variance of one box from its sums (exact or shifted, by accumulator type).
+inline void momentsToMeanVariance(std::int64_t sum, std::int64_t sumSquares, std::int64_t count,
+  double, double& mean, double& variance)
+{
+  meanVarianceFromExactSums(sum, sumSquares, count, mean, variance);
+}
+
+inline void momentsToMeanVariance(double sum, double sumSquares, std::int64_t count, double shift,
   double& mean, double& variance)
 {
-  const double m1 = static_cast<double>(sum) / count;
-  const double v = static_cast<double>(sumSquares) / count - m1 * m1;
-  mean = m1 + shift;
-  variance = v > 0.0 ? v : 0.0;
+  meanVarianceFromShiftedSums(sum, sumSquares, count, shift, mean, variance);
 }
 
 /// Streams the moment planes of every region slice to consume(slice) on worker threads;
@@ -269,7 +272,7 @@ bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
           planes.advanceFrom(z - 1);
         }
         MomentSlice<T> slice{ z, planes.sum(), planes.sumSquares(), static_cast<double>(shift),
-          static_cast<double>(clippedWindowCount(z, geometry.radius.z, geometry.dims[2])) };
+          clippedWindowCount(z, geometry.radius.z, geometry.dims[2]) };
         consume(slice);
         if (!control.advance(1, caller))
         {

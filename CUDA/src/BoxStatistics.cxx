@@ -37,12 +37,12 @@ Status computeBoxStatistics(const VolumeView& view, const Region& region, const 
           {
             const std::int64_t p = j * nx + i;
             const std::int64_t k = base + p;
-            const double count = countX[i] * countY[j] * slice.countZ;
+            const std::int64_t count = countX[i] * countY[j] * slice.countZ;
             double mean, variance;
             detail::momentsToMeanVariance(slice.sum[p], slice.sumSquares[p], count, slice.shift, mean, variance);
             if (output.count)
             {
-              output.count[k] = count;
+              output.count[k] = static_cast<double>(count);
             }
             if (output.mean)
             {

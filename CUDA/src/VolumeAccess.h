@@ -43,9 +43,9 @@ auto dispatchScalarType(ScalarType type, F&& f)
   }
 }
 
-/// Sums of v and v^2 are exact in int64 for types of up to 16 bits (after an integer shift,
-/// |v - K|^2 < 2^32, so 2^31 voxels fit); wider types accumulate in double after a shift
-/// by a representative value, which removes the catastrophic cancellation of E[v^2] - mu^2.
+/// Sums of v and v^2 are exact in int64 for types of up to 16 bits (v^2 <= 2^32, so boxes
+/// of up to 2^31 voxels fit); wider types accumulate in double after a shift by a
+/// representative value, which removes the catastrophic cancellation of E[v^2] - mu^2.
 template <class T>
 struct MomentTraits
 {

@@ -151,6 +151,31 @@ VAO_HD double opennessFromStats(
   }
 }
 
+/// Mean and variance of a box of `count` voxels from exact integer sums of v and v^2.
+/// The numerator count * sumSquares - sum^2 is exact in 128 bits, so the variance is
+/// correctly rounded and does not depend on how the sums were formed: a distributed or
+/// streamed run gives the serial bits.
+VAO_HD void meanVarianceFromExactSums(
+  long long sum, long long sumSquares, long long count, double& mean, double& variance)
+{
+  const __int128 numerator = static_cast<__int128>(count) * sumSquares - static_cast<__int128>(sum) * sum;
+  const double n = static_cast<double>(count);
+  mean = static_cast<double>(sum) / n;
+  variance = numerator > 0 ? static_cast<double>(numerator) / (n * n) : 0.0;
+}
+
+/// Mean and variance from double sums of (v - shift) and (v - shift)^2: the shift keeps
+/// E[v^2] - mu^2 from cancelling catastrophically when values are large.
+VAO_HD void meanVarianceFromShiftedSums(
+  double sum, double sumSquares, long long count, double shift, double& mean, double& variance)
+{
+  const double n = static_cast<double>(count);
+  const double m1 = sum / n;
+  const double v = sumSquares / n - m1 * m1;
+  mean = m1 + shift;
+  variance = v > 0.0 ? v : 0.0;
+}
+
 /// Number of voxels of a window of half-width r around i, clipped to [0, n).
 VAO_HD long long clippedWindowCount(long long i, long long r, long long n)
 {

@@ -1,0 +1,422 @@
+#include "vtkVolumetricAmbientOcclusion.h"
+
+#include "vao/AmbientOcclusion.h"
+
+#include "vtkDataArray.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+vtkStandardNewMacro(vtkVolumetricAmbientOcclusion);
+
+namespace
+{
+
+const char* const MethodNames[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box",
+  "Exact Sphere" };
+
+bool ToKernelType(int vtkType, vao::ScalarType& type)
+{
+  switch (vtkType)
+  {
+    case VTK_CHAR:
+    case VTK_SIGNED_CHAR:
+      type = vao::ScalarType::Int8;
+      return true;
+    case VTK_UNSIGNED_CHAR:
+      type = vao::ScalarType::UInt8;
+      return true;
+    case VTK_SHORT:
+      type = vao::ScalarType::Int16;
+      return true;
+    case VTK_UNSIGNED_SHORT:
+      type = vao::ScalarType::UInt16;
+      return true;
+    case VTK_INT:
+      type = vao::ScalarType::Int32;
+      return true;
+    case VTK_UNSIGNED_INT:
+      type = vao::ScalarType::UInt32;
+      return true;
+    case VTK_LONG:
+    case VTK_LONG_LONG:
+    case VTK_ID_TYPE:
+      type = sizeof(long) == 8 || vtkType != VTK_LONG ? vao::ScalarType::Int64 : vao::ScalarType::Int32;
+      return true;
+    case VTK_UNSIGNED_LONG:
+    case VTK_UNSIGNED_LONG_LONG:
+      type = sizeof(unsigned long) == 8 || vtkType != VTK_UNSIGNED_LONG ? vao::ScalarType::UInt64
+                                                                         : vao::ScalarType::UInt32;
+      return true;
+    case VTK_FLOAT:
+      type = vao::ScalarType::Float32;
+      return true;
+    case VTK_DOUBLE:
+      type = vao::ScalarType::Float64;
+      return true;
+    default:
+      return false;
+  }
+}
+
+/// Grows ext by r on each axis, clipped to whole.
+void GrowExtent(int ext[6], const int r[3], const int whole[6])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    ext[2 * a] = std::max(ext[2 * a] - r[a], whole[2 * a]);
+    ext[2 * a + 1] = std::min(ext[2 * a + 1] + r[a], whole[2 * a + 1]);
+  }
+}
+
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkVolumetricAmbientOcclusion::vtkVolumetricAmbientOcclusion()
+{
+  this->SetInputArrayToProcess(
+    0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumetricAmbientOcclusion::ComputeVoxelRadius(const double spacing[3], int radius[3]) const
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    double voxels = this->Radius;
+    if (this->RadiusUnits == WORLD)
+    {
+      voxels = spacing[a] > 0.0 ? this->Radius / spacing[a] : 0.0;
+    }
+    // Bounded so an absurd radius cannot overflow; CheckParameters reports it.
+    voxels = std::isfinite(voxels) ? std::min(std::max(voxels, 0.0), 1e9) : 0.0;
+    radius[a] = static_cast<int>(std::lround(voxels));
+  }
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumetricAmbientOcclusion::CheckParameters()
+{
+  if (!std::isfinite(this->Radius) || this->Radius < 0.0)
+  {
+    vtkErrorMacro(<< "Radius must be a finite, non-negative number (got " << this->Radius << ").");
+    return false;
+  }
+  if (this->Method < CDF_RECONSTRUCTION || this->Method > EXACT_SPHERE)
+  {
+    vtkErrorMacro(<< "Unknown Method " << this->Method
+                  << " (0 CDF Reconstruction, 1 Gaussian CDF, 2 Chebyshev, 3 Exact Box, 4 Exact Sphere).");
+    return false;
+  }
+  if (this->RadiusUnits != VOXELS && this->RadiusUnits != WORLD)
+  {
+    vtkErrorMacro(<< "Unknown RadiusUnits " << this->RadiusUnits << " (0 Voxels, 1 World).");
+    return false;
+  }
+  if (this->QueryMode != VOXEL_VALUE && this->QueryMode != ISO_VALUE)
+  {
+    vtkErrorMacro(<< "Unknown QueryMode " << this->QueryMode << " (0 Voxel Value, 1 Iso Value).");
+    return false;
+  }
+  if (this->QueryMode == ISO_VALUE && !std::isfinite(this->IsoValue))
+  {
+    vtkErrorMacro(<< "IsoValue must be a finite number (got " << this->IsoValue << ").");
+    return false;
+  }
+  if (this->ErfApproximation != ERF_EXACT && this->ErfApproximation != ERF_WINITZKI)
+  {
+    vtkErrorMacro(<< "Unknown ErfApproximation " << this->ErfApproximation << " (0 Exact, 1 Winitzki).");
+    return false;
+  }
+  if (this->Backend < BACKEND_AUTO || this->Backend > BACKEND_CUDA)
+  {
+    vtkErrorMacro(<< "Unknown Backend " << this->Backend << " (0 Auto, 1 CPU, 2 CUDA).");
+    return false;
+  }
+  if (this->NumberOfThreads < 0)
+  {
+    vtkErrorMacro(<< "NumberOfThreads must be 0 (all cores) or positive (got " << this->NumberOfThreads << ").");
+    return false;
+  }
+  if (this->OutputArrayName.empty())
+  {
+    vtkErrorMacro(<< "OutputArrayName must not be empty.");
+    return false;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumetricAmbientOcclusion::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  // Any sub-extent can be computed (from that extent grown by the radius), so the
+  // executive may turn a piece request (MPI rank, streaming) into an extent request here.
+  outputVector->GetInformationObject(0)->Set(CAN_PRODUCE_SUB_EXTENT(), 1);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  int ext[6], whole[6], radius[3];
+  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), ext);
+  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  double spacing[3] = { 1.0, 1.0, 1.0 };
+  if (inInfo->Has(vtkDataObject::SPACING()))
+  {
+    inInfo->Get(vtkDataObject::SPACING(), spacing);
+  }
+  this->ComputeVoxelRadius(spacing, radius);
+  // Every neighbourhood of the requested extent, clipped to the whole extent, must arrive.
+  // An extent request is grown here; a piece request (MPI ranks, streaming by pieces) is
+  // turned into an extent by the source's executive, which grows it by the ghost levels:
+  // ask for as many more as the largest radius, as vtkImageGradient asks for one.
+  if (ext[0] <= ext[1] && ext[2] <= ext[3] && ext[4] <= ext[5])
+  {
+    GrowExtent(ext, radius, whole);
+  }
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), ext, 6);
+  const int ghostLevels =
+    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS());
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(),
+    ghostLevels + std::max({ radius[0], radius[1], radius[2] }));
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumetricAmbientOcclusion::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkImageData* input = vtkImageData::GetData(inInfo);
+  vtkImageData* output = vtkImageData::GetData(outInfo);
+  output->Initialize();
+  this->LastBackend.clear();
+  if (!input || !this->CheckParameters())
+  {
+    return 1;
+  }
+
+  int whole[6], outExt[6];
+  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), outExt);
+  const int wholeDims[3] = { whole[1] - whole[0] + 1, whole[3] - whole[2] + 1, whole[5] - whole[4] + 1 };
+  if (wholeDims[0] < 2 || wholeDims[1] < 2 || wholeDims[2] < 2)
+  {
+    vtkErrorMacro(<< "Ambient occlusion needs a 3-D volume; the input is " << std::max(wholeDims[0], 0)
+                  << " x " << std::max(wholeDims[1], 0) << " x " << std::max(wholeDims[2], 0)
+                  << " voxels (empty, a single voxel, or 2-D).");
+    return 1;
+  }
+  const int* inExt = input->GetExtent();
+  if (input->GetNumberOfPoints() == 0)
+  {
+    return 1; // an empty piece of a distributed data set (e.g. MetaImage on rank > 0)
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    if (outExt[2 * a] < inExt[2 * a] || outExt[2 * a + 1] > inExt[2 * a + 1] ||
+      outExt[2 * a] > outExt[2 * a + 1])
+    {
+      vtkErrorMacro(<< "The input extent (" << inExt[0] << ".." << inExt[1] << ", " << inExt[2] << ".."
+                    << inExt[3] << ", " << inExt[4] << ".." << inExt[5]
+                    << ") does not cover the requested extent: the upstream source ignored the request.");
+      return 1;
+    }
+  }
+
+  int radius[3];
+  this->ComputeVoxelRadius(input->GetSpacing(), radius);
+  if (radius[0] == 0 && radius[1] == 0 && radius[2] == 0)
+  {
+    vtkErrorMacro(<< "Radius " << this->Radius << (this->RadiusUnits == WORLD ? " (world units)" : "")
+                  << " rounds to 0 voxels on every axis: the neighbourhood would be the voxel alone "
+                     "and the ambient occlusion 1 everywhere. Use at least one voxel.");
+    return 1;
+  }
+  if (radius[0] >= wholeDims[0] - 1 && radius[1] >= wholeDims[1] - 1 && radius[2] >= wholeDims[2] - 1)
+  {
+    vtkErrorMacro(<< "Radius " << this->Radius << " (" << radius[0] << " x " << radius[1] << " x "
+                  << radius[2] << " voxels) covers the whole " << wholeDims[0] << " x " << wholeDims[1]
+                  << " x " << wholeDims[2] << " volume from every voxel: every neighbourhood "
+                  << "would be the whole volume. Use a smaller radius.");
+    return 1;
+  }
+
+  vtkDataArray* scalars = this->GetInputArrayToProcess(0, inputVector);
+  vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
+  const char* arrayName = arrayInfo->Get(vtkDataObject::FIELD_NAME());
+  if (!scalars && (!arrayName || !*arrayName))
+  {
+    // No array chosen (pvpython before the input was updated): the active point scalars.
+    scalars = input->GetPointData()->GetScalars();
+  }
+  if (!scalars)
+  {
+    vtkErrorMacro(<< "No numeric point array to process: choose a point-data array of the image "
+                     "(the Scalars property; string and cell arrays are not accepted).");
+    return 1;
+  }
+  if (input->GetPointData()->GetAbstractArray(scalars->GetName()) != scalars)
+  {
+    vtkErrorMacro(<< "Array '" << (scalars->GetName() ? scalars->GetName() : "")
+                  << "' is not a point-data array; ambient occlusion is defined on points (voxels).");
+    return 1;
+  }
+  const int components = scalars->GetNumberOfComponents();
+  int component = this->Component;
+  if (component < 0 && components == 1)
+  {
+    component = 0;
+  }
+  if (component < 0 || component >= components)
+  {
+    vtkErrorMacro(<< "Array '" << scalars->GetName() << "' has " << components
+                  << " components; set Component to one of 0.." << components - 1
+                  << " (got " << this->Component << ").");
+    return 1;
+  }
+  vao::VolumeView volume;
+  if (!ToKernelType(scalars->GetDataType(), volume.type))
+  {
+    vtkErrorMacro(<< "Array '" << scalars->GetName() << "' has unsupported type "
+                  << scalars->GetDataTypeAsString() << ".");
+    return 1;
+  }
+  std::vector<double> unpacked; // only for arrays without the standard (AOS) layout
+  const int* dims = input->GetDimensions();
+  volume.dims = { dims[0], dims[1], dims[2] };
+  if (scalars->HasStandardMemoryLayout())
+  {
+    volume.data = scalars->GetVoidPointer(component);
+    volume.voxelStride = components;
+  }
+  else
+  {
+    unpacked.resize(static_cast<size_t>(scalars->GetNumberOfTuples()));
+    for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i)
+    {
+      unpacked[i] = scalars->GetComponent(i, component);
+    }
+    volume.data = unpacked.data();
+    volume.type = vao::ScalarType::Float64;
+  }
+  std::int64_t firstBad = 0;
+  const std::int64_t nonFinite = vao::countNonFinite(volume, &firstBad);
+  if (nonFinite > 0)
+  {
+    int ijk[3] = { static_cast<int>(firstBad % dims[0]) + inExt[0],
+      static_cast<int>((firstBad / dims[0]) % dims[1]) + inExt[2],
+      static_cast<int>(firstBad / (static_cast<std::int64_t>(dims[0]) * dims[1])) + inExt[4] };
+    vtkErrorMacro(<< "Array '" << scalars->GetName() << "' has " << nonFinite
+                  << " NaN or infinite values (the first at voxel " << ijk[0] << ", " << ijk[1] << ", "
+                  << ijk[2] << "). A non-finite value has no place in a cumulative distribution: "
+                  << "replace them (e.g. with the Calculator or Threshold filters) first.");
+    return 1;
+  }
+
+  if (this->Backend == BACKEND_CUDA)
+  {
+    vtkWarningMacro(<< "This build has no CUDA backend; computing on the CPU.");
+  }
+  this->LastBackend = "CPU";
+
+  vao::Region region;
+  for (int a = 0; a < 3; ++a)
+  {
+    region.begin[a] = outExt[2 * a] - inExt[2 * a];
+    region.size[a] = outExt[2 * a + 1] - outExt[2 * a] + 1;
+  }
+  vao::AmbientOcclusionParameters parameters;
+  parameters.method = static_cast<vao::Method>(this->Method);
+  parameters.radius = { radius[0], radius[1], radius[2] };
+  parameters.queryMode = static_cast<vao::QueryMode>(this->QueryMode);
+  parameters.isoValue = this->IsoValue;
+  parameters.erfMode = static_cast<vao::ErfMode>(this->ErfApproximation);
+
+  vtkNew<vtkFloatArray> openness;
+  openness->SetName(this->OutputArrayName.c_str());
+  openness->SetNumberOfTuples(region.voxelCount());
+  vtkSmartPointer<vtkFloatArray> variance;
+  if (this->ComputeVariance)
+  {
+    variance = vtkSmartPointer<vtkFloatArray>::New();
+    variance->SetName("Variance");
+    variance->SetNumberOfTuples(region.voxelCount());
+  }
+  vao::Execution execution;
+  execution.threads = this->NumberOfThreads;
+  execution.progress = [this](double p) { this->UpdateProgress(p); };
+  execution.abortRequested = [this] { return this->GetAbortExecute() != 0; };
+  const vao::Status status = vao::computeAmbientOcclusion(volume, region, parameters,
+    { openness->GetPointer(0), variance ? variance->GetPointer(0) : nullptr }, execution);
+  if (!status.ok)
+  {
+    if (!status.aborted)
+    {
+      vtkErrorMacro(<< "Ambient occlusion failed: " << status.message << ".");
+    }
+    return 1;
+  }
+
+  // The output is exactly the requested extent: the input's arrays cropped to it.
+  if (region.voxelCount() == input->GetNumberOfPoints())
+  {
+    output->ShallowCopy(input);
+  }
+  else
+  {
+    output->SetExtent(outExt);
+    output->SetOrigin(input->GetOrigin());
+    output->SetSpacing(input->GetSpacing());
+    output->SetDirectionMatrix(input->GetDirectionMatrix());
+    output->GetPointData()->CopyAllocate(input->GetPointData(), region.voxelCount());
+    output->GetPointData()->CopyStructuredData(input->GetPointData(), inExt, outExt);
+    output->GetFieldData()->ShallowCopy(input->GetFieldData());
+  }
+  output->GetPointData()->AddArray(openness);
+  if (variance)
+  {
+    output->GetPointData()->AddArray(variance);
+  }
+  vtkNew<vtkStringArray> backend;
+  backend->SetName("AmbientOcclusionBackend");
+  backend->InsertNextValue(this->LastBackend);
+  output->GetFieldData()->AddArray(backend);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumetricAmbientOcclusion::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  const bool knownMethod = this->Method >= CDF_RECONSTRUCTION && this->Method <= EXACT_SPHERE;
+  os << indent << "Method: " << (knownMethod ? MethodNames[this->Method] : "(invalid)") << "\n";
+  os << indent << "Radius: " << this->Radius << (this->RadiusUnits == WORLD ? " world" : " voxels") << "\n";
+  os << indent << "QueryMode: " << (this->QueryMode == ISO_VALUE ? "Iso Value" : "Voxel Value") << "\n";
+  os << indent << "IsoValue: " << this->IsoValue << "\n";
+  os << indent << "ErfApproximation: " << (this->ErfApproximation == ERF_WINITZKI ? "Winitzki" : "Exact") << "\n";
+  os << indent << "ComputeVariance: " << this->ComputeVariance << "\n";
+  os << indent << "Component: " << this->Component << "\n";
+  os << indent << "Backend: " << this->Backend << " (last run: " << this->LastBackend << ")\n";
+  os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "OutputArrayName: " << this->OutputArrayName << "\n";
+}

@@ -1,0 +1,54 @@
+// Helpers shared by the VTK tests of the filters.
+#pragma once
+
+#include "vtkCommand.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkObject.h"
+#include "vtkSmartPointer.h"
+
+#include <string>
+#include <vector>
+
+namespace vaotest
+{
+
+/// Collects the error and warning messages an object emits.
+class MessageCatcher : public vtkCommand
+{
+public:
+  static MessageCatcher* New() { return new MessageCatcher; }
+  void Execute(vtkObject*, unsigned long event, void* data) override
+  {
+    const std::string text = data ? static_cast<const char*>(data) : "";
+    (event == vtkCommand::ErrorEvent ? this->Errors : this->Warnings).push_back(text);
+  }
+  void Watch(vtkObject* object)
+  {
+    object->AddObserver(vtkCommand::ErrorEvent, this);
+    object->AddObserver(vtkCommand::WarningEvent, this);
+  }
+  std::string AllErrors() const
+  {
+    std::string all;
+    for (const auto& e : this->Errors)
+      all += e;
+    return all;
+  }
+  std::vector<std::string> Errors;
+  std::vector<std::string> Warnings;
+};
+
+/// Path of a file under ../shared/data (the real scans beside the checkout).
+inline std::string SharedData(const std::string& relative)
+{
+  return std::string(VAO_SHARED_DATA_DIR) + "/" + relative;
+}
+
+/// Reads a MetaImage volume; fails the calling test when it cannot.
+vtkSmartPointer<vtkImageData> ReadMetaImage(const std::string& path);
+
+/// Values of a one-component array as doubles.
+std::vector<double> Values(vtkDataArray* array);
+
+} // namespace vaotest

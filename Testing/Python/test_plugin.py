@@ -1,0 +1,95 @@
+"""pvpython: load the plugin, check the proxy's properties, run every method on Wavelet
+and on the CT head phantom, check arrays and ranges, write the result and read it back.
+
+Usage: pvpython test_plugin.py PLUGIN SHARED_DATA_DIR OUTPUT_DIR"""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from vao_test_utils import METHODS, array_of, check, fail, read_image  # noqa: E402
+
+from paraview.simple import *  # noqa: E402,F401,F403
+from paraview import servermanager  # noqa: E402
+import numpy as np  # noqa: E402
+
+plugin, shared, out_dir = sys.argv[1:4]
+LoadPlugin(plugin, ns=globals())
+check("VolumetricAmbientOcclusion" in globals(), "the plugin defines VolumetricAmbientOcclusion")
+
+wavelet = Wavelet(WholeExtent=[-12, 12, -10, 10, -8, 8])
+ao = VolumetricAmbientOcclusion(Input=wavelet)
+
+# Properties: names, defaults, enumeration texts, documentation.
+expected_enums = {
+    "Method": METHODS,
+    "RadiusUnits": ["Voxels", "World"],
+    "QueryMode": ["Voxel Value", "Iso Value"],
+    "ErfApproximation": ["Exact", "Winitzki"],
+    "Backend": ["Auto", "CPU", "CUDA"],
+}
+for name, texts in expected_enums.items():
+    check(list(ao.GetProperty(name).Available) == texts, "%s offers %s" % (name, texts))
+check(ao.Method == "Gaussian CDF", "Method defaults to Gaussian CDF")
+check(ao.Radius == 10, "Radius defaults to 10")
+check(ao.OutputArrayName == "AmbientOcclusion", "OutputArrayName defaults to AmbientOcclusion")
+for name in ["Scalars", "Method", "Radius", "RadiusUnits", "QueryMode", "IsoValue", "ErfApproximation",
+             "ComputeVariance", "Backend", "OutputArrayName", "Component", "NumberOfThreads"]:
+    prop = ao.GetProperty(name)
+    check(prop is not None, "property %s exists" % name)
+    doc = prop.SMProperty.GetDocumentation()
+    check(doc is not None and len(doc.GetDescription().strip()) > 20, "property %s is documented" % name)
+
+
+def run(source, array, method, radius, **extra):
+    filt = VolumetricAmbientOcclusion(Input=source, Method=method, Radius=radius, ComputeVariance=1, **extra)
+    filt.Scalars = ["POINTS", array]
+    filt.UpdatePipeline()
+    data = servermanager.Fetch(filt)
+    Delete(filt)
+    return data
+
+
+def check_result(data, what, points):
+    check(data.GetNumberOfPoints() == points, "%s: output has all %d points" % (what, points))
+    ao_values = array_of(data, "AmbientOcclusion")
+    variance = array_of(data, "Variance")
+    check(data.GetPointData().GetArray("AmbientOcclusion").GetDataTypeAsString() == "float",
+          "%s: AmbientOcclusion is float32" % what)
+    check(ao_values.min() >= 0.0 and ao_values.max() <= 1.0, "%s: AO in [0, 1] (%.4f .. %.4f)"
+          % (what, ao_values.min(), ao_values.max()))
+    check(ao_values.max() - ao_values.min() > 0.2, "%s: AO is not constant" % what)
+    check(variance.min() >= 0.0 and variance.max() > 0.0, "%s: variance >= 0 and not all 0" % what)
+    return ao_values
+
+
+wavelet_points = 25 * 21 * 17
+results = {m: check_result(run(wavelet, "RTData", m, 3), "Wavelet/" + m, wavelet_points) for m in METHODS}
+check(np.all(results["Chebyshev"] <= results["Exact Box"] + 1e-6), "Wavelet: Chebyshev <= Exact Box")
+
+ct_path = os.path.join(shared, "ct_head_phantom", "ct_head_phantom_128x128x136_int16.mha")
+ct = OpenDataFile(ct_path)
+ct_points = 128 * 128 * 136
+for method in METHODS:
+    radius = 5 if method not in ("Exact Box", "Exact Sphere") else 3
+    check_result(run(ct, "MetaImage", method, radius), "CT head/" + method, ct_points)
+
+# Iso value query and world units.
+iso = run(ct, "MetaImage", "Gaussian CDF", 10.0, RadiusUnits="World", QueryMode="Iso Value", IsoValue=400.0)
+check_result(iso, "CT head/iso 400 world 10 mm", ct_points)
+
+# Bad input: an error and an empty output, not a crash.
+bad = VolumetricAmbientOcclusion(Input=ct, Radius=0)
+bad.UpdatePipeline()
+check(servermanager.Fetch(bad).GetNumberOfPoints() == 0, "Radius 0 gives an empty output")
+Delete(bad)
+
+# Write and read back (inline binary .vti: this VTK cannot read appended .vti).
+final = VolumetricAmbientOcclusion(Input=ct, Method="Gaussian CDF", Radius=5, ComputeVariance=1)
+final.UpdatePipeline()
+reference = servermanager.Fetch(final)
+vti = os.path.join(out_dir, "plugin_ct_ao.vti")
+SaveData(vti, proxy=final, DataMode="Binary")
+back = read_image(vti)
+for name in ["AmbientOcclusion", "Variance", "MetaImage"]:
+    check(np.array_equal(array_of(back, name), array_of(reference, name)), "%s survives the .vti round trip" % name)
+print("all plugin checks passed")
