@@ -83,6 +83,19 @@ bad.UpdatePipeline()
 check(servermanager.Fetch(bad).GetNumberOfPoints() == 0, "Radius 0 gives an empty output")
 Delete(bad)
 
+# The project's own phantom source, straight into the filter with default settings
+# (Scalars left to the active point scalars).
+phantom = AmbientOcclusionHeadPhantom(Dimensions=[48, 44, 40])
+default_run = VolumetricAmbientOcclusion(Input=phantom, Radius=4)
+default_run.UpdatePipeline()
+phantom_ao = servermanager.Fetch(default_run)
+check(phantom_ao.GetPointData().GetArray("Density").GetDataTypeAsString() == "short",
+      "the phantom is int16 HU")
+values = array_of(phantom_ao, "AmbientOcclusion")
+check(values.size == 48 * 44 * 40 and 0.0 <= values.min() and values.max() <= 1.0 and values.std() > 0.05,
+      "phantom: default run gives AO in [0, 1] with contrast (std %.3f)" % values.std())
+Delete(default_run)
+
 # Write and read back (inline binary .vti: this VTK cannot read appended .vti).
 final = VolumetricAmbientOcclusion(Input=ct, Method="Gaussian CDF", Radius=5, ComputeVariance=1)
 final.UpdatePipeline()

@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# One set-up for every use of the project on a fresh Debian 12 machine: install the
+# Debian packages that are missing, configure and build (build/), then run one job:
+#
+#   bash .ci/setup.sh demo [vao-demo arguments]   the main job (AO of the generated phantom
+#                                                 or of a file you name; see README)
+#   bash .ci/setup.sh test                        the whole test suite (ctest)
+#   bash .ci/setup.sh benchmark                   the benchmark table (README "Benchmark")
+#   bash .ci/setup.sh build                       set-up only
+set -euo pipefail
+cd "$(dirname "$0")/.."
+job="${1:-demo}"
+shift || true
+
+# Verified from a bare Debian 12 (see ../shared/ARCHITECTURE.md), plus scipy for the
+# benchmark's peer.
+packages=(cmake g++ ninja-build paraview-dev paraview python3-paraview qtbase5-dev qttools5-dev
+  libqt5svg5-dev libqt5opengl5-dev qtxmlpatterns5-dev-tools libqt5x11extras5-dev
+  libhdf5-openmpi-dev libutfcpp-dev libgl2ps-dev libglew-dev libgdal-dev libnetcdf-dev
+  libavcodec-dev libavformat-dev libswscale-dev libtheora-dev libdouble-conversion-dev
+  liblz4-dev libexpat1-dev libeigen3-dev libboost-dev libfreetype-dev mpi-default-dev
+  python3-mpi4py libgtest-dev xvfb xauth python3-numpy python3-scipy)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "== installing ${#missing[@]} missing Debian packages: ${missing[*]}"
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+echo "== configuring and building (build/)"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j "$(nproc)"
+
+case "$job" in
+  demo)
+    exec build/bin/vao-demo "$@" ;;
+  test)
+    # Open MPI refuses to run as root without these (the MPI tests add the flags too).
+    export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+    cd build && exec ctest --output-on-failure -j "$(nproc)" "$@" ;;
+  benchmark)
+    exec build/bin/vao_benchmark "$@" ;;
+  build)
+    ;;
+  *)
+    echo "unknown job '$job' (demo, test, benchmark, build)" >&2
+    exit 2 ;;
+esac
