@@ -61,47 +61,19 @@ Status separableOpenness(const VolumeView& view, const Region& region,
 {
   const detail::TypedVolume<T> volume(view);
   const detail::BoxGeometry geometry(view.dims, region, p.radius);
-  const bool needExtrema = output.openness && p.method == Method::CdfReconstruction;
-  detail::BoxExtrema<T> extrema;
-  const double split = needExtrema ? 0.5 : 0.0;
-  if (needExtrema &&
-    !detail::computeBoxExtrema(volume, geometry, detail::stageExecution(execution, 0.0, split), extrema))
-  {
-    return Status::cancelled();
-  }
-  const auto countX = geometry.windowCounts(0);
-  const auto countY = geometry.windowCounts(1);
-  const std::int64_t nx = region.size[0], ny = region.size[1];
+  const bool withExtrema = output.openness && p.method == Method::CdfReconstruction;
   const bool voxelQuery = p.queryMode == QueryMode::VoxelValue;
-  const bool ok = detail::streamMoments(volume, geometry,
-    detail::stageExecution(execution, split, 1.0), [&](const detail::MomentSlice<T>& slice) {
-      const std::int64_t base = (slice.z - region.begin[2]) * nx * ny;
-      for (std::int64_t j = 0; j < ny; ++j)
+  const bool ok = detail::forEachNeighbourhood(volume, geometry, withExtrema, execution,
+    [&](const detail::VoxelNeighbourhood& voxel) {
+      if (output.variance)
       {
-        const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
-        for (std::int64_t i = 0; i < nx; ++i)
-        {
-          const std::int64_t p2 = j * nx + i;
-          const std::int64_t k = base + p2;
-          NeighbourhoodStats s;
-          detail::momentsToMeanVariance(slice.sum[p2], slice.sumSquares[p2],
-            countX[i] * countY[j] * slice.countZ, slice.shift, s.mean, s.variance);
-          if (output.variance)
-          {
-            output.variance[k] = static_cast<float>(s.variance);
-          }
-          if (!output.openness)
-          {
-            continue;
-          }
-          if (needExtrema)
-          {
-            s.minimum = static_cast<double>(extrema.minimum[k]);
-            s.maximum = static_cast<double>(extrema.maximum[k]);
-          }
-          const double q = voxelQuery ? static_cast<double>(row[i * volume.stride]) : p.isoValue;
-          output.openness[k] = static_cast<float>(opennessFromStats(p.method, q, s, p.erfMode));
-        }
+        output.variance[voxel.index] = static_cast<float>(voxel.stats.variance);
+      }
+      if (output.openness)
+      {
+        const double q = voxelQuery ? voxel.value : p.isoValue;
+        output.openness[voxel.index] =
+          static_cast<float>(opennessFromStats(p.method, q, voxel.stats, p.erfMode));
       }
     });
   return ok ? Status::success() : Status::cancelled();

@@ -379,3 +379,63 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
 
 } // namespace detail
 } // namespace vao
+
+namespace vao
+{
+namespace detail
+{
+
+/// One voxel of the region with its neighbourhood's statistics, as handed to a consumer.
+struct VoxelNeighbourhood
+{
+  std::int64_t index; // in the region, x fastest
+  double value;       // the voxel's own value
+  std::int64_t count; // voxels in the clipped box
+  NeighbourhoodStats stats; // minimum/maximum only when asked for
+};
+
+/// The separable statistics of every region voxel, handed to visit(VoxelNeighbourhood)
+/// slice by slice on worker threads: the extrema passes first when withExtrema, then the
+/// streamed moments. Returns false when cancelled.
+template <class T, class Visit>
+bool forEachNeighbourhood(const TypedVolume<T>& volume, const BoxGeometry& geometry,
+  bool withExtrema, const Execution& execution, Visit&& visit)
+{
+  const Region& region = geometry.region;
+  BoxExtrema<T> extrema;
+  const double split = withExtrema ? 0.5 : 0.0;
+  if (withExtrema && !computeBoxExtrema(volume, geometry, stageExecution(execution, 0.0, split), extrema))
+  {
+    return false;
+  }
+  const auto countX = geometry.windowCounts(0);
+  const auto countY = geometry.windowCounts(1);
+  const std::int64_t nx = region.size[0], ny = region.size[1];
+  return streamMoments(volume, geometry, stageExecution(execution, split, 1.0),
+    [&](const MomentSlice<T>& slice) {
+      const std::int64_t base = (slice.z - region.begin[2]) * nx * ny;
+      VoxelNeighbourhood voxel{ 0, 0.0, 0, { 0.0, 0.0, 0.0, 0.0 } };
+      for (std::int64_t j = 0; j < ny; ++j)
+      {
+        const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
+        for (std::int64_t i = 0; i < nx; ++i)
+        {
+          const std::int64_t p = j * nx + i;
+          voxel.index = base + p;
+          voxel.value = static_cast<double>(row[i * volume.stride]);
+          voxel.count = countX[i] * countY[j] * slice.countZ;
+          momentsToMeanVariance(slice.sum[p], slice.sumSquares[p], voxel.count, slice.shift,
+            voxel.stats.mean, voxel.stats.variance);
+          if (withExtrema)
+          {
+            voxel.stats.minimum = static_cast<double>(extrema.minimum[voxel.index]);
+            voxel.stats.maximum = static_cast<double>(extrema.maximum[voxel.index]);
+          }
+          visit(voxel);
+        }
+      }
+    });
+}
+
+} // namespace detail
+} // namespace vao
