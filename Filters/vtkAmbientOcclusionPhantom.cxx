@@ -39,6 +39,32 @@ double HashNoise(std::uint64_t index, std::uint64_t seed)
   return static_cast<double>(h >> 11) / static_cast<double>(1ull << 53) * 2.0 - 1.0;
 }
 
+/// Smooth noise in [-1, 1]: hash values on a lattice of kNoiseCell voxels, trilinearly
+/// interpolated. Acquired CT noise is correlated over a few voxels; white noise would make
+/// every flat region's voxel-value AO a random rank (salt and pepper).
+double SmoothNoise(int i, int j, int k, std::uint64_t seed)
+{
+  constexpr int kNoiseCell = 4;
+  constexpr std::uint64_t kLattice = 1u << 20; // lattice indices stay below this
+  const int c[3] = { i / kNoiseCell, j / kNoiseCell, k / kNoiseCell };
+  const double f[3] = { (i % kNoiseCell) / double(kNoiseCell), (j % kNoiseCell) / double(kNoiseCell),
+    (k % kNoiseCell) / double(kNoiseCell) };
+  double sum = 0.0;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    double weight = 1.0;
+    std::uint64_t index = 0;
+    for (int a = 2; a >= 0; --a)
+    {
+      const int bit = (corner >> a) & 1;
+      weight *= bit ? f[a] : 1.0 - f[a];
+      index = index * kLattice + static_cast<std::uint64_t>(c[a] + bit);
+    }
+    sum += weight * HashNoise(index, seed);
+  }
+  return sum;
+}
+
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -167,7 +193,6 @@ int vtkAmbientOcclusionPhantom::RequestData(
   values->SetName("Density");
   values->SetNumberOfTuples(output->GetNumberOfPoints());
   short* out = values->GetPointer(0);
-  const std::int64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
   for (int k = ext[4]; k <= ext[5]; ++k)
   {
     this->UpdateProgress(static_cast<double>(k - ext[4]) / (ext[5] - ext[4] + 1));
@@ -178,8 +203,8 @@ int vtkAmbientOcclusionPhantom::RequestData(
         // Patient axes: image y runs front to back, image z foot to head.
         const double hu = Density(origin[0] + i * spacing[0], origin[1] + j * spacing[1],
           origin[2] + k * spacing[2]);
-        const std::uint64_t index = (static_cast<std::uint64_t>(k) * ny + j) * nx + i;
-        const double noisy = hu + this->NoiseAmplitude * HashNoise(index, this->Seed);
+        // Air stays clean, as in a CT whose air is clipped at the bottom of its range.
+        const double noisy = hu <= -1000.0 ? hu : hu + this->NoiseAmplitude * SmoothNoise(i, j, k, this->Seed);
         *out++ = static_cast<short>(std::lround(std::max(-1024.0, std::min(3000.0, noisy))));
       }
     }

@@ -6,7 +6,9 @@
  * air (-1000 HU) around a head of soft tissue (skin, brain ~ 20-45 HU) inside a skull of
  * bone (700-1300 HU) with eye sockets, a nasal cavity of air, ventricles of CSF (~5 HU),
  * teeth (~1500 HU), a neck and a headrest plate under it. Deterministic noise of
- * NoiseAmplitude HU (a hash of the voxel index and Seed) makes it look acquired.
+ * NoiseAmplitude HU, correlated over 4 voxels like acquired CT noise (a hash of the
+ * voxel index and Seed, smoothly interpolated), makes the tissue look acquired; air stays
+ * at -1000 HU.
  *
  * The phantom spans a fixed 240 mm field of view: Spacing = 240 mm / Dimensions, the
  * origin at the centre. RequestData fills only the requested extent, so the source
