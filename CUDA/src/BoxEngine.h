@@ -284,16 +284,22 @@ bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
   return !control.stopped();
 }
 
-/// Box minimum and maximum of every region voxel, as region-sized arrays of T.
+/// Box minimum and maximum of every region voxel: planes of the slices the region reads,
+/// the region's own slices starting at `offset` (x fastest, region-sized planes).
 template <class T>
 struct BoxExtrema
 {
-  std::vector<T> minimum;
-  std::vector<T> maximum;
+  std::vector<T> minimumPlanes;
+  std::vector<T> maximumPlanes;
+  std::int64_t offset = 0;
+
+  T minimum(std::int64_t regionIndex) const { return this->minimumPlanes[this->offset + regionIndex]; }
+  T maximum(std::int64_t regionIndex) const { return this->maximumPlanes[this->offset + regionIndex]; }
 };
 
 /// Three van Herk passes: x then y within each slice the region reads (into planes of
-/// region width), then z along each region row. Progress: slices, then rows.
+/// region width), then z along each region row, written back in place. Progress: slices,
+/// then rows.
 template <class T>
 bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry,
   const Execution& execution, BoxExtrema<T>& result)
@@ -302,8 +308,11 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
   const std::int64_t nx = region.size[0];
   const std::int64_t plane = geometry.planeSize();
   const std::int64_t slices = geometry.zs.size();
-  std::vector<T> planeMin(static_cast<std::size_t>(slices * plane));
-  std::vector<T> planeMax(static_cast<std::size_t>(slices * plane));
+  std::vector<T>& planeMin = result.minimumPlanes;
+  std::vector<T>& planeMax = result.maximumPlanes;
+  planeMin.resize(static_cast<std::size_t>(slices * plane));
+  planeMax.resize(static_cast<std::size_t>(slices * plane));
+  result.offset = (region.begin[2] - geometry.zs.lo) * plane;
   const int threads = resolveThreadCount(execution.threads);
   LoopControl control(execution, slices + region.size[1]);
 
@@ -327,14 +336,13 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
             row[i] = src[i * volume.stride];
           }
           const std::int64_t x0 = region.begin[0] - geometry.xs.lo;
-          slidingExtremum(row.data(), span, 1, geometry.radius.x, x0, nx, &xMin[j * nx], scratch, MinOp{});
-          slidingExtremum(row.data(), span, 1, geometry.radius.x, x0, nx, &xMax[j * nx], scratch, MaxOp{});
+          slidingMinMax(row.data(), row.data(), span, 1, geometry.radius.x, x0, nx, &xMin[j * nx],
+            &xMax[j * nx], scratch);
         }
+        // y pass: whole rows are the lanes.
         const std::int64_t y0 = region.begin[1] - geometry.ys.lo;
-        slidingExtremum(xMin.data(), rows, nx, geometry.radius.y, y0, region.size[1],
-          &planeMin[s * plane], scratch, MinOp{});
-        slidingExtremum(xMax.data(), rows, nx, geometry.radius.y, y0, region.size[1],
-          &planeMax[s * plane], scratch, MaxOp{});
+        slidingMinMax(xMin.data(), xMax.data(), rows, nx, geometry.radius.y, y0, region.size[1],
+          &planeMin[s * plane], &planeMax[s * plane], scratch);
         control.advance(1, caller);
       }
     },
@@ -344,32 +352,33 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
     return false;
   }
 
-  result.minimum.resize(static_cast<std::size_t>(region.voxelCount()));
-  result.maximum.resize(static_cast<std::size_t>(region.voxelCount()));
   parallelChunks(
     region.size[1], threads,
     [&](std::int64_t begin, std::int64_t end, bool caller) {
-      std::vector<T> lanes(static_cast<std::size_t>(slices * nx));
-      std::vector<T> out(static_cast<std::size_t>(region.size[2] * nx));
+      std::vector<T> lanesMin(static_cast<std::size_t>(slices * nx));
+      std::vector<T> lanesMax(static_cast<std::size_t>(slices * nx));
+      std::vector<T> outMin(static_cast<std::size_t>(region.size[2] * nx));
+      std::vector<T> outMax(static_cast<std::size_t>(region.size[2] * nx));
       ExtremumScratch<T> scratch;
       const std::int64_t z0 = region.begin[2] - geometry.zs.lo;
       for (std::int64_t y = begin; y < end && !control.stopped(); ++y)
       {
-        auto zPass = [&](const std::vector<T>& source, std::vector<T>& target, auto op) {
-          for (std::int64_t s = 0; s < slices; ++s)
-          {
-            const T* src = source.data() + s * plane + y * nx;
-            std::copy(src, src + nx, &lanes[s * nx]);
-          }
-          slidingExtremum(lanes.data(), slices, nx, geometry.radius.z, z0, region.size[2],
-            out.data(), scratch, op);
-          for (std::int64_t k = 0; k < region.size[2]; ++k)
-          {
-            std::copy(&out[k * nx], &out[k * nx] + nx, target.data() + k * plane + y * nx);
-          }
-        };
-        zPass(planeMin, result.minimum, MinOp{});
-        zPass(planeMax, result.maximum, MaxOp{});
+        // z pass: row y of every slice, gathered, is a sequence of lane vectors.
+        for (std::int64_t s = 0; s < slices; ++s)
+        {
+          const std::int64_t from = s * plane + y * nx;
+          std::copy(&planeMin[from], &planeMin[from] + nx, &lanesMin[s * nx]);
+          std::copy(&planeMax[from], &planeMax[from] + nx, &lanesMax[s * nx]);
+        }
+        slidingMinMax(lanesMin.data(), lanesMax.data(), slices, nx, geometry.radius.z, z0,
+          region.size[2], outMin.data(), outMax.data(), scratch);
+        // In place: this row of every slice was gathered above.
+        for (std::int64_t k = 0; k < region.size[2]; ++k)
+        {
+          const std::int64_t to = result.offset + k * plane + y * nx;
+          std::copy(&outMin[k * nx], &outMin[k * nx] + nx, &planeMin[to]);
+          std::copy(&outMax[k * nx], &outMax[k * nx] + nx, &planeMax[to]);
+        }
         control.advance(1, caller);
       }
     },
@@ -428,8 +437,8 @@ bool forEachNeighbourhood(const TypedVolume<T>& volume, const BoxGeometry& geome
             voxel.stats.mean, voxel.stats.variance);
           if (withExtrema)
           {
-            voxel.stats.minimum = static_cast<double>(extrema.minimum[voxel.index]);
-            voxel.stats.maximum = static_cast<double>(extrema.maximum[voxel.index]);
+            voxel.stats.minimum = static_cast<double>(extrema.minimum(voxel.index));
+            voxel.stats.maximum = static_cast<double>(extrema.maximum(voxel.index));
           }
           visit(voxel);
         }

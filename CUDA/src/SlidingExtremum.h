@@ -13,21 +13,44 @@ namespace vao
 namespace detail
 {
 
-struct MinOp
+/// Where each output window's two partial results sit, for one (n, r, outBegin, outCount):
+/// out[o] = op(parts[first[o]], parts[second[o]]) with parts = [prefix | suffix]. Computed
+/// once and reused for every lane vector and row of the same shape, so the per-element
+/// work has no integer division.
+struct WindowPlan
 {
-  template <class T>
-  T operator()(T a, T b) const
-  {
-    return b < a ? b : a;
-  }
-};
+  std::int64_t n = -1, r = -1, outBegin = -1, outCount = -1;
+  std::vector<std::int64_t> first, second;
 
-struct MaxOp
-{
-  template <class T>
-  T operator()(T a, T b) const
+  void prepare(std::int64_t length, std::int64_t radius, std::int64_t begin, std::int64_t count)
   {
-    return a < b ? b : a;
+    if (length == n && radius == r && begin == outBegin && count == outCount)
+    {
+      return;
+    }
+    n = length, r = radius, outBegin = begin, outCount = count;
+    first.resize(static_cast<std::size_t>(count));
+    second.resize(static_cast<std::size_t>(count));
+    const std::int64_t w = 2 * r + 1;
+    for (std::int64_t o = 0; o < count; ++o)
+    {
+      const std::int64_t i = begin + o;
+      const std::int64_t lo = std::max<std::int64_t>(0, i - r);
+      const std::int64_t hi = std::min<std::int64_t>(n - 1, i + r);
+      if (lo / w != hi / w)
+      {
+        first[o] = n + lo; // suffix of the first block at lo
+        second[o] = hi;    // prefix of the next block at hi
+      }
+      else if (lo % w == 0)
+      {
+        first[o] = second[o] = hi; // the window starts its block: a prefix
+      }
+      else
+      {
+        first[o] = second[o] = n + lo; // the window ends its block (or the data): a suffix
+      }
+    }
   }
 };
 
@@ -35,79 +58,63 @@ struct MaxOp
 template <class T>
 struct ExtremumScratch
 {
-  std::vector<T> prefix;
-  std::vector<T> suffix;
+  std::vector<T> minParts; // prefix (n x m) then suffix (n x m) of the minimum
+  std::vector<T> maxParts; // the same for the maximum
+  WindowPlan plan;
 };
 
-/// out[k] = op over in[j], j in [i - r, i + r] clipped to [0, n), for i = outBegin + k,
-/// k < outCount. in holds n x m values, out outCount x m (x fastest within a lane vector).
-/// Blocks of w = 2r + 1 start at 0; a window spans at most two blocks, so it is
-/// op(suffix of the first block at lo, prefix of the next at hi).
-template <class T, class Op>
-void slidingExtremum(const T* in, std::int64_t n, std::int64_t m, std::int64_t r,
-  std::int64_t outBegin, std::int64_t outCount, T* out, ExtremumScratch<T>& scratch, Op op)
+/// outMin[k] = min over inMin[j] and outMax[k] = max over inMax[j], j in [i - r, i + r]
+/// clipped to [0, n), for i = outBegin + k, k < outCount. The inputs hold n x m values, the
+/// outputs outCount x m (x fastest within a lane vector). Blocks of w = 2r + 1 start at 0;
+/// a window spans at most two blocks, so it combines the suffix of the first block at lo
+/// with the prefix of the next at hi. Both extrema go in one sweep (inMin == inMax on the
+/// first pass, the previous pass's minimum and maximum after it).
+template <class T>
+void slidingMinMax(const T* inMin, const T* inMax, std::int64_t n, std::int64_t m, std::int64_t r,
+  std::int64_t outBegin, std::int64_t outCount, T* outMin, T* outMax, ExtremumScratch<T>& scratch)
 {
   const std::int64_t w = 2 * r + 1;
-  scratch.prefix.resize(static_cast<std::size_t>(n * m));
-  scratch.suffix.resize(static_cast<std::size_t>(n * m));
-  T* prefix = scratch.prefix.data();
-  T* suffix = scratch.suffix.data();
-  for (std::int64_t i = 0; i < n; ++i)
+  scratch.minParts.resize(static_cast<std::size_t>(2 * n * m));
+  scratch.maxParts.resize(static_cast<std::size_t>(2 * n * m));
+  scratch.plan.prepare(n, r, outBegin, outCount);
+  T* preMin = scratch.minParts.data();
+  T* sufMin = preMin + n * m;
+  T* preMax = scratch.maxParts.data();
+  T* sufMax = preMax + n * m;
+  for (std::int64_t blockStart = 0; blockStart < n; blockStart += w)
   {
-    const T* src = in + i * m;
-    T* dst = prefix + i * m;
-    if (i % w == 0)
+    const std::int64_t blockEnd = std::min(n, blockStart + w);
+    // The first element of a block starts both running results; the rest extend them.
+    std::copy(inMin + blockStart * m, inMin + (blockStart + 1) * m, preMin + blockStart * m);
+    std::copy(inMax + blockStart * m, inMax + (blockStart + 1) * m, preMax + blockStart * m);
+    for (std::int64_t i = blockStart + 1; i < blockEnd; ++i)
     {
-      std::copy(src, src + m, dst);
-    }
-    else
-    {
-      const T* previous = dst - m;
       for (std::int64_t k = 0; k < m; ++k)
       {
-        dst[k] = op(previous[k], src[k]);
+        preMin[i * m + k] = std::min(preMin[(i - 1) * m + k], inMin[i * m + k]);
+        preMax[i * m + k] = std::max(preMax[(i - 1) * m + k], inMax[i * m + k]);
+      }
+    }
+    std::copy(inMin + (blockEnd - 1) * m, inMin + blockEnd * m, sufMin + (blockEnd - 1) * m);
+    std::copy(inMax + (blockEnd - 1) * m, inMax + blockEnd * m, sufMax + (blockEnd - 1) * m);
+    for (std::int64_t i = blockEnd - 2; i >= blockStart; --i)
+    {
+      for (std::int64_t k = 0; k < m; ++k)
+      {
+        sufMin[i * m + k] = std::min(sufMin[(i + 1) * m + k], inMin[i * m + k]);
+        sufMax[i * m + k] = std::max(sufMax[(i + 1) * m + k], inMax[i * m + k]);
       }
     }
   }
-  for (std::int64_t i = n - 1; i >= 0; --i)
-  {
-    const T* src = in + i * m;
-    T* dst = suffix + i * m;
-    if (i % w == w - 1 || i == n - 1)
-    {
-      std::copy(src, src + m, dst);
-    }
-    else
-    {
-      const T* next = dst + m;
-      for (std::int64_t k = 0; k < m; ++k)
-      {
-        dst[k] = op(src[k], next[k]);
-      }
-    }
-  }
+  const std::int64_t* first = scratch.plan.first.data();
+  const std::int64_t* second = scratch.plan.second.data();
   for (std::int64_t o = 0; o < outCount; ++o)
   {
-    const std::int64_t i = outBegin + o;
-    const std::int64_t lo = std::max<std::int64_t>(0, i - r);
-    const std::int64_t hi = std::min<std::int64_t>(n - 1, i + r);
-    T* dst = out + o * m;
-    if (lo / w != hi / w)
+    const std::int64_t a = first[o] * m, b = second[o] * m;
+    for (std::int64_t k = 0; k < m; ++k)
     {
-      const T* a = suffix + lo * m;
-      const T* b = prefix + hi * m;
-      for (std::int64_t k = 0; k < m; ++k)
-      {
-        dst[k] = op(a[k], b[k]);
-      }
-    }
-    else if (lo % w == 0)
-    {
-      std::copy(prefix + hi * m, prefix + hi * m + m, dst); // window starts its block
-    }
-    else
-    {
-      std::copy(suffix + lo * m, suffix + lo * m + m, dst); // window ends its block
+      outMin[o * m + k] = std::min(preMin[a + k], preMin[b + k]);
+      outMax[o * m + k] = std::max(preMax[a + k], preMax[b + k]);
     }
   }
 }
