@@ -1,6 +1,7 @@
 #include "vtkVolumetricAmbientOcclusion.h"
 
 #include "vao/AmbientOcclusion.h"
+#include "vao/Cuda.h"
 
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
@@ -333,11 +334,6 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     return 1;
   }
 
-  if (this->Backend == BACKEND_CUDA)
-  {
-    vtkWarningMacro(<< "This build has no CUDA backend; computing on the CPU.");
-  }
-  this->LastBackend = "CPU";
 
   vao::Region region;
   for (int a = 0; a < 3; ++a)
@@ -366,8 +362,24 @@ int vtkVolumetricAmbientOcclusion::RequestData(
   execution.threads = this->NumberOfThreads;
   execution.progress = [this](double p) { this->UpdateProgress(p); };
   execution.abortRequested = [this] { return this->GetAbortExecute() != 0; };
-  const vao::Status status = vao::computeAmbientOcclusion(volume, region, parameters,
-    { openness->GetPointer(0), variance ? variance->GetPointer(0) : nullptr }, execution);
+  const vao::AmbientOcclusionOutput arrays{ openness->GetPointer(0),
+    variance ? variance->GetPointer(0) : nullptr };
+  vao::Status status;
+  bool onDevice = this->ChooseCuda(vao::isSeparableMethod(parameters.method), region.voxelCount());
+  if (onDevice)
+  {
+    status = vao::cuda::computeAmbientOcclusion(volume, region, parameters, arrays, execution);
+    if (!status.ok && !status.aborted)
+    {
+      vtkWarningMacro(<< "The CUDA backend failed (" << status.message << "); computing on the CPU.");
+      onDevice = false;
+    }
+  }
+  if (!onDevice)
+  {
+    status = vao::computeAmbientOcclusion(volume, region, parameters, arrays, execution);
+  }
+  this->LastBackend = onDevice ? "CUDA" : "CPU";
   if (!status.ok)
   {
     if (!status.aborted)
@@ -402,6 +414,32 @@ int vtkVolumetricAmbientOcclusion::RequestData(
   backend->InsertNextValue(this->LastBackend);
   output->GetFieldData()->AddArray(backend);
   return 1;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumetricAmbientOcclusion::ChooseCuda(bool separableMethod, long long voxels)
+{
+  if (this->Backend == BACKEND_CPU)
+  {
+    return false;
+  }
+  const vao::cuda::DeviceStatus device = vao::cuda::deviceStatus();
+  if (this->Backend == BACKEND_AUTO)
+  {
+    // Below about a million voxels the CPU finishes before the transfers would.
+    return device.available && separableMethod && voxels >= AutoCudaMinimumVoxels;
+  }
+  if (!separableMethod)
+  {
+    vtkWarningMacro(<< "Exact Box and Exact Sphere run on the CPU only; computing on the CPU.");
+    return false;
+  }
+  if (!device.available)
+  {
+    vtkWarningMacro(<< "Backend CUDA: no CUDA device (" << device.description << "); computing on the CPU.");
+    return false;
+  }
+  return true;
 }
 
 //------------------------------------------------------------------------------

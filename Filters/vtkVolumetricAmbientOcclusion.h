@@ -112,12 +112,16 @@ public:
   ///@}
 
   ///@{
-  /// Compute backend: AUTO (default), CPU or CUDA. Without a CUDA build or device the
-  /// CPU runs, with a warning when CUDA was asked for. The backend that ran is reported
-  /// by GetLastBackend() and in the output's field data string "AmbientOcclusionBackend".
+  /// Compute backend: AUTO (default: CUDA for the separable methods when a device is
+  /// present and the extent has at least AutoCudaMinimumVoxels voxels, else the CPU),
+  /// CPU, or CUDA. Without a CUDA build or device, for the exact methods, or when the
+  /// device fails (e.g. out of memory), the CPU runs, with a warning when CUDA was asked
+  /// for. The backend that ran ("CPU" or "CUDA") is reported by GetLastBackend() and in
+  /// the output's field data string "AmbientOcclusionBackend".
   vtkSetMacro(Backend, int);
   vtkGetMacro(Backend, int);
   const char* GetLastBackend() const { return this->LastBackend.c_str(); }
+  static constexpr long long AutoCudaMinimumVoxels = 1 << 20;
   ///@}
 
   ///@{
@@ -161,6 +165,7 @@ private:
   void operator=(const vtkVolumetricAmbientOcclusion&) = delete;
 
   bool CheckParameters();
+  bool ChooseCuda(bool separableMethod, long long voxels);
 };
 
 #endif

@@ -233,19 +233,6 @@ struct MomentSlice
   std::int64_t countZ;    // clipped window size along z
 };
 
-/// Mean and variance of one box from its sums (exact or shifted, by accumulator type).
-inline void momentsToMeanVariance(std::int64_t sum, std::int64_t sumSquares, std::int64_t count,
-  double, double& mean, double& variance)
-{
-  meanVarianceFromExactSums(sum, sumSquares, count, mean, variance);
-}
-
-inline void momentsToMeanVariance(double sum, double sumSquares, std::int64_t count, double shift,
-  double& mean, double& variance)
-{
-  meanVarianceFromShiftedSums(sum, sumSquares, count, shift, mean, variance);
-}
-
 /// Streams the moment planes of every region slice to consume(slice) on worker threads;
 /// each thread takes a contiguous chunk of slices. Returns false when cancelled.
 template <class T, class Consume>
@@ -433,7 +420,7 @@ bool forEachNeighbourhood(const TypedVolume<T>& volume, const BoxGeometry& geome
           voxel.index = base + p;
           voxel.value = static_cast<double>(row[i * volume.stride]);
           voxel.count = countX[i] * countY[j] * slice.countZ;
-          momentsToMeanVariance(slice.sum[p], slice.sumSquares[p], voxel.count, slice.shift,
+          meanVarianceFromSums(slice.sum[p], slice.sumSquares[p], voxel.count, slice.shift,
             voxel.stats.mean, voxel.stats.variance);
           if (withExtrema)
           {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cmath>
+#include <type_traits>
 
 #if defined(__CUDACC__)
 #define VAO_HD __host__ __device__ inline
@@ -174,6 +175,22 @@ VAO_HD void meanVarianceFromShiftedSums(
   const double v = sumSquares / n - m1 * m1;
   mean = m1 + shift;
   variance = v > 0.0 ? v : 0.0;
+}
+
+/// Mean and variance from box sums of either kind: exact integer sums (no shift) or
+/// double sums of values shifted by `shift`.
+template <class Accumulator>
+VAO_HD void meanVarianceFromSums(Accumulator sum, Accumulator sumSquares, long long count,
+  double shift, double& mean, double& variance)
+{
+  if constexpr (std::is_integral<Accumulator>::value)
+  {
+    meanVarianceFromExactSums(sum, sumSquares, count, mean, variance);
+  }
+  else
+  {
+    meanVarianceFromShiftedSums(sum, sumSquares, count, shift, mean, variance);
+  }
 }
 
 /// Number of voxels of a window of half-width r around i, clipped to [0, n).

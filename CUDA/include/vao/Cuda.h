@@ -1,0 +1,65 @@
+// The CUDA backend of the kernel library: the same computations as AmbientOcclusion.h on
+// an NVIDIA GPU, with the same formulas (Estimators.h) and the same numbers.
+//
+// Every function exists in every build: without CUDA (VAO_ENABLE_CUDA off or no nvcc)
+// built() is false, deviceStatus() says why and the compute functions return a failure,
+// so callers fall back to the CPU without #ifdefs. Errors of the device (no device, out
+// of memory, launch failure) come back as a failed Status with CUDA's message, never as
+// a crash.
+#pragma once
+
+#include "vao/AmbientOcclusion.h"
+
+#include <string>
+#include <vector>
+
+namespace vao
+{
+namespace cuda
+{
+
+/// True when the library was compiled with the CUDA backend.
+bool built();
+
+struct DeviceStatus
+{
+  bool available = false;
+  std::string description; // the device's name and memory, or why there is none
+};
+
+/// Whether a usable device is present (queried once, then cached).
+DeviceStatus deviceStatus();
+
+/// Time of one device pass, with the bytes it reads and writes, for bandwidth reports.
+struct PassTiming
+{
+  std::string name;
+  double milliseconds = 0.0;
+  double bytes = 0.0;
+};
+
+/// Where the time of one call went (CUDA events for the kernels, wall clock overall).
+struct Timing
+{
+  double kernelMilliseconds = 0.0; // all kernels, measured with CUDA events
+  double totalMilliseconds = 0.0;  // the whole call: allocation, transfers, kernels
+  std::vector<PassTiming> passes;
+};
+
+/// Openness (and optionally the variance) of every voxel of the region, on the GPU.
+/// Method must be CdfReconstruction, GaussianCdf or Chebyshev: the exact references run
+/// on the CPU only.
+Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
+  const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
+  const Execution& execution = {}, Timing* timing = nullptr);
+
+/// Count, mean, variance, minimum and maximum over each voxel's clipped box, on the GPU.
+Status computeBoxStatistics(const VolumeView& volume, const Region& region, const Radius& radius,
+  const BoxStatisticsOutput& output, const Execution& execution = {}, Timing* timing = nullptr);
+
+/// Device-to-device copy bandwidth in GB/s over a buffer of `bytes` (the reference the
+/// passes are compared with); 0 without a device.
+double measureCopyBandwidth(double bytes);
+
+} // namespace cuda
+} // namespace vao

@@ -1,0 +1,37 @@
+// The CUDA interface in a build without CUDA: nothing is available, every call says so.
+#include "vao/Cuda.h"
+
+namespace vao
+{
+namespace cuda
+{
+
+bool built()
+{
+  return false;
+}
+
+DeviceStatus deviceStatus()
+{
+  return { false, "this build has no CUDA backend (VAO_ENABLE_CUDA off or no CUDA compiler)" };
+}
+
+Status computeAmbientOcclusion(const VolumeView&, const Region&, const AmbientOcclusionParameters&,
+  const AmbientOcclusionOutput&, const Execution&, Timing*)
+{
+  return Status::failure("no CUDA device: " + deviceStatus().description);
+}
+
+Status computeBoxStatistics(const VolumeView&, const Region&, const Radius&, const BoxStatisticsOutput&,
+  const Execution&, Timing*)
+{
+  return Status::failure("no CUDA device: " + deviceStatus().description);
+}
+
+double measureCopyBandwidth(double)
+{
+  return 0.0;
+}
+
+} // namespace cuda
+} // namespace vao

@@ -1,0 +1,403 @@
+// The CUDA backend: the passes of Pipeline.h as GPU kernels, one thread per index, plus
+// transfers, a tiled transpose and error handling. The maths and the indexing live in
+// Pipeline.h (shared with the host emulation that tests them without a GPU) and
+// Estimators.h (shared with the CPU path).
+#include "vao/Cuda.h"
+
+#include "../VolumeAccess.h"
+#include "Pipeline.h"
+
+#include <cuda_runtime.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace vao
+{
+namespace cuda
+{
+namespace
+{
+
+using gpu::Index;
+
+struct CudaFailure : std::runtime_error
+{
+  using std::runtime_error::runtime_error;
+};
+
+void check(cudaError_t error, const char* what)
+{
+  if (error != cudaSuccess)
+  {
+    throw CudaFailure(std::string("CUDA ") + what + ": " + cudaGetErrorString(error));
+  }
+}
+
+/// A device allocation, freed on every exit path.
+template <class T>
+class DeviceBuffer
+{
+public:
+  explicit DeviceBuffer(Index count)
+  {
+    if (count > 0)
+    {
+      check(cudaMalloc(&this->Data, static_cast<size_t>(count) * sizeof(T)), "allocation");
+    }
+  }
+  ~DeviceBuffer() { cudaFree(this->Data); }
+  DeviceBuffer(DeviceBuffer&& other) noexcept : Data(other.Data) { other.Data = nullptr; }
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  T* get() const { return this->Data; }
+
+private:
+  T* Data = nullptr;
+};
+
+constexpr int kThreads = 256;
+
+template <class Kernel>
+__global__ void runKernel(Kernel kernel, Index threads)
+{
+  const Index thread = static_cast<Index>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (thread < threads)
+  {
+    kernel(thread);
+  }
+}
+
+/// out[z][x][y] = in[z][y][x] for every slice, through a padded shared-memory tile.
+template <class T>
+__global__ void transposeSlices(const T* in, T* out, Index nx, Index ny)
+{
+  __shared__ T tile[32][33];
+  const Index z = blockIdx.z;
+  const Index x0 = static_cast<Index>(blockIdx.x) * 32, y0 = static_cast<Index>(blockIdx.y) * 32;
+  for (int j = threadIdx.y; j < 32; j += blockDim.y)
+  {
+    const Index x = x0 + threadIdx.x, y = y0 + j;
+    if (x < nx && y < ny)
+    {
+      tile[j][threadIdx.x] = in[(z * ny + y) * nx + x];
+    }
+  }
+  __syncthreads();
+  for (int j = threadIdx.y; j < 32; j += blockDim.y)
+  {
+    const Index y = y0 + threadIdx.x, x = x0 + j;
+    if (x < nx && y < ny)
+    {
+      out[(z * nx + x) * ny + y] = tile[threadIdx.x][j];
+    }
+  }
+}
+
+/// Runs the pipeline's kernels on the device, timing each with CUDA events when asked.
+class CudaExecutor
+{
+public:
+  CudaExecutor(Timing* timing, const Execution& execution)
+    : Report(timing)
+    , Exec(execution)
+  {
+    if (this->Report)
+    {
+      check(cudaEventCreate(&this->Start), "event");
+      check(cudaEventCreate(&this->Stop), "event");
+    }
+  }
+  ~CudaExecutor()
+  {
+    if (this->Report)
+    {
+      cudaEventDestroy(this->Start);
+      cudaEventDestroy(this->Stop);
+    }
+  }
+  CudaExecutor(const CudaExecutor&) = delete;
+  CudaExecutor& operator=(const CudaExecutor&) = delete;
+
+  template <class U>
+  DeviceBuffer<U> allocate(Index count)
+  {
+    return DeviceBuffer<U>(count);
+  }
+
+  template <class Kernel>
+  void launch(const Kernel& kernel, const char* name, double bytes)
+  {
+    const Index threads = kernel.threads();
+    this->begin();
+    if (threads > 0)
+    {
+      runKernel<<<static_cast<unsigned>((threads + kThreads - 1) / kThreads), kThreads>>>(kernel, threads);
+    }
+    this->end(name, bytes);
+  }
+
+  template <class U>
+  void transpose(const U* in, U* out, Index nx, Index ny, Index nz, const char* name)
+  {
+    this->begin();
+    const dim3 grid(static_cast<unsigned>((nx + 31) / 32), static_cast<unsigned>((ny + 31) / 32),
+      static_cast<unsigned>(nz));
+    transposeSlices<U><<<grid, dim3(32, 8)>>>(in, out, nx, ny);
+    this->end(name, 2.0 * nx * ny * nz * sizeof(U));
+  }
+
+  void progress(double fraction)
+  {
+    if (this->Exec.progress)
+      this->Exec.progress(fraction);
+    if (this->Exec.abortRequested && this->Exec.abortRequested())
+      throw CudaFailure("cancelled");
+  }
+
+private:
+  void begin()
+  {
+    if (this->Report)
+      check(cudaEventRecord(this->Start), "event record");
+  }
+  /// Ends a pass: checks its launch, and records its time and traffic.
+  void end(const char* name, double bytes)
+  {
+    check(cudaGetLastError(), name);
+    if (!this->Report)
+      return;
+    check(cudaEventRecord(this->Stop), "event record");
+    check(cudaEventSynchronize(this->Stop), name);
+    float ms = 0.0f;
+    check(cudaEventElapsedTime(&ms, this->Start, this->Stop), "event time");
+    this->Report->passes.push_back({ name, ms, bytes });
+    this->Report->kernelMilliseconds += ms;
+  }
+
+  Timing* Report;
+  const Execution& Exec;
+  cudaEvent_t Start = nullptr, Stop = nullptr;
+};
+
+/// Copies the block the region reads into device memory, contiguous.
+template <class T>
+void upload(const detail::TypedVolume<T>& volume, const Region& region, const gpu::RegionGeometry& g, T* device)
+{
+  const Index x0 = region.begin[0] - g.ox, y0 = region.begin[1] - g.oy, z0 = region.begin[2] - g.oz;
+  if (volume.stride == 1)
+  {
+    cudaMemcpy3DParms p = {};
+    p.srcPtr = make_cudaPitchedPtr(const_cast<T*>(volume.data), volume.dims[0] * sizeof(T), volume.dims[0],
+      volume.dims[1]);
+    p.srcPos = make_cudaPos(x0 * sizeof(T), y0, z0);
+    p.dstPtr = make_cudaPitchedPtr(device, g.sx * sizeof(T), g.sx, g.sy);
+    p.extent = make_cudaExtent(g.sx * sizeof(T), g.sy, g.sz);
+    p.kind = cudaMemcpyHostToDevice;
+    check(cudaMemcpy3D(&p), "upload");
+    return;
+  }
+  // One component of a multi-component array: gathered on the host first.
+  std::vector<T> gathered(static_cast<size_t>(g.block()));
+  Index k = 0;
+  for (Index z = z0; z < z0 + g.sz; ++z)
+    for (Index y = y0; y < y0 + g.sy; ++y)
+      for (Index x = x0; x < x0 + g.sx; ++x)
+        gathered[k++] = volume.value(x, y, z);
+  check(cudaMemcpy(device, gathered.data(), gathered.size() * sizeof(T), cudaMemcpyHostToDevice), "upload");
+}
+
+/// Host pointers of the results (null: not asked for), region-sized.
+struct HostOutputs
+{
+  float* openness = nullptr;
+  float* variance = nullptr;
+  BoxStatisticsOutput statistics;
+};
+
+template <class T>
+void run(const VolumeView& view, const Region& region, const Radius& radius, bool withExtrema,
+  const gpu::EstimatorSetting& estimator, const HostOutputs& host, const Execution& execution, Timing* timing)
+{
+  using Acc = typename detail::MomentTraits<T>::Accumulator;
+  const detail::TypedVolume<T> volume(view);
+  const gpu::RegionGeometry g = gpu::geometryFor(view.dims, region, radius);
+  const Acc shift =
+    detail::MomentTraits<T>::exactInteger ? Acc(0) : static_cast<Acc>(detail::sampledMean(volume));
+  CudaExecutor ex(timing, execution);
+  DeviceBuffer<T> input(g.block());
+  upload(volume, region, g, input.get());
+  ex.progress(0.1);
+
+  const Index n = g.region();
+  const BoxStatisticsOutput& st = host.statistics;
+  DeviceBuffer<float> openness(host.openness ? n : 0), variance(host.variance ? n : 0);
+  DeviceBuffer<double> count(st.count ? n : 0), mean(st.mean ? n : 0), varianceD(st.variance ? n : 0),
+    minimum(st.minimum ? n : 0), maximum(st.maximum ? n : 0);
+  const gpu::FinalOutputs out{ openness.get(), variance.get(), count.get(), mean.get(), varianceD.get(),
+    minimum.get(), maximum.get() };
+  gpu::runPasses<T, Acc>(ex, input.get(), g, withExtrema, shift, estimator, out);
+
+  auto download = [n](auto* to, const auto& from) {
+    if (to)
+      check(cudaMemcpy(to, from.get(), n * sizeof(*to), cudaMemcpyDeviceToHost), "download");
+  };
+  download(host.openness, openness);
+  download(host.variance, variance);
+  download(st.count, count);
+  download(st.mean, mean);
+  download(st.variance, varianceD);
+  download(st.minimum, minimum);
+  download(st.maximum, maximum);
+  ex.progress(1.0);
+}
+
+Status runChecked(const VolumeView& view, const Region& region, const Radius& radius, bool withExtrema,
+  const gpu::EstimatorSetting& estimator, const HostOutputs& host, const Execution& execution, Timing* timing)
+{
+  Status status = validate(view, region, radius);
+  if (!status.ok)
+  {
+    return status;
+  }
+  const DeviceStatus device = deviceStatus();
+  if (!device.available)
+  {
+    return Status::failure("no CUDA device: " + device.description);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  if (timing)
+  {
+    *timing = Timing{};
+  }
+  try
+  {
+    detail::dispatchScalarType(view.type, [&](auto tag) {
+      run<decltype(tag)>(view, region, radius, withExtrema, estimator, host, execution, timing);
+    });
+    check(cudaDeviceSynchronize(), "synchronize");
+  }
+  catch (const CudaFailure& failure)
+  {
+    cudaGetLastError(); // clear a non-sticky error so the next call starts clean
+    return std::strcmp(failure.what(), "cancelled") == 0 ? Status::cancelled() : Status::failure(failure.what());
+  }
+  catch (const std::bad_alloc&)
+  {
+    return Status::failure("out of host memory for the transfer");
+  }
+  if (timing)
+  {
+    timing->totalMilliseconds =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
+  return Status::success();
+}
+
+} // namespace
+
+bool built()
+{
+  return true;
+}
+
+DeviceStatus deviceStatus()
+{
+  static std::once_flag once;
+  static DeviceStatus status;
+  std::call_once(once, [] {
+    int count = 0;
+    const cudaError_t error = cudaGetDeviceCount(&count);
+    if (error != cudaSuccess || count == 0)
+    {
+      status.description = error != cudaSuccess ? cudaGetErrorString(error) : "no CUDA device found";
+      cudaGetLastError();
+      return;
+    }
+    cudaDeviceProp properties;
+    if (cudaGetDeviceProperties(&properties, 0) != cudaSuccess)
+    {
+      status.description = "cannot query CUDA device 0";
+      return;
+    }
+    std::ostringstream text;
+    text << properties.name << " (" << properties.totalGlobalMem / (1024 * 1024) << " MiB, sm_"
+         << properties.major << properties.minor << ")";
+    status.available = true;
+    status.description = text.str();
+  });
+  return status;
+}
+
+Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
+  const AmbientOcclusionParameters& p, const AmbientOcclusionOutput& output,
+  const Execution& execution, Timing* timing)
+{
+  if (!isSeparableMethod(p.method))
+  {
+    return Status::failure("the exact references (Exact Box, Exact Sphere) run on the CPU only");
+  }
+  if (p.queryMode == QueryMode::IsoValue && !std::isfinite(p.isoValue))
+  {
+    return Status::failure("the iso value must be a finite number");
+  }
+  HostOutputs host;
+  host.openness = output.openness;
+  host.variance = output.variance;
+  const bool withExtrema = output.openness && p.method == Method::CdfReconstruction;
+  return runChecked(volume, region, p.radius, withExtrema, { p.method, p.queryMode, p.isoValue, p.erfMode },
+    host, execution, timing);
+}
+
+Status computeBoxStatistics(const VolumeView& volume, const Region& region, const Radius& radius,
+  const BoxStatisticsOutput& output, const Execution& execution, Timing* timing)
+{
+  HostOutputs host;
+  host.statistics = output;
+  return runChecked(volume, region, radius, output.minimum || output.maximum,
+    { Method::GaussianCdf, QueryMode::VoxelValue, 0.0, ErfMode::Exact }, host, execution, timing);
+}
+
+double measureCopyBandwidth(double bytes)
+{
+  if (!deviceStatus().available || bytes <= 0)
+  {
+    return 0.0;
+  }
+  try
+  {
+    const Index n = static_cast<Index>(bytes);
+    DeviceBuffer<char> from(n), to(n);
+    check(cudaMemcpy(to.get(), from.get(), n, cudaMemcpyDeviceToDevice), "copy"); // warm-up
+    cudaEvent_t start, stop;
+    check(cudaEventCreate(&start), "event");
+    check(cudaEventCreate(&stop), "event");
+    float best = 1e30f;
+    for (int repeat = 0; repeat < 5; ++repeat)
+    {
+      check(cudaEventRecord(start), "event record");
+      check(cudaMemcpy(to.get(), from.get(), n, cudaMemcpyDeviceToDevice), "copy");
+      check(cudaEventRecord(stop), "event record");
+      check(cudaEventSynchronize(stop), "copy");
+      float ms = 0.0f;
+      check(cudaEventElapsedTime(&ms, start, stop), "event time");
+      best = std::min(best, ms);
+    }
+    cudaEventDestroy(start);
+    cudaEventDestroy(stop);
+    return 2.0 * bytes / (best * 1e-3) / 1e9; // read + write, like the passes' traffic
+  }
+  catch (const CudaFailure&)
+  {
+    cudaGetLastError();
+    return 0.0;
+  }
+}
+
+} // namespace cuda
+} // namespace vao

@@ -1,0 +1,451 @@
+// The GPU pipeline, written once for two executors: the CUDA one (CudaBackend.cu) runs
+// each kernel as one GPU thread per index; the host emulator (tests) runs the same
+// per-thread code in a loop, so the indexing of every pass is tested on machines without
+// a GPU. No CUDA runtime calls here.
+//
+// Every pass runs along one axis with one thread per "lane" (a line of voxels along the
+// axis) and adjacent threads on adjacent voxels, so loads and stores are coalesced. The
+// x axis is contiguous in memory, so the x passes run on a transposed copy (x and y
+// swapped per slice) and transpose back. Each pass is O(1) per voxel whatever the radius:
+// running sums for the moments, van Herk / Gil-Werman blocks for the extrema. The last
+// (z) pass evaluates the estimator (Estimators.h, the formulas the CPU uses) in place, so
+// the statistics themselves are never written out for the openness.
+#pragma once
+
+#include "vao/AmbientOcclusion.h"
+#include "vao/Estimators.h"
+
+#include <algorithm>
+#include <cstdint>
+
+namespace vao
+{
+namespace gpu
+{
+
+using Index = long long;
+
+template <class T>
+VAO_HD T lower(T a, T b)
+{
+  return b < a ? b : a;
+}
+template <class T>
+VAO_HD T greater(T a, T b)
+{
+  return a < b ? b : a;
+}
+
+/// Element (lane, i) of an array seen as lanes along one axis: lanes run over an inner
+/// dimension (contiguous) and an outer one; i steps along the axis.
+struct LaneLayout
+{
+  Index inner;       // lanes along the contiguous dimension
+  Index outerStride; // elements between consecutive outer lanes
+  Index step;        // elements between consecutive voxels along the axis
+
+  VAO_HD Index at(Index lane, Index i) const { return (lane / inner) * outerStride + lane % inner + i * step; }
+};
+
+/// One sliding-window pass along an axis: n input voxels per lane, outCount outputs for
+/// positions outBegin.., windows of half-width r clipped to [0, n).
+struct AxisPass
+{
+  Index lanes;
+  Index n;
+  Index r;
+  Index outBegin;
+  Index outCount;
+  LaneLayout in;
+  LaneLayout out;
+
+  VAO_HD Index blocks() const { return (n + 2 * r) / (2 * r + 1); } // van Herk blocks per lane
+};
+
+/// Outputs one thread of a running-sum pass computes: its initial window costs 2r + 1
+/// additions, spread over at least as many outputs, so the cost per voxel stays O(1).
+VAO_HD Index segmentLength(Index r)
+{
+  return 2 * (2 * r + 1) > 32 ? 2 * (2 * r + 1) : 32;
+}
+
+VAO_HD Index segmentsOf(Index count, Index segment)
+{
+  return (count + segment - 1) / segment;
+}
+
+/// Value of voxel i of a lane as the accumulator sees it: raw input (first pass, shifted,
+/// squared for the second moment) or the previous pass's two sums.
+template <class TIn, class Acc, bool FromInput>
+struct MomentSource
+{
+  const TIn* first;
+  const TIn* second; // unused when FromInput: both moments come from `first`
+  Acc shift;
+
+  VAO_HD void load(Index index, Acc& v1, Acc& v2) const
+  {
+    if (FromInput)
+    {
+      const Acc v = static_cast<Acc>(first[index]) - shift;
+      v1 = v;
+      v2 = v * v;
+    }
+    else
+    {
+      v1 = static_cast<Acc>(first[index]);
+      v2 = static_cast<Acc>(second[index]);
+    }
+  }
+};
+
+/// Box sums of both moments along one axis: one thread per (lane, segment of outputs),
+/// a running window moved by one addition and one subtraction per output.
+template <class TIn, class Acc, bool FromInput>
+struct MomentKernel
+{
+  MomentSource<TIn, Acc, FromInput> source;
+  Acc* out1;
+  Acc* out2;
+  AxisPass pass;
+  Index segment;
+
+  VAO_HD Index threads() const { return pass.lanes * segmentsOf(pass.outCount, segment); }
+
+  VAO_HD void operator()(Index thread) const
+  {
+    const Index lane = thread % pass.lanes; // adjacent threads: adjacent lanes (coalesced)
+    const Index first = (thread / pass.lanes) * segment;
+    const Index last = lower(first + segment, pass.outCount);
+    const Index i0 = pass.outBegin + first;
+    const Index lo = greater(Index(0), i0 - pass.r), hi = lower(pass.n - 1, i0 + pass.r);
+    Acc s1 = 0, s2 = 0, v1, v2;
+    for (Index j = lo; j <= hi; ++j)
+    {
+      source.load(pass.in.at(lane, j), v1, v2);
+      s1 += v1;
+      s2 += v2;
+    }
+    for (Index o = first; o < last; ++o)
+    {
+      const Index at = pass.out.at(lane, o);
+      out1[at] = s1;
+      out2[at] = s2;
+      const Index i = pass.outBegin + o + 1; // the next output's window
+      if (i + pass.r <= pass.n - 1)
+      {
+        source.load(pass.in.at(lane, i + pass.r), v1, v2);
+        s1 += v1;
+        s2 += v2;
+      }
+      if (i - pass.r - 1 >= 0)
+      {
+        source.load(pass.in.at(lane, i - pass.r - 1), v1, v2);
+        s1 -= v1;
+        s2 -= v2;
+      }
+    }
+  }
+};
+
+/// Van Herk step 1: suffix minimum and maximum of every block of w = 2r + 1 voxels,
+/// one thread per (lane, block).
+template <class T>
+struct ExtremaSuffixKernel
+{
+  const T* inMin;
+  const T* inMax;
+  T* sufMin;
+  T* sufMax;
+  AxisPass pass;
+
+  VAO_HD Index threads() const { return pass.lanes * pass.blocks(); }
+
+  VAO_HD void operator()(Index thread) const
+  {
+    const Index lane = thread % pass.lanes;
+    const Index start = (thread / pass.lanes) * (2 * pass.r + 1);
+    const Index end = lower(start + 2 * pass.r + 1, pass.n);
+    Index at = pass.in.at(lane, end - 1);
+    T lo = inMin[at], hi = inMax[at];
+    sufMin[at] = lo;
+    sufMax[at] = hi;
+    for (Index i = end - 2; i >= start; --i)
+    {
+      at = pass.in.at(lane, i);
+      lo = lower(lo, inMin[at]);
+      hi = greater(hi, inMax[at]);
+      sufMin[at] = lo;
+      sufMax[at] = hi;
+    }
+  }
+};
+
+/// Van Herk step 2: one thread per (lane, block B) takes the outputs whose window ends in
+/// B, runs B's prefix up to each window end and combines it with the suffix at its start.
+template <class T>
+struct ExtremaOutputKernel
+{
+  const T* inMin;
+  const T* inMax;
+  const T* sufMin;
+  const T* sufMax;
+  T* outMin;
+  T* outMax;
+  AxisPass pass;
+
+  VAO_HD Index threads() const { return pass.lanes * pass.blocks(); }
+
+  VAO_HD void operator()(Index thread) const
+  {
+    const Index lane = thread % pass.lanes;
+    const Index start = (thread / pass.lanes) * (2 * pass.r + 1);
+    const Index end = lower(start + 2 * pass.r + 1, pass.n); // block [start, end)
+    T preMin = inMin[pass.in.at(lane, start)], preMax = inMax[pass.in.at(lane, start)];
+    Index prefixEnd = start; // the prefix covers [start, prefixEnd]
+    // The outputs whose window end hi = min(n - 1, i + r) lies in [start, end): windows
+    // clipped at the end of the data end in the last block.
+    const Index iFirst = greater(pass.outBegin, start - pass.r);
+    const Index iLast =
+      lower(pass.outBegin + pass.outCount - 1, end == pass.n ? pass.n - 1 : end - 1 - pass.r);
+    for (Index i = iFirst; i <= iLast; ++i)
+    {
+      const Index hi = lower(pass.n - 1, i + pass.r);
+      while (prefixEnd < hi)
+      {
+        ++prefixEnd;
+        const Index at = pass.in.at(lane, prefixEnd);
+        preMin = lower(preMin, inMin[at]);
+        preMax = greater(preMax, inMax[at]);
+      }
+      const Index lo = greater(Index(0), i - pass.r);
+      T resultMin = preMin, resultMax = preMax; // the window starts the block
+      if (lo < start)
+      {
+        // It spans the previous block's suffix from lo and this block's prefix to hi.
+        const Index at = pass.in.at(lane, lo);
+        resultMin = lower(sufMin[at], preMin);
+        resultMax = greater(sufMax[at], preMax);
+      }
+      else if (lo > start)
+      {
+        // Clipped at the end of the data: the suffix of this (last) block from lo.
+        const Index at = pass.in.at(lane, lo);
+        resultMin = sufMin[at];
+        resultMax = sufMax[at];
+      }
+      const Index to = pass.out.at(lane, i - pass.outBegin);
+      outMin[to] = resultMin;
+      outMax[to] = resultMax;
+    }
+  }
+};
+
+/// What the last pass writes (null: not asked for): openness and variance (float) or the
+/// statistics (double).
+struct FinalOutputs
+{
+  float* openness;
+  float* variance;
+  double* count;
+  double* mean;
+  double* varianceD;
+  double* minimum;
+  double* maximum;
+};
+
+/// Geometry of the computation: the block the region reads, and the region inside it.
+struct RegionGeometry
+{
+  Index sx, sy, sz; // the uploaded block (the spans the region reads)
+  Index ox, oy, oz; // the region's origin inside it
+  Index rx, ry, rz; // the region's size
+  Index radius[3];
+
+  VAO_HD Index block() const { return sx * sy * sz; }
+  VAO_HD Index afterX() const { return rx * sy * sz; } // region width, spans in y and z
+  VAO_HD Index afterY() const { return rx * ry * sz; }
+  VAO_HD Index region() const { return rx * ry * rz; }
+};
+
+/// The block a region reads (its spans grown by the radius, clipped to the volume) and
+/// the region inside it. Windows clipped to the block are those clipped to the volume.
+inline RegionGeometry geometryFor(const Index3& dims, const Region& region, const Radius& radius)
+{
+  const int r[3] = { radius.x, radius.y, radius.z };
+  Index lo[3], size[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = std::max<Index>(0, region.begin[a] - r[a]);
+    size[a] = std::min<Index>(dims[a], region.begin[a] + region.size[a] + r[a]) - lo[a];
+  }
+  return RegionGeometry{ size[0], size[1], size[2], region.begin[0] - lo[0], region.begin[1] - lo[1],
+    region.begin[2] - lo[2], region.size[0], region.size[1], region.size[2], { r[0], r[1], r[2] } };
+}
+
+/// What to compute: the estimator and its query (ignored for the statistics).
+struct EstimatorSetting
+{
+  Method method;
+  QueryMode query;
+  double isoValue;
+  ErfMode erfMode;
+};
+
+/// The z pass fused with the estimator: one thread per (x, y) column of the region and
+/// segment of slices; running sums of both moments along z, then the formulas of
+/// Estimators.h on each voxel's statistics.
+template <class T, class Acc>
+struct FinalKernel
+{
+  const Acc* sum1; // x and y box sums, [sz][ry][rx]
+  const Acc* sum2;
+  const T* extremaMin; // box extrema of the region, or null
+  const T* extremaMax;
+  const T* input; // the uploaded block, for the voxel-value query
+  RegionGeometry g;
+  Acc shift;
+  EstimatorSetting estimator;
+  FinalOutputs out;
+  Index segment;
+
+  VAO_HD Index threads() const { return g.rx * g.ry * segmentsOf(g.rz, segment); }
+
+  VAO_HD void operator()(Index thread) const
+  {
+    const Index lanes = g.rx * g.ry;
+    const Index lane = thread % lanes;
+    const Index x = lane % g.rx, y = lane / g.rx;
+    const Index first = (thread / lanes) * segment;
+    const Index last = lower(first + segment, g.rz);
+    const Index r = g.radius[2];
+    const Index countXY =
+      clippedWindowCount(g.ox + x, g.radius[0], g.sx) * clippedWindowCount(g.oy + y, g.radius[1], g.sy);
+    const Index lo = greater(Index(0), g.oz + first - r), hi = lower(g.sz - 1, g.oz + first + r);
+    Acc s1 = 0, s2 = 0;
+    for (Index j = lo; j <= hi; ++j)
+    {
+      s1 += sum1[j * lanes + lane];
+      s2 += sum2[j * lanes + lane];
+    }
+    for (Index k = first; k < last; ++k)
+    {
+      const Index z = g.oz + k;
+      const Index index = k * lanes + lane; // in the region, x fastest
+      const long long count = countXY * clippedWindowCount(z, r, g.sz);
+      this->write(index, z, x, y, count, s1, s2);
+      if (z + r + 1 <= g.sz - 1)
+      {
+        s1 += sum1[(z + r + 1) * lanes + lane];
+        s2 += sum2[(z + r + 1) * lanes + lane];
+      }
+      if (z - r >= 0)
+      {
+        s1 -= sum1[(z - r) * lanes + lane];
+        s2 -= sum2[(z - r) * lanes + lane];
+      }
+    }
+  }
+
+  VAO_HD void write(Index index, Index z, Index x, Index y, long long count, Acc s1, Acc s2) const
+  {
+    NeighbourhoodStats s{ 0.0, 0.0, 0.0, 0.0 };
+    meanVarianceFromSums(s1, s2, count, static_cast<double>(shift), s.mean, s.variance);
+    if (extremaMin)
+    {
+      s.minimum = static_cast<double>(extremaMin[index]);
+      s.maximum = static_cast<double>(extremaMax[index]);
+    }
+    if (out.openness)
+    {
+      const double q = estimator.query == QueryMode::VoxelValue
+        ? static_cast<double>(input[(z * g.sy + g.oy + y) * g.sx + g.ox + x])
+        : estimator.isoValue;
+      out.openness[index] = static_cast<float>(opennessFromStats(estimator.method, q, s, estimator.erfMode));
+    }
+    if (out.variance)
+      out.variance[index] = static_cast<float>(s.variance);
+    if (out.count)
+      out.count[index] = static_cast<double>(count);
+    if (out.mean)
+      out.mean[index] = s.mean;
+    if (out.varianceD)
+      out.varianceD[index] = s.variance;
+    if (out.minimum)
+      out.minimum[index] = s.minimum;
+    if (out.maximum)
+      out.maximum[index] = s.maximum;
+  }
+};
+
+/// The passes in order, on an executor that provides:
+///   Buffer<U> allocate<U>(Index count)          (.get() gives the pointer)
+///   void launch(const Kernel& k, const char* name, double bytes)   runs k(t), t < k.threads()
+///   void transpose(const U* in, U* out, Index nx, Index ny, Index nz, const char* name)
+///   void progress(double fraction)              (may throw to cancel)
+/// `input` is the uploaded block (g.block() values); `out` points to executor memory.
+template <class T, class Acc, class Executor>
+void runPasses(Executor& ex, const T* input, const RegionGeometry& g, bool withExtrema, Acc shift,
+  const EstimatorSetting& estimator, const FinalOutputs& out)
+{
+  const AxisPass xPass{ g.sy * g.sz, g.sx, g.radius[0], g.ox, g.rx, LaneLayout{ g.sy, g.sx * g.sy, g.sy },
+    LaneLayout{ g.sy, g.rx * g.sy, g.sy } };
+  const AxisPass yPass{ g.rx * g.sz, g.sy, g.radius[1], g.oy, g.ry, LaneLayout{ g.rx, g.sy * g.rx, g.rx },
+    LaneLayout{ g.rx, g.ry * g.rx, g.rx } };
+  const AxisPass zPass{ g.rx * g.ry, g.sz, g.radius[2], g.oz, g.rz, LaneLayout{ g.rx * g.ry, 0, g.rx * g.ry },
+    LaneLayout{ g.rx * g.ry, 0, g.rx * g.ry } };
+
+  // x passes run on the transposed block: lanes are (y, z), x is the axis.
+  auto transposed = ex.template allocate<T>(g.block());
+  ex.transpose(input, transposed.get(), g.sx, g.sy, g.sz, "transpose input");
+
+  // Moments along x and y; z in the final pass.
+  auto a1 = ex.template allocate<Acc>(g.afterX()), a2 = ex.template allocate<Acc>(g.afterX());
+  auto b1 = ex.template allocate<Acc>(g.afterX()), b2 = ex.template allocate<Acc>(g.afterX());
+  const MomentKernel<T, Acc, true> momentsX{ { transposed.get(), nullptr, shift }, a1.get(), a2.get(), xPass,
+    segmentLength(xPass.r) };
+  ex.launch(momentsX, "moments x", g.block() * sizeof(T) + 2.0 * g.afterX() * sizeof(Acc));
+  ex.transpose(a1.get(), b1.get(), g.sy, g.rx, g.sz, "transpose moments"); // -> [z][y][x]
+  ex.transpose(a2.get(), b2.get(), g.sy, g.rx, g.sz, "transpose moments");
+  const MomentKernel<Acc, Acc, false> momentsY{ { b1.get(), b2.get(), Acc(0) }, a1.get(), a2.get(), yPass,
+    segmentLength(yPass.r) };
+  ex.launch(momentsY, "moments y", 2.0 * (g.afterX() + g.afterY()) * sizeof(Acc));
+  ex.progress(0.4);
+
+  // Extrema (CDF Reconstruction, statistics): the same three axes with van Herk blocks.
+  // x: transposed -> e (suffixes in f), transpose e -> f, y: f -> e, z: e -> f.
+  const Index room = withExtrema ? (g.block() > g.afterX() ? g.block() : g.afterX()) : 0;
+  auto e1 = ex.template allocate<T>(withExtrema ? g.afterX() : 0), e2 = ex.template allocate<T>(withExtrema ? g.afterX() : 0);
+  auto f1 = ex.template allocate<T>(room), f2 = ex.template allocate<T>(room);
+  auto s1 = ex.template allocate<T>(withExtrema ? g.afterX() : 0), s2 = ex.template allocate<T>(withExtrema ? g.afterX() : 0);
+  if (withExtrema)
+  {
+    ex.launch(ExtremaSuffixKernel<T>{ transposed.get(), transposed.get(), f1.get(), f2.get(), xPass },
+      "extrema x suffix", 3.0 * g.block() * sizeof(T));
+    ex.launch(ExtremaOutputKernel<T>{ transposed.get(), transposed.get(), f1.get(), f2.get(), e1.get(), e2.get(), xPass },
+      "extrema x", 2.0 * g.block() * sizeof(T) + 2.0 * g.afterX() * sizeof(T));
+    ex.transpose(e1.get(), f1.get(), g.sy, g.rx, g.sz, "transpose extrema");
+    ex.transpose(e2.get(), f2.get(), g.sy, g.rx, g.sz, "transpose extrema");
+    ex.launch(ExtremaSuffixKernel<T>{ f1.get(), f2.get(), s1.get(), s2.get(), yPass }, "extrema y suffix",
+      4.0 * g.afterX() * sizeof(T));
+    ex.launch(ExtremaOutputKernel<T>{ f1.get(), f2.get(), s1.get(), s2.get(), e1.get(), e2.get(), yPass },
+      "extrema y", 4.0 * g.afterX() * sizeof(T) + 2.0 * g.afterY() * sizeof(T));
+    ex.launch(ExtremaSuffixKernel<T>{ e1.get(), e2.get(), s1.get(), s2.get(), zPass }, "extrema z suffix",
+      4.0 * g.afterY() * sizeof(T));
+    ex.launch(ExtremaOutputKernel<T>{ e1.get(), e2.get(), s1.get(), s2.get(), f1.get(), f2.get(), zPass },
+      "extrema z", 4.0 * g.afterY() * sizeof(T) + 2.0 * g.region() * sizeof(T));
+  }
+  ex.progress(0.6);
+
+  const FinalKernel<T, Acc> final{ a1.get(), a2.get(), withExtrema ? f1.get() : nullptr,
+    withExtrema ? f2.get() : nullptr, input, g, shift, estimator, out, segmentLength(g.radius[2]) };
+  const double written = g.region() * ((out.openness ? 4.0 : 0.0) + (out.variance ? 4.0 : 0.0) +
+    8.0 * ((out.count != nullptr) + (out.mean != nullptr) + (out.varianceD != nullptr) +
+      (out.minimum != nullptr) + (out.maximum != nullptr)));
+  ex.launch(final, "z + estimator",
+    2.0 * g.afterY() * sizeof(Acc) + g.region() * sizeof(T) * (withExtrema ? 3.0 : 1.0) + written);
+  ex.progress(0.9);
+}
+
+} // namespace gpu
+} // namespace vao
