@@ -39,6 +39,7 @@ struct PassTiming
 };
 
 /// Where the time of one call went (CUDA events for the kernels, wall clock overall).
+/// Reset by every call that receives it; totalMilliseconds is set on success only.
 struct Timing
 {
   double kernelMilliseconds = 0.0; // all kernels, measured with CUDA events
@@ -47,6 +48,8 @@ struct Timing
 };
 
 /// Openness (and optionally the variance) of every voxel of the region, on the GPU.
+/// Execution: progress and cancellation between stages (a running kernel is not
+/// interrupted); the thread count does not apply.
 /// Method must be CdfReconstruction, GaussianCdf or Chebyshev: the exact references run
 /// on the CPU only.
 Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
@@ -57,8 +60,9 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
 Status computeBoxStatistics(const VolumeView& volume, const Region& region, const Radius& radius,
   const BoxStatisticsOutput& output, const Execution& execution = {}, Timing* timing = nullptr);
 
-/// Device-to-device copy bandwidth in GB/s over a buffer of `bytes` (the reference the
-/// passes are compared with); 0 without a device.
+/// Device-to-device copy bandwidth in GB/s over a buffer of `bytes`, counting the bytes
+/// read plus those written (as PassTiming::bytes does): the reference the passes are
+/// compared with. 0 without a device.
 double measureCopyBandwidth(double bytes);
 
 } // namespace cuda

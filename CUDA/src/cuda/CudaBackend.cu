@@ -99,7 +99,9 @@ __global__ void transposeSlices(const T* in, T* out, Index nx, Index ny)
   }
 }
 
-/// Runs the pipeline's kernels on the device, timing each with CUDA events when asked.
+/// Runs the pipeline's kernels on the device. When asked for timings, each pass gets a
+/// pair of CUDA events; they are read once at the end (finish), so timing adds no waits
+/// between passes.
 class CudaExecutor
 {
 public:
@@ -107,18 +109,15 @@ public:
     : Report(timing)
     , Exec(execution)
   {
-    if (this->Report)
-    {
-      check(cudaEventCreate(&this->Start), "event");
-      check(cudaEventCreate(&this->Stop), "event");
-    }
   }
   ~CudaExecutor()
   {
-    if (this->Report)
+    for (const Pass& pass : this->Passes)
     {
-      cudaEventDestroy(this->Start);
-      cudaEventDestroy(this->Stop);
+      if (pass.start)
+        cudaEventDestroy(pass.start);
+      if (pass.stop)
+        cudaEventDestroy(pass.stop);
     }
   }
   CudaExecutor(const CudaExecutor&) = delete;
@@ -152,6 +151,7 @@ public:
     this->end(name, 2.0 * nx * ny * nz * sizeof(U));
   }
 
+  /// Between stages only: a running kernel is not interrupted.
   void progress(double fraction)
   {
     if (this->Exec.progress)
@@ -160,29 +160,53 @@ public:
       throw CudaFailure("cancelled");
   }
 
+  /// Waits for the passes and reports their times.
+  void finish()
+  {
+    check(cudaDeviceSynchronize(), "passes");
+    for (const Pass& pass : this->Passes)
+    {
+      float ms = 0.0f;
+      check(cudaEventElapsedTime(&ms, pass.start, pass.stop), "event time");
+      this->Report->passes.push_back({ pass.name, ms, pass.bytes });
+      this->Report->kernelMilliseconds += ms;
+    }
+  }
+
 private:
+  struct Pass
+  {
+    const char* name;
+    double bytes;
+    cudaEvent_t start;
+    cudaEvent_t stop;
+  };
+
   void begin()
   {
-    if (this->Report)
-      check(cudaEventRecord(this->Start), "event record");
+    if (!this->Report)
+      return;
+    this->Passes.push_back({ nullptr, 0.0, nullptr, nullptr }); // destroyed with the executor
+    Pass& pass = this->Passes.back();
+    check(cudaEventCreate(&pass.start), "event");
+    check(cudaEventCreate(&pass.stop), "event");
+    check(cudaEventRecord(pass.start), "event record");
   }
-  /// Ends a pass: checks its launch, and records its time and traffic.
+  /// Ends a pass: checks its launch and records its stop event.
   void end(const char* name, double bytes)
   {
     check(cudaGetLastError(), name);
     if (!this->Report)
       return;
-    check(cudaEventRecord(this->Stop), "event record");
-    check(cudaEventSynchronize(this->Stop), name);
-    float ms = 0.0f;
-    check(cudaEventElapsedTime(&ms, this->Start, this->Stop), "event time");
-    this->Report->passes.push_back({ name, ms, bytes });
-    this->Report->kernelMilliseconds += ms;
+    Pass& pass = this->Passes.back();
+    pass.name = name;
+    pass.bytes = bytes;
+    check(cudaEventRecord(pass.stop), "event record");
   }
 
   Timing* Report;
   const Execution& Exec;
-  cudaEvent_t Start = nullptr, Stop = nullptr;
+  std::vector<Pass> Passes;
 };
 
 /// Copies the block the region reads into device memory, contiguous.
@@ -242,6 +266,10 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
   const gpu::FinalOutputs out{ openness.get(), variance.get(), count.get(), mean.get(), varianceD.get(),
     minimum.get(), maximum.get() };
   gpu::runPasses<T, Acc>(ex, input.get(), g, withExtrema, shift, estimator, out);
+  if (timing)
+  {
+    ex.finish();
+  }
 
   auto download = [n](auto* to, const auto& from) {
     if (to)
@@ -315,7 +343,8 @@ DeviceStatus deviceStatus()
     const cudaError_t error = cudaGetDeviceCount(&count);
     if (error != cudaSuccess || count == 0)
     {
-      status.description = error != cudaSuccess ? cudaGetErrorString(error) : "no CUDA device found";
+      status.description = std::string("no usable CUDA device (") +
+        (error != cudaSuccess ? cudaGetErrorString(error) : "none found") + ")";
       cudaGetLastError();
       return;
     }
