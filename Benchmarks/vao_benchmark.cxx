@@ -2,15 +2,21 @@
 // (the CT-body size of Ruiz et al. Table 1) and on the 512x512x209 CT head phantom, and,
 // measured in the same run, scipy.ndimage computing the same statistics.
 //
+// Then occlusion sweeping (distance only, with the occlusion, with the 8 octants) on the
+// generated scenes of Singh et al.'s Table 2 sizes and the CT head phantom's skin, against
+// scipy.ndimage.distance_transform_edt in the same run.
+//
 // Usage: vao_benchmark [--shared DIR] [--scipy PATH/TO/scipy_peer.py] [--repeat N]
-//                      [--exact] [--threads N]
+//                      [--exact] [--threads N] [--sweeping (the sweeping table only)]
 // Exact Box and Exact Sphere are O(R^3) references: by default they are timed on a
 // 32-slice slab and the whole-volume time is extrapolated (marked "~"); --exact times
 // them on the whole volume (minutes).
 #include "vtkAmbientOcclusionPhantom.h"
 #include "vtkVolumetricAmbientOcclusion.h"
 
+#include "SweepScene.h"
 #include "vao/AmbientOcclusion.h"
+#include "vao/OcclusionSweeping.h"
 
 #include "vtkExtractVOI.h"
 #include "vtkImageData.h"
@@ -46,6 +52,8 @@ struct Options
 {
   std::string shared = VAO_DEFAULT_SHARED_DATA_DIR;
   std::string scipy = VAO_DEFAULT_SCIPY_PEER;
+  std::string scipyEdt = VAO_DEFAULT_SCIPY_EDT_PEER;
+  bool sweepingOnly = false;
   int repeat = 3;
   bool exact = false;
   int threads = 0;
@@ -170,6 +178,125 @@ void Benchmark(const std::string& label, vtkImageData* image, const std::string&
   }
 }
 
+/// A MetaImage scan from ../shared/data; exits with a message when it cannot be read.
+vtkSmartPointer<vtkImageData> ReadScanOrExit(const std::string& path)
+{
+  vtkNew<vtkMetaImageReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (reader->GetOutput()->GetNumberOfPoints() == 0)
+  {
+    std::fprintf(stderr, "cannot read %s\n", path.c_str());
+    std::exit(1);
+  }
+  return reader->GetOutput();
+}
+
+/// Runs the scipy EDT peer on a raw float32 volume; seconds, or a negative value.
+double RunScipyEdt(const Options& options, const std::string& volumeFile, double iso)
+{
+  const std::string command = "/usr/bin/python3 '" + options.scipyEdt + "' '" + volumeFile + "' " + std::to_string(iso);
+  FILE* pipe = popen(command.c_str(), "r");
+  double seconds = -1.0;
+  char line[256];
+  while (pipe && std::fgets(line, sizeof(line), pipe))
+  {
+    std::sscanf(line, "edt %lf", &seconds);
+  }
+  if (pipe)
+  {
+    pclose(pipe);
+  }
+  return seconds;
+}
+
+/// Best of `repeat` runs of the sweeping kernel: distance only, with the combined
+/// occlusion, or with the 8 octants written out.
+double TimeSweeping(const vao::VolumeView& view, const std::array<double, 3>& spacing, double iso, int outputs,
+  int repeat, std::vector<float>& distance, std::vector<float>& ao, std::vector<float>& octants)
+{
+  vao::SweepParameters parameters;
+  parameters.isoValue = iso;
+  const vao::SweepOutput output{ distance.data(), outputs >= 1 ? ao.data() : nullptr,
+    outputs >= 2 ? octants.data() : nullptr };
+  double best = 1e300;
+  for (int r = 0; r < repeat; ++r)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    const vao::Status status = vao::computeOcclusionSweeping(view, spacing, parameters, output);
+    best = std::min(best, Seconds(start));
+    if (!status.ok)
+    {
+      std::fprintf(stderr, "sweeping failed: %s\n", status.message.c_str());
+      std::exit(1);
+    }
+  }
+  return best;
+}
+
+void SweepRow(const std::string& label, const vao::VolumeView& view, const std::array<double, 3>& spacing, double iso,
+  const std::string& rawForPeer, const Options& options)
+{
+  const size_t n = static_cast<size_t>(view.voxelCount());
+  std::vector<float> distance(n), ao(n), octants(8 * n);
+  const double sdf = TimeSweeping(view, spacing, iso, 0, options.repeat, distance, ao, octants);
+  const double combined = TimeSweeping(view, spacing, iso, 1, options.repeat, distance, ao, octants);
+  const double eight = TimeSweeping(view, spacing, iso, 2, options.repeat, distance, ao, octants);
+  const double edt = rawForPeer.empty() ? -1.0 : RunScipyEdt(options, rawForPeer, iso);
+  std::printf("  %-28s %10.0f %10.0f %10.0f %10.0f\n", label.c_str(), 1e3 * sdf, 1e3 * combined, 1e3 * eight,
+    edt > 0 ? 1e3 * edt : -1.0);
+}
+
+/// The sweeping table: the sizes of Singh et al.'s Table 2 (generated Fig. 3 scenes) and
+/// the CT head phantom's skin.
+void BenchmarkSweeping(const Options& options, vtkImageData* ct)
+{
+  std::printf("\nOcclusion sweeping (one pass; best of %d; ms) and scipy.ndimage.distance_transform_edt\n",
+    options.repeat);
+  std::printf("  %-28s %10s %10s %10s %10s\n", "volume", "SDF only", "SDF+AO", "8 octants", "scipy EDT");
+  const int sizes[][3] = { { 101, 101, 61 }, { 100, 100, 100 }, { 150, 150, 150 }, { 200, 200, 200 },
+    { 250, 250, 250 } };
+  for (const auto& size : sizes)
+  {
+    const int nx = size[0], ny = size[1], nz = size[2];
+    std::vector<float> volume(static_cast<size_t>(nx) * ny * nz);
+    for (int z = 0; z < nz; ++z)
+      for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x)
+        {
+          // The 100^3 scene stretched over the grid, a one-voxel occupancy ramp.
+          const double scale = (nx - 1) / 99.0;
+          const double d = vaotest::SceneDistance(x * 99.0 / (nx - 1), y * 99.0 / (ny - 1), z * 99.0 / (nz - 1));
+          volume[(static_cast<size_t>(z) * ny + y) * nx + x] = static_cast<float>(std::min(1.0, std::max(0.0, 0.5 - d * scale)));
+        }
+    const std::string raw = "/tmp/vao_sweep_" + std::to_string(nx) + "x" + std::to_string(ny) + "x" +
+      std::to_string(nz) + "_float32.raw";
+    std::ofstream(raw, std::ios::binary).write(reinterpret_cast<const char*>(volume.data()), volume.size() * sizeof(float));
+    vao::VolumeView view;
+    view.data = volume.data();
+    view.type = vao::ScalarType::Float32;
+    view.dims = { nx, ny, nz };
+    SweepRow(std::to_string(nx) + "x" + std::to_string(ny) + "x" + std::to_string(nz) + " scene", view,
+      { 1.0, 1.0, 1.0 }, 0.5, raw, options);
+    std::remove(raw.c_str());
+  }
+  vao::VolumeView view;
+  view.data = ct->GetScalarPointer();
+  view.type = vao::ScalarType::Int16;
+  const int* d = ct->GetDimensions();
+  view.dims = { d[0], d[1], d[2] };
+  const double* h = ct->GetSpacing();
+  // The peer reads float32: convert once for it.
+  std::vector<float> asFloat(static_cast<size_t>(view.voxelCount()));
+  const short* values = static_cast<const short*>(view.data);
+  std::copy(values, values + asFloat.size(), asFloat.begin());
+  const std::string raw = "/tmp/vao_sweep_ct_" + std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" +
+    std::to_string(d[2]) + "_float32.raw";
+  std::ofstream(raw, std::ios::binary).write(reinterpret_cast<const char*>(asFloat.data()), asFloat.size() * sizeof(float));
+  SweepRow("CT head skin (-300 HU)", view, { h[0], h[1], h[2] }, -300.0, raw, options);
+  std::remove(raw.c_str());
+}
+
 } // namespace
 
 int main(int argc, char* argv[])
@@ -188,37 +315,33 @@ int main(int argc, char* argv[])
       options.threads = std::max(0, std::atoi(argv[++i]));
     else if (arg == "--exact")
       options.exact = true;
+    else if (arg == "--sweeping")
+      options.sweepingOnly = true;
     else
     {
-      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--sweeping]\n", argv[0]);
       return 2;
     }
   }
   std::printf("VolumetricAO benchmark: best of %d runs of the filter (wall clock, input in memory)\n",
     options.repeat);
 
-  // The generated CT-body-sized volume, written raw for the scipy peer.
-  vtkNew<vtkAmbientOcclusionPhantom> phantom;
-  phantom->SetDimensions(256, 256, 415);
-  phantom->Update();
-  const std::string raw = "/tmp/vao_benchmark_phantom_256x256x415_int16.raw";
+  if (!options.sweepingOnly)
   {
-    std::ofstream out(raw, std::ios::binary);
-    out.write(static_cast<const char*>(phantom->GetOutput()->GetScalarPointer()),
-      phantom->GetOutput()->GetNumberOfPoints() * sizeof(short));
-  }
-  Benchmark("generated phantom", phantom->GetOutput(), raw, options);
-  std::remove(raw.c_str());
+    // The generated CT-body-sized volume, written raw for the scipy peer.
+    vtkNew<vtkAmbientOcclusionPhantom> phantom;
+    phantom->SetDimensions(256, 256, 415);
+    phantom->Update();
+    const std::string raw = "/tmp/vao_benchmark_phantom_256x256x415_int16.raw";
+    std::ofstream(raw, std::ios::binary)
+      .write(static_cast<const char*>(phantom->GetOutput()->GetScalarPointer()),
+        phantom->GetOutput()->GetNumberOfPoints() * sizeof(short));
+    Benchmark("generated phantom", phantom->GetOutput(), raw, options);
+    std::remove(raw.c_str());
 
-  const std::string ct = options.shared + "/ct_head_phantom/ct_head_phantom_512x512x209_int16.mha";
-  vtkNew<vtkMetaImageReader> reader;
-  reader->SetFileName(ct.c_str());
-  reader->Update();
-  if (reader->GetOutput()->GetNumberOfPoints() == 0)
-  {
-    std::fprintf(stderr, "cannot read %s\n", ct.c_str());
-    return 1;
+    const std::string ct = options.shared + "/ct_head_phantom/ct_head_phantom_512x512x209_int16.mha";
+    Benchmark("ct_head_phantom_512x512x209_int16.mha", ReadScanOrExit(ct), ct, options);
   }
-  Benchmark("ct_head_phantom_512x512x209_int16.mha", reader->GetOutput(), ct, options);
+  BenchmarkSweeping(options, ReadScanOrExit(options.shared + "/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));
   return 0;
 }

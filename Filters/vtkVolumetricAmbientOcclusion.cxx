@@ -1,5 +1,7 @@
 #include "vtkVolumetricAmbientOcclusion.h"
 
+#include "vtkAmbientOcclusionInput.h"
+
 #include "vao/AmbientOcclusion.h"
 #include "vao/Cuda.h"
 
@@ -28,50 +30,6 @@ namespace
 
 const char* const MethodNames[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box",
   "Exact Sphere" };
-
-bool ToKernelType(int vtkType, vao::ScalarType& type)
-{
-  switch (vtkType)
-  {
-    case VTK_CHAR:
-    case VTK_SIGNED_CHAR:
-      type = vao::ScalarType::Int8;
-      return true;
-    case VTK_UNSIGNED_CHAR:
-      type = vao::ScalarType::UInt8;
-      return true;
-    case VTK_SHORT:
-      type = vao::ScalarType::Int16;
-      return true;
-    case VTK_UNSIGNED_SHORT:
-      type = vao::ScalarType::UInt16;
-      return true;
-    case VTK_INT:
-      type = vao::ScalarType::Int32;
-      return true;
-    case VTK_UNSIGNED_INT:
-      type = vao::ScalarType::UInt32;
-      return true;
-    case VTK_LONG:
-    case VTK_LONG_LONG:
-    case VTK_ID_TYPE:
-      type = sizeof(long) == 8 || vtkType != VTK_LONG ? vao::ScalarType::Int64 : vao::ScalarType::Int32;
-      return true;
-    case VTK_UNSIGNED_LONG:
-    case VTK_UNSIGNED_LONG_LONG:
-      type = sizeof(unsigned long) == 8 || vtkType != VTK_UNSIGNED_LONG ? vao::ScalarType::UInt64
-                                                                         : vao::ScalarType::UInt32;
-      return true;
-    case VTK_FLOAT:
-      type = vao::ScalarType::Float32;
-      return true;
-    case VTK_DOUBLE:
-      type = vao::ScalarType::Float64;
-      return true;
-    default:
-      return false;
-  }
-}
 
 /// Grows ext by r on each axis, clipped to whole.
 void GrowExtent(int ext[6], const int r[3], const int whole[6])
@@ -219,14 +177,13 @@ int vtkVolumetricAmbientOcclusion::RequestData(
   int whole[6], outExt[6];
   inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
   outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), outExt);
-  const int wholeDims[3] = { whole[1] - whole[0] + 1, whole[3] - whole[2] + 1, whole[5] - whole[4] + 1 };
-  if (wholeDims[0] < 2 || wholeDims[1] < 2 || wholeDims[2] < 2)
+  std::string error;
+  if (!vtkAmbientOcclusionInput::CheckWholeExtent(whole, error))
   {
-    vtkErrorMacro(<< "Ambient occlusion needs a 3-D volume; the input is " << std::max(wholeDims[0], 0)
-                  << " x " << std::max(wholeDims[1], 0) << " x " << std::max(wholeDims[2], 0)
-                  << " voxels (empty, a single voxel, or 2-D).");
+    vtkErrorMacro(<< error);
     return 1;
   }
+  const int wholeDims[3] = { whole[1] - whole[0] + 1, whole[3] - whole[2] + 1, whole[5] - whole[4] + 1 };
   const int* inExt = input->GetExtent();
   if (input->GetNumberOfPoints() == 0)
   {
@@ -262,78 +219,14 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     return 1;
   }
 
-  vtkDataArray* scalars = this->GetInputArrayToProcess(0, inputVector);
-  vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
-  const char* arrayName = arrayInfo->Get(vtkDataObject::FIELD_NAME());
-  if (!scalars && (!arrayName || !*arrayName))
+  vtkAmbientOcclusionInput::ScalarVolume scalars;
+  if (!vtkAmbientOcclusionInput::PrepareScalars(
+        this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error))
   {
-    // No array chosen (pvpython before the input was updated): the active point scalars.
-    scalars = input->GetPointData()->GetScalars();
-  }
-  if (!scalars)
-  {
-    vtkErrorMacro(<< "No numeric point array to process: choose a point-data array of the image "
-                     "(the Scalars property; string and cell arrays are not accepted).");
+    vtkErrorMacro(<< error);
     return 1;
   }
-  if (input->GetPointData()->GetAbstractArray(scalars->GetName()) != scalars)
-  {
-    vtkErrorMacro(<< "Array '" << (scalars->GetName() ? scalars->GetName() : "")
-                  << "' is not a point-data array; ambient occlusion is defined on points (voxels).");
-    return 1;
-  }
-  const int components = scalars->GetNumberOfComponents();
-  int component = this->Component;
-  if (component < 0 && components == 1)
-  {
-    component = 0;
-  }
-  if (component < 0 || component >= components)
-  {
-    vtkErrorMacro(<< "Array '" << scalars->GetName() << "' has " << components
-                  << " components; set Component to one of 0.." << components - 1
-                  << " (got " << this->Component << ").");
-    return 1;
-  }
-  vao::VolumeView volume;
-  if (!ToKernelType(scalars->GetDataType(), volume.type))
-  {
-    vtkErrorMacro(<< "Array '" << scalars->GetName() << "' has unsupported type "
-                  << scalars->GetDataTypeAsString() << ".");
-    return 1;
-  }
-  std::vector<double> unpacked; // only for arrays without the standard (AOS) layout
-  const int* dims = input->GetDimensions();
-  volume.dims = { dims[0], dims[1], dims[2] };
-  if (scalars->HasStandardMemoryLayout())
-  {
-    volume.data = scalars->GetVoidPointer(component);
-    volume.voxelStride = components;
-  }
-  else
-  {
-    unpacked.resize(static_cast<size_t>(scalars->GetNumberOfTuples()));
-    for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i)
-    {
-      unpacked[i] = scalars->GetComponent(i, component);
-    }
-    volume.data = unpacked.data();
-    volume.type = vao::ScalarType::Float64;
-  }
-  std::int64_t firstBad = 0;
-  const std::int64_t nonFinite = vao::countNonFinite(volume, &firstBad);
-  if (nonFinite > 0)
-  {
-    int ijk[3] = { static_cast<int>(firstBad % dims[0]) + inExt[0],
-      static_cast<int>((firstBad / dims[0]) % dims[1]) + inExt[2],
-      static_cast<int>(firstBad / (static_cast<std::int64_t>(dims[0]) * dims[1])) + inExt[4] };
-    vtkErrorMacro(<< "Array '" << scalars->GetName() << "' has " << nonFinite
-                  << " NaN or infinite values (the first at voxel " << ijk[0] << ", " << ijk[1] << ", "
-                  << ijk[2] << "). A non-finite value has no place in a cumulative distribution: "
-                  << "replace them (e.g. with the Calculator or Threshold filters) first.");
-    return 1;
-  }
-
+  const vao::VolumeView& volume = scalars.view;
 
   vao::Region region;
   for (int a = 0; a < 3; ++a)
@@ -390,20 +283,7 @@ int vtkVolumetricAmbientOcclusion::RequestData(
   }
 
   // The output is exactly the requested extent: the input's arrays cropped to it.
-  if (region.voxelCount() == input->GetNumberOfPoints())
-  {
-    output->ShallowCopy(input);
-  }
-  else
-  {
-    output->SetExtent(outExt);
-    output->SetOrigin(input->GetOrigin());
-    output->SetSpacing(input->GetSpacing());
-    output->SetDirectionMatrix(input->GetDirectionMatrix());
-    output->GetPointData()->CopyAllocate(input->GetPointData(), region.voxelCount());
-    output->GetPointData()->CopyStructuredData(input->GetPointData(), inExt, outExt);
-    output->GetFieldData()->ShallowCopy(input->GetFieldData());
-  }
+  vtkAmbientOcclusionInput::CopyRequestedExtent(input, output, outExt);
   output->GetPointData()->AddArray(openness);
   if (variance)
   {

@@ -15,4 +15,7 @@ for method, radius, name in stages:
     current = VolumetricAmbientOcclusion(Input=current, Method=method, Radius=radius,
                                          OutputArrayName=name, ComputeVariance=(name == "GaussianCDF"))
     current.Scalars = ["POINTS", "MetaImage"]
+# Occlusion sweeping is global: every rank sweeps the whole volume, keeps its piece.
+current = OcclusionSweeping(Input=current, IsoValue=400.0)
+current.Scalars = ["POINTS", "MetaImage"]
 SaveData(target, proxy=current, DataMode="Binary")

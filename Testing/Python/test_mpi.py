@@ -38,7 +38,8 @@ def run(ranks):
     return target
 
 
-names = ["GaussianCDF", "Variance", "CDFReconstruction", "Chebyshev", "ExactBox"]
+names = ["GaussianCDF", "Variance", "CDFReconstruction", "Chebyshev", "ExactBox", "SignedDistance",
+         "AmbientOcclusion"]
 serial = read_image(run(1))
 reference = {name: array_of(serial, name) for name in names}
 for name in names:

@@ -96,6 +96,32 @@ check(values.size == 48 * 44 * 40 and 0.0 <= values.min() and values.max() <= 1.
       "phantom: default run gives AO in [0, 1] with contrast (std %.3f)" % values.std())
 Delete(default_run)
 
+# Occlusion Sweeping: properties, outputs on the CT head's skin, and a contour coloured
+# by it (the pipeline a user builds).
+sweep = OcclusionSweeping(Input=ct, IsoValue=-300.0, OutputOctantVisibility=1, UseGeometryTerm=0)
+for name in ["Scalars", "IsoValue", "InsideIsAbove", "NumberOfIterations", "ConvergenceTolerance",
+             "UseGeometryTerm", "OctantMask", "Gamma", "Opacity", "OutputOctantVisibility", "Component"]:
+    prop = sweep.GetProperty(name)
+    check(prop is not None and len(prop.SMProperty.GetDocumentation().GetDescription().strip()) > 20,
+          "OcclusionSweeping property %s exists and is documented" % name)
+check(list(sweep.OctantMask) == [1] * 8 and sweep.NumberOfIterations == 1 and sweep.InsideIsAbove == 1,
+      "OcclusionSweeping defaults: all octants, one pass, inside above")
+sweep.Scalars = ["POINTS", "MetaImage"]
+swept = servermanager.Fetch(sweep)
+distance = array_of(swept, "SignedDistance")
+occlusion = array_of(swept, "AmbientOcclusion")
+ct_values = array_of(swept, "MetaImage")
+check(np.array_equal(distance < 0, ct_values > -300.0), "sweeping: negative distance exactly inside the skin")
+check(occlusion.min() >= 0.0 and occlusion.max() <= 1.0 and occlusion.std() > 0.05,
+      "sweeping: AO in [0, 1] with contrast (std %.3f)" % occlusion.std())
+check(swept.GetPointData().GetArray("OctantVisibility").GetNumberOfComponents() == 8, "sweeping: 8 octants")
+skin = Contour(Input=sweep, ContourBy=["POINTS", "MetaImage"], Isosurfaces=[-300.0], ComputeScalars=1)
+surface = servermanager.Fetch(skin)
+surface_ao = surface.GetPointData().GetArray("AmbientOcclusion")
+check(surface.GetNumberOfPoints() > 10000 and surface_ao is not None, "the skin contour carries AmbientOcclusion")
+Delete(skin)
+Delete(sweep)
+
 # Write and read back (inline binary .vti: this VTK cannot read appended .vti).
 final = VolumetricAmbientOcclusion(Input=ct, Method="Gaussian CDF", Radius=5, ComputeVariance=1)
 final.UpdatePipeline()

@@ -1,0 +1,178 @@
+#include "vtkAmbientOcclusionInput.h"
+
+#include "vtkAlgorithm.h"
+#include "vtkDataArray.h"
+#include "vtkFieldData.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkPointData.h"
+
+#include <algorithm>
+#include <sstream>
+
+namespace vtkAmbientOcclusionInput
+{
+namespace
+{
+
+bool ToKernelType(int vtkType, vao::ScalarType& type)
+{
+  const bool longIs64 = sizeof(long) == 8;
+  switch (vtkType)
+  {
+    case VTK_CHAR:
+    case VTK_SIGNED_CHAR:
+      type = vao::ScalarType::Int8;
+      return true;
+    case VTK_UNSIGNED_CHAR:
+      type = vao::ScalarType::UInt8;
+      return true;
+    case VTK_SHORT:
+      type = vao::ScalarType::Int16;
+      return true;
+    case VTK_UNSIGNED_SHORT:
+      type = vao::ScalarType::UInt16;
+      return true;
+    case VTK_INT:
+      type = vao::ScalarType::Int32;
+      return true;
+    case VTK_UNSIGNED_INT:
+      type = vao::ScalarType::UInt32;
+      return true;
+    case VTK_LONG:
+      type = longIs64 ? vao::ScalarType::Int64 : vao::ScalarType::Int32;
+      return true;
+    case VTK_LONG_LONG:
+    case VTK_ID_TYPE:
+      type = vao::ScalarType::Int64;
+      return true;
+    case VTK_UNSIGNED_LONG:
+      type = longIs64 ? vao::ScalarType::UInt64 : vao::ScalarType::UInt32;
+      return true;
+    case VTK_UNSIGNED_LONG_LONG:
+      type = vao::ScalarType::UInt64;
+      return true;
+    case VTK_FLOAT:
+      type = vao::ScalarType::Float32;
+      return true;
+    case VTK_DOUBLE:
+      type = vao::ScalarType::Float64;
+      return true;
+    default:
+      return false;
+  }
+}
+
+vtkDataArray* ChosenArray(vtkAlgorithm* algorithm, vtkDataArray* scalars, vtkImageData* input)
+{
+  const char* name = algorithm->GetInputArrayInformation(0)->Get(vtkDataObject::FIELD_NAME());
+  if (!scalars && (!name || !*name))
+  {
+    // No array chosen (pvpython before the input was updated): the active point scalars.
+    scalars = input->GetPointData()->GetScalars();
+  }
+  return scalars;
+}
+
+} // namespace
+
+bool CheckWholeExtent(const int whole[6], std::string& error)
+{
+  const int dims[3] = { whole[1] - whole[0] + 1, whole[3] - whole[2] + 1, whole[5] - whole[4] + 1 };
+  if (dims[0] >= 2 && dims[1] >= 2 && dims[2] >= 2)
+  {
+    return true;
+  }
+  std::ostringstream why;
+  why << "The filter needs a 3-D volume; the input is " << std::max(dims[0], 0) << " x "
+      << std::max(dims[1], 0) << " x " << std::max(dims[2], 0) << " voxels (empty, a single voxel, or 2-D).";
+  error = why.str();
+  return false;
+}
+
+bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input, int component,
+  ScalarVolume& volume, std::string& error)
+{
+  std::ostringstream why;
+  vtkDataArray* scalars = ChosenArray(algorithm, chosen, input);
+  if (!scalars)
+  {
+    error = "No numeric point array to process: choose a point-data array of the image "
+            "(the Scalars property; string and cell arrays are not accepted).";
+    return false;
+  }
+  volume.name = scalars->GetName() ? scalars->GetName() : "";
+  if (input->GetPointData()->GetAbstractArray(scalars->GetName()) != scalars)
+  {
+    error = "Array '" + volume.name + "' is not a point-data array; the filter works on points (voxels).";
+    return false;
+  }
+  const int components = scalars->GetNumberOfComponents();
+  const int picked = component < 0 && components == 1 ? 0 : component;
+  if (picked < 0 || picked >= components)
+  {
+    why << "Array '" << volume.name << "' has " << components << " components; set Component to one of 0.."
+        << components - 1 << " (got " << component << ").";
+    error = why.str();
+    return false;
+  }
+  vao::VolumeView& view = volume.view;
+  if (!ToKernelType(scalars->GetDataType(), view.type))
+  {
+    error = "Array '" + volume.name + "' has unsupported type " + scalars->GetDataTypeAsString() + ".";
+    return false;
+  }
+  const int* dims = input->GetDimensions();
+  view.dims = { dims[0], dims[1], dims[2] };
+  if (scalars->HasStandardMemoryLayout())
+  {
+    view.data = scalars->GetVoidPointer(picked);
+    view.voxelStride = components;
+  }
+  else
+  {
+    volume.unpacked.resize(static_cast<size_t>(scalars->GetNumberOfTuples()));
+    for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i)
+    {
+      volume.unpacked[i] = scalars->GetComponent(i, picked);
+    }
+    view.data = volume.unpacked.data();
+    view.type = vao::ScalarType::Float64;
+    view.voxelStride = 1;
+  }
+  std::int64_t first = 0;
+  const std::int64_t nonFinite = vao::countNonFinite(view, &first);
+  if (nonFinite > 0)
+  {
+    const int* e = input->GetExtent();
+    const std::int64_t plane = static_cast<std::int64_t>(dims[0]) * dims[1];
+    why << "Array '" << volume.name << "' has " << nonFinite << " NaN or infinite values (the first at voxel "
+        << first % dims[0] + e[0] << ", " << (first / dims[0]) % dims[1] + e[2] << ", " << first / plane + e[4]
+        << "). A non-finite value has no place in a cumulative distribution or an isosurface: replace "
+           "them (e.g. with the Calculator or Threshold filters) first.";
+    error = why.str();
+    return false;
+  }
+  return true;
+}
+
+void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int outExt[6])
+{
+  const int* inExt = input->GetExtent();
+  if (std::equal(outExt, outExt + 6, inExt))
+  {
+    output->ShallowCopy(input);
+    return;
+  }
+  const vtkIdType points = static_cast<vtkIdType>(outExt[1] - outExt[0] + 1) * (outExt[3] - outExt[2] + 1) *
+    (outExt[5] - outExt[4] + 1);
+  output->SetExtent(const_cast<int*>(outExt));
+  output->SetOrigin(input->GetOrigin());
+  output->SetSpacing(input->GetSpacing());
+  output->SetDirectionMatrix(input->GetDirectionMatrix());
+  output->GetPointData()->CopyAllocate(input->GetPointData(), points);
+  output->GetPointData()->CopyStructuredData(input->GetPointData(), inExt, outExt);
+  output->GetFieldData()->ShallowCopy(input->GetFieldData());
+}
+
+} // namespace vtkAmbientOcclusionInput

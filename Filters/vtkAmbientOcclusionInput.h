@@ -1,0 +1,43 @@
+// Private helpers shared by the module's image filters: picking and checking the input
+// array, presenting it to the kernels in place, and cropping the output to the requested
+// extent. Not part of the module's public interface.
+#ifndef vtkAmbientOcclusionInput_h
+#define vtkAmbientOcclusionInput_h
+
+#include "vao/AmbientOcclusion.h"
+
+#include <string>
+#include <vector>
+
+class vtkAlgorithm;
+class vtkDataArray;
+class vtkImageData;
+
+namespace vtkAmbientOcclusionInput
+{
+
+/// The input scalars as the kernels read them: in place when the array has the standard
+/// layout (one component through the stride), unpacked to double otherwise.
+struct ScalarVolume
+{
+  vao::VolumeView view;
+  std::string name;
+  std::vector<double> unpacked;
+};
+
+/// Takes the array the algorithm chose to process (`chosen`, from GetInputArrayToProcess;
+/// the active point scalars when no array was named at all), checks it (numeric, point
+/// data, a valid component, no NaN or infinite voxels) and fills volume. On failure
+/// returns false and says why in `error`.
+bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input, int component,
+  ScalarVolume& volume, std::string& error);
+
+/// Checks that the whole extent is a 3-D volume (at least 2 voxels on every axis).
+bool CheckWholeExtent(const int whole[6], std::string& error);
+
+/// Makes `output` the input restricted to `outExt` (a shallow copy when they are equal).
+void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int outExt[6]);
+
+} // namespace vtkAmbientOcclusionInput
+
+#endif

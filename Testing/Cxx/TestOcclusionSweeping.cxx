@@ -1,0 +1,168 @@
+// The Occlusion Sweeping filter: outputs, pieces, bad input, an iso value off the data.
+#include "TestHelpers.h"
+
+#include "vtkAmbientOcclusionPhantom.h"
+#include "vtkOcclusionSweeping.h"
+
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkShortArray.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <functional>
+
+using namespace vaotest;
+
+namespace
+{
+
+/// A ball of radius r voxels (value 100 inside, 0 outside) in an n^3 image.
+vtkSmartPointer<vtkImageData> Ball(int n, double r)
+{
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(n, n, n);
+  image->SetSpacing(0.5, 0.5, 0.5);
+  vtkNew<vtkShortArray> values;
+  values->SetName("Density");
+  values->SetNumberOfTuples(image->GetNumberOfPoints());
+  const double c = 0.5 * (n - 1);
+  vtkIdType id = 0;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i, ++id)
+        values->SetValue(id, std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c)) < r ? 100 : 0);
+  image->GetPointData()->SetScalars(values);
+  return image;
+}
+
+struct SweepRun
+{
+  vtkSmartPointer<vtkImageData> output;
+  std::vector<std::string> errors, warnings;
+};
+
+SweepRun Sweep(vtkImageData* input, const std::function<void(vtkOcclusionSweeping*)>& configure)
+{
+  vtkNew<vtkOcclusionSweeping> filter;
+  vtkNew<MessageCatcher> catcher;
+  catcher->Watch(filter);
+  filter->SetInputData(input);
+  filter->SetIsoValue(50);
+  configure(filter);
+  filter->Update();
+  return { filter->GetOutput(), catcher->Errors, catcher->Warnings };
+}
+
+TEST(OcclusionSweepingFilter, OutputsDistanceOcclusionAndOctants)
+{
+  auto ball = Ball(25, 7.3);
+  const SweepRun run = Sweep(ball, [](vtkOcclusionSweeping* f) { f->OutputOctantVisibilityOn(); });
+  ASSERT_TRUE(run.errors.empty()) << run.errors[0];
+  auto* distance = vtkFloatArray::SafeDownCast(run.output->GetPointData()->GetArray("SignedDistance"));
+  auto* ao = vtkFloatArray::SafeDownCast(run.output->GetPointData()->GetArray("AmbientOcclusion"));
+  auto* octants = vtkFloatArray::SafeDownCast(run.output->GetPointData()->GetArray("OctantVisibility"));
+  ASSERT_TRUE(distance && ao && octants);
+  EXPECT_EQ(octants->GetNumberOfComponents(), 8);
+  ASSERT_NE(run.output->GetPointData()->GetArray("Density"), nullptr);
+  const double c = 12.0;
+  vtkIdType id = 0;
+  for (int k = 0; k < 25; ++k)
+    for (int j = 0; j < 25; ++j)
+      for (int i = 0; i < 25; ++i, ++id)
+      {
+        const bool inside = ball->GetPointData()->GetScalars()->GetComponent(id, 0) > 50;
+        ASSERT_EQ(distance->GetValue(id) < 0, inside) << i << "," << j << "," << k;
+        const double exact = 0.5 * (std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c)) - 7.3);
+        ASSERT_NEAR(distance->GetValue(id), exact, 0.5 * 1.5) << "world units, spacing 0.5";
+        ASSERT_GE(ao->GetValue(id), 0.0f);
+        ASSERT_LE(ao->GetValue(id), 1.0f);
+      }
+  // The centre of the ball sees no sky; a corner of the volume, far from it, nearly all.
+  EXPECT_LT(ao->GetValue((12 * 25 + 12) * 25 + 12), 0.01);
+  EXPECT_GT(ao->GetValue(0), 0.8);
+}
+
+TEST(OcclusionSweepingFilter, PiecesEqualTheWholeResult)
+{
+  vtkNew<vtkAmbientOcclusionPhantom> phantom;
+  phantom->SetDimensions(36, 40, 32);
+  vtkNew<vtkOcclusionSweeping> filter;
+  filter->SetInputConnection(phantom->GetOutputPort());
+  filter->SetIsoValue(400);
+  filter->Update();
+  vtkNew<vtkImageData> whole;
+  whole->DeepCopy(filter->GetOutput());
+  const auto wholeAO = Values(whole->GetPointData()->GetArray("AmbientOcclusion"));
+  for (int piece = 0; piece < 3; ++piece)
+  {
+    filter->UpdatePiece(piece, 3, 0);
+    vtkImageData* out = filter->GetOutput();
+    EXPECT_LT(out->GetNumberOfPoints(), whole->GetNumberOfPoints());
+    const int* e = out->GetExtent();
+    const auto ao = Values(out->GetPointData()->GetArray("AmbientOcclusion"));
+    vtkIdType id = 0;
+    for (int k = e[4]; k <= e[5]; ++k)
+      for (int j = e[2]; j <= e[3]; ++j)
+        for (int i = e[0]; i <= e[1]; ++i, ++id)
+          ASSERT_EQ(ao[id], wholeAO[(k * 40 + j) * 36 + i]);
+  }
+}
+
+TEST(OcclusionSweepingFilter, AnIsoValueOffTheDataWarnsAndGivesAnOpenField)
+{
+  const SweepRun run = Sweep(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(1000); });
+  EXPECT_TRUE(run.errors.empty());
+  ASSERT_EQ(run.warnings.size(), 1u);
+  EXPECT_NE(run.warnings[0].find("does not cross"), std::string::npos);
+  const auto ao = Values(run.output->GetPointData()->GetArray("AmbientOcclusion"));
+  EXPECT_EQ(*std::min_element(ao.begin(), ao.end()), 1.0);
+}
+
+void ExpectRejected(vtkImageData* input, const std::function<void(vtkOcclusionSweeping*)>& configure,
+  const std::string& words)
+{
+  const SweepRun run = Sweep(input, configure);
+  ASSERT_FALSE(run.errors.empty()) << "no error for: " << words;
+  std::string lower = run.errors[0];
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::string wanted = words;
+  std::transform(wanted.begin(), wanted.end(), wanted.begin(), [](unsigned char c) { return std::tolower(c); });
+  EXPECT_NE(lower.find(wanted), std::string::npos) << run.errors[0];
+  EXPECT_EQ(run.output->GetNumberOfPoints(), 0);
+}
+
+TEST(OcclusionSweepingFilter, RejectsBadInputWithAClearError)
+{
+  const auto none = [](vtkOcclusionSweeping*) {};
+  vtkNew<vtkImageData> noArray;
+  noArray->SetDimensions(5, 5, 5);
+  ExpectRejected(noArray, none, "No numeric point array");
+  vtkNew<vtkImageData> flat;
+  flat->DeepCopy(Ball(9, 3));
+  flat->SetDimensions(9, 81, 1);
+  ExpectRejected(flat, none, "needs a 3-D volume");
+  auto nan = Ball(9, 3);
+  vtkNew<vtkFloatArray> values;
+  values->DeepCopy(nan->GetPointData()->GetScalars());
+  values->SetName("Density");
+  values->SetValue(40, std::nanf(""));
+  nan->GetPointData()->SetScalars(values);
+  ExpectRejected(nan, none, "NaN");
+  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(std::nan("")); }, "iso");
+  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfIterations(0); }, "iteration");
+  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetGamma(0); }, "gamma");
+  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetOpacity(1.5); }, "opacity");
+  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetConvergenceTolerance(-1); }, "tolerance");
+  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) {
+    int none8[8] = { 0, 0, 0, 0, 0, 0, 0, 0 };
+    f->SetOctantMask(none8);
+  }, "octant");
+}
+
+} // namespace

@@ -1,0 +1,178 @@
+// Regression image: the CT head phantom's skin isosurface coloured by occlusion-sweeping
+// AO, rendered with VTK (under Xvfb in the test suite) and compared with the committed
+// baseline. A constant AO rendered the same way must differ: the comparison can fail.
+//
+// Usage: vaoSweepingRenderingTest CT.mha BASELINE.png OUTPUT.png [--write-baseline]
+#include "vtkOcclusionSweeping.h"
+
+#include "vtkActor.h"
+#include "vtkCamera.h"
+#include "vtkFloatArray.h"
+#include "vtkFlyingEdges3D.h"
+#include "vtkImageData.h"
+#include "vtkLookupTable.h"
+#include "vtkMetaImageReader.h"
+#include "vtkNew.h"
+#include "vtkPNGReader.h"
+#include "vtkPNGWriter.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkPolyDataMapper.h"
+#include "vtkProperty.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtkWindowToImageFilter.h"
+#include "vtkProbeFilter.h"
+#include "vtkWarpVector.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <string>
+
+namespace
+{
+
+/// Renders the surface coloured by `array` (grey, 0 black .. 1 white), seen from the front.
+vtkSmartPointer<vtkImageData> Render(vtkPolyData* surface, const char* array)
+{
+  vtkNew<vtkLookupTable> grey;
+  grey->SetTableRange(0.0, 1.0);
+  grey->SetSaturationRange(0.0, 0.0);
+  grey->SetValueRange(0.1, 1.0);
+  grey->Build();
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(surface);
+  mapper->SetLookupTable(grey);
+  mapper->SetScalarModeToUsePointFieldData();
+  mapper->SelectColorArray(array);
+  mapper->SetScalarRange(0.0, 1.0);
+  mapper->ScalarVisibilityOn();
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  // Ambient light only: the picture shows the AO field itself, not the lighting.
+  actor->GetProperty()->SetAmbient(1.0);
+  actor->GetProperty()->SetDiffuse(0.0);
+  actor->GetProperty()->SetSpecular(0.0);
+  vtkNew<vtkRenderer> renderer;
+  renderer->AddActor(actor);
+  renderer->SetBackground(0.1, 0.1, 0.2);
+  vtkNew<vtkRenderWindow> window;
+  window->SetOffScreenRendering(1);
+  window->SetSize(300, 300);
+  window->AddRenderer(renderer);
+  // The face looks towards -y (DICOM LPS: y points to the back of the head).
+  const double* c = surface->GetCenter();
+  vtkCamera* camera = renderer->GetActiveCamera();
+  camera->SetFocalPoint(c);
+  camera->SetPosition(c[0] - 120.0, c[1] - 600.0, c[2] + 60.0);
+  camera->SetViewUp(0.0, 0.0, 1.0);
+  renderer->ResetCamera();
+  window->Render();
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(window);
+  grab->Update();
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->DeepCopy(grab->GetOutput());
+  return image;
+}
+
+/// Root-mean-square difference of the RGB values (0..255) of two images of one size.
+double Difference(vtkImageData* image, vtkImageData* baseline)
+{
+  vtkDataArray* a = image->GetPointData()->GetScalars();
+  vtkDataArray* b = baseline->GetPointData()->GetScalars();
+  if (!a || !b || a->GetNumberOfTuples() != b->GetNumberOfTuples())
+  {
+    return 1e30;
+  }
+  double sum = 0.0;
+  for (vtkIdType i = 0; i < a->GetNumberOfTuples(); ++i)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      const double d = a->GetComponent(i, c) - b->GetComponent(i, c);
+      sum += d * d;
+    }
+  }
+  return std::sqrt(sum / (3.0 * a->GetNumberOfTuples()));
+}
+
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  if (argc < 4)
+  {
+    std::fprintf(stderr, "usage: %s CT.mha BASELINE.png OUTPUT.png [--write-baseline]\n", argv[0]);
+    return 2;
+  }
+  vtkNew<vtkMetaImageReader> reader;
+  reader->SetFileName(argv[1]);
+  vtkNew<vtkOcclusionSweeping> sweep;
+  sweep->SetInputConnection(reader->GetOutputPort());
+  sweep->SetIsoValue(-300.0);
+  sweep->UseGeometryTermOn(); // irradiance for the surface normal: a convex skin is bright
+  vtkNew<vtkFlyingEdges3D> skin;
+  skin->SetInputConnection(sweep->GetOutputPort());
+  skin->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "MetaImage");
+  skin->SetValue(0, -300.0);
+  skin->ComputeScalarsOff();
+  skin->ComputeNormalsOn();
+  // The AO of the surface is the AO just outside it: points moved one voxel outwards
+  // (FlyingEdges orients the normals towards lower values: outwards here) sample
+  // the field there, away from the inside voxels, whose visibility is dark by definition.
+  vtkNew<vtkWarpVector> outwards;
+  outwards->SetInputConnection(skin->GetOutputPort());
+  outwards->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "Normals");
+  outwards->SetScaleFactor(2.0); // about one voxel (1.95 x 1.95 x 2 mm)
+  vtkNew<vtkProbeFilter> probe;
+  probe->SetInputConnection(outwards->GetOutputPort());
+  probe->SetSourceConnection(sweep->GetOutputPort());
+  probe->Update();
+  vtkNew<vtkPolyData> surface;
+  surface->DeepCopy(skin->GetOutput());
+  surface->GetPointData()->AddArray(probe->GetOutput()->GetPointData()->GetArray("AmbientOcclusion"));
+  if (!surface->GetPointData()->GetArray("AmbientOcclusion") || surface->GetNumberOfPoints() < 1000)
+  {
+    std::fprintf(stderr, "FAILED: the skin surface carries no AmbientOcclusion\n");
+    return 1;
+  }
+  auto image = Render(surface, "AmbientOcclusion");
+  vtkNew<vtkPNGWriter> writer;
+  writer->SetInputData(image);
+  writer->SetFileName(argv[3]);
+  writer->Write();
+  if (argc > 4 && std::strcmp(argv[4], "--write-baseline") == 0)
+  {
+    writer->SetFileName(argv[2]);
+    writer->Write();
+  }
+  if (!std::ifstream(argv[2]).good())
+  {
+    std::fprintf(stderr, "FAILED: missing baseline %s\n", argv[2]);
+    return 1;
+  }
+  vtkNew<vtkPNGReader> baselineReader;
+  baselineReader->SetFileName(argv[2]);
+  baselineReader->Update();
+  const double error = Difference(image, baselineReader->GetOutput());
+
+  vtkNew<vtkFloatArray> constant;
+  constant->SetName("Constant");
+  constant->SetNumberOfTuples(surface->GetNumberOfPoints());
+  constant->Fill(0.5f);
+  surface->GetPointData()->AddArray(constant);
+  const double constantError = Difference(Render(surface, "Constant"), baselineReader->GetOutput());
+  std::printf("regression image RMS difference %g (threshold 2), constant-AO RMS difference %g (must exceed 10); "
+              "image %s\n",
+    error, constantError, argv[3]);
+  if (error > 2.0 || constantError < 10.0)
+  {
+    std::printf("FAILED\n");
+    return 1;
+  }
+  std::printf("passed\n");
+  return 0;
+}
