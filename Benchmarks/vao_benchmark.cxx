@@ -7,7 +7,8 @@
 // scipy.ndimage.distance_transform_edt in the same run.
 //
 // Usage: vao_benchmark [--shared DIR] [--scipy PATH/TO/scipy_peer.py] [--repeat N]
-//                      [--exact] [--threads N] [--sweeping (the sweeping table only)]
+//                      [--exact] [--threads N] [--sweeping | --penner (one table only)]
+// Last, the variance occlusion maps: pyramid builds and the surface query rate.
 // Exact Box and Exact Sphere are O(R^3) references: by default they are timed on a
 // 32-slice slab and the whole-volume time is extrapolated (marked "~"); --exact times
 // them on the whole volume (minutes).
@@ -17,6 +18,10 @@
 #include "SweepScene.h"
 #include "vao/AmbientOcclusion.h"
 #include "vao/OcclusionSweeping.h"
+#include "vao/VarianceOcclusionMap.h"
+
+#include "vtkFlyingEdges3D.h"
+#include "vtkPolyData.h"
 
 #include "vtkExtractVOI.h"
 #include "vtkImageData.h"
@@ -54,6 +59,7 @@ struct Options
   std::string scipy = VAO_DEFAULT_SCIPY_PEER;
   std::string scipyEdt = VAO_DEFAULT_SCIPY_EDT_PEER;
   bool sweepingOnly = false;
+  bool pennerOnly = false;
   int repeat = 3;
   bool exact = false;
   int threads = 0;
@@ -297,6 +303,76 @@ void BenchmarkSweeping(const Options& options, vtkImageData* ct)
   std::remove(raw.c_str());
 }
 
+/// Penner & Mitchell: the pyramid build on generated volumes of the paper's Table 1 sizes
+/// and the surface query rate on the CT head phantom's bone.
+void BenchmarkPyramid(const Options& options, vtkImageData* ct)
+{
+  std::printf("\nVariance occlusion maps: pyramid build (4 levels, best of %d; paper Table 1: 170 / 678 / "
+              "1524 ms CPU)\n", options.repeat);
+  const int sizes[][3] = { { 256, 256, 256 }, { 512, 512, 256 }, { 512, 512, 512 } };
+  for (const auto& size : sizes)
+  {
+    vtkNew<vtkAmbientOcclusionPhantom> phantom;
+    phantom->SetDimensions(size[0], size[1], size[2]);
+    phantom->Update();
+    vao::VolumeView view;
+    view.data = phantom->GetOutput()->GetScalarPointer();
+    view.type = vao::ScalarType::Int16;
+    view.dims = { size[0], size[1], size[2] };
+    std::vector<vao::MomentLevel> pyramid;
+    double best = 1e300;
+    for (int r = 0; r < options.repeat; ++r)
+    {
+      const auto start = std::chrono::steady_clock::now();
+      vao::buildMomentPyramid(view, { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid);
+      best = std::min(best, Seconds(start));
+    }
+    std::printf("  %4d x %4d x %4d int16   %8.0f ms\n", size[0], size[1], size[2], 1e3 * best);
+  }
+
+  // The bone surface of the CT head phantom and its normals.
+  vtkNew<vtkFlyingEdges3D> contour;
+  contour->SetInputData(ct);
+  contour->SetValue(0, 400.0);
+  contour->ComputeNormalsOn();
+  contour->Update();
+  vtkPolyData* bone = contour->GetOutput();
+  const vtkIdType n = bone->GetNumberOfPoints();
+  std::vector<double> points(3 * n), normals(3 * n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    bone->GetPoint(i, &points[3 * i]);
+    bone->GetPointData()->GetNormals()->GetTuple(i, &normals[3 * i]);
+  }
+  vao::VolumeView view;
+  view.data = ct->GetScalarPointer();
+  view.type = vao::ScalarType::Int16;
+  const int* d = ct->GetDimensions();
+  view.dims = { d[0], d[1], d[2] };
+  const double* o = ct->GetOrigin();
+  const double* h = ct->GetSpacing();
+  std::vector<vao::MomentLevel> pyramid;
+  vao::buildMomentPyramid(view, { o[0], o[1], o[2] }, { h[0], h[1], h[2] }, {}, pyramid);
+  std::vector<float> out(n);
+  auto rate = [&](bool shadows) {
+    double best = 1e300;
+    for (int r = 0; r < options.repeat; ++r)
+    {
+      const auto start = std::chrono::steady_clock::now();
+      vao::surfaceAmbientOcclusion(pyramid, view, { o[0], o[1], o[2] }, { h[0], h[1], h[2] }, points.data(),
+        normals.data(), n, {}, out.data());
+      if (shadows)
+      {
+        vao::surfaceShadow(pyramid, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 }, {}, out.data());
+      }
+      best = std::min(best, Seconds(start));
+    }
+    return n / best;
+  };
+  std::printf("  CT head bone surface (400 HU, %lld points): AO %.1f M points/s, AO + shadows %.1f M points/s\n",
+    static_cast<long long>(n), rate(false) / 1e6, rate(true) / 1e6);
+}
+
 } // namespace
 
 int main(int argc, char* argv[])
@@ -317,16 +393,18 @@ int main(int argc, char* argv[])
       options.exact = true;
     else if (arg == "--sweeping")
       options.sweepingOnly = true;
+    else if (arg == "--penner")
+      options.pennerOnly = true;
     else
     {
-      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--sweeping]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--sweeping | --penner]\n", argv[0]);
       return 2;
     }
   }
   std::printf("VolumetricAO benchmark: best of %d runs of the filter (wall clock, input in memory)\n",
     options.repeat);
 
-  if (!options.sweepingOnly)
+  if (!options.sweepingOnly && !options.pennerOnly)
   {
     // The generated CT-body-sized volume, written raw for the scipy peer.
     vtkNew<vtkAmbientOcclusionPhantom> phantom;
@@ -342,6 +420,14 @@ int main(int argc, char* argv[])
     const std::string ct = options.shared + "/ct_head_phantom/ct_head_phantom_512x512x209_int16.mha";
     Benchmark("ct_head_phantom_512x512x209_int16.mha", ReadScanOrExit(ct), ct, options);
   }
-  BenchmarkSweeping(options, ReadScanOrExit(options.shared + "/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));
+  const auto head = ReadScanOrExit(options.shared + "/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha");
+  if (!options.pennerOnly)
+  {
+    BenchmarkSweeping(options, head);
+  }
+  if (!options.sweepingOnly)
+  {
+    BenchmarkPyramid(options, head);
+  }
   return 0;
 }

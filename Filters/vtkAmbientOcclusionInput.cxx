@@ -3,9 +3,12 @@
 #include "vtkAlgorithm.h"
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
+#include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkNew.h"
 #include "vtkPointData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <algorithm>
 #include <sstream>
@@ -173,6 +176,69 @@ void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int ou
   output->GetPointData()->CopyAllocate(input->GetPointData(), points);
   output->GetPointData()->CopyStructuredData(input->GetPointData(), inExt, outExt);
   output->GetFieldData()->ShallowCopy(input->GetFieldData());
+}
+
+void RequestWholeExtent(vtkInformation* info)
+{
+  int whole[6];
+  info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), whole, 6);
+  info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
+  info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+  info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+  info->Set(vtkStreamingDemandDrivenPipeline::EXACT_EXTENT(), 1);
+}
+
+vao::Execution ExecutionOf(vtkAlgorithm* algorithm)
+{
+  vao::Execution execution;
+  execution.progress = [algorithm](double p) { algorithm->UpdateProgress(p); };
+  execution.abortRequested = [algorithm] { return algorithm->GetAbortExecute() != 0; };
+  return execution;
+}
+
+std::array<double, 3> ExtentOrigin(vtkImageData* image)
+{
+  const double* o = image->GetOrigin();
+  const double* h = image->GetSpacing();
+  const int* e = image->GetExtent();
+  return { o[0] + e[0] * h[0], o[1] + e[2] * h[1], o[2] + e[4] * h[2] };
+}
+
+bool BuildPyramid(vtkAlgorithm* algorithm, const ScalarVolume& scalars, vtkImageData* input, int levels,
+  bool startAtHalfResolution, std::vector<vao::MomentLevel>& pyramid, std::string& error)
+{
+  const double* h = input->GetSpacing();
+  vao::PyramidParameters parameters;
+  parameters.levels = levels;
+  parameters.startAtHalfResolution = startAtHalfResolution;
+  const vao::Status status = vao::buildMomentPyramid(
+    scalars.view, ExtentOrigin(input), { h[0], h[1], h[2] }, parameters, pyramid, ExecutionOf(algorithm));
+  if (!status.ok)
+  {
+    error = status.aborted ? "" : "The variance occlusion map failed: " + status.message + ".";
+    return false;
+  }
+  return true;
+}
+
+vtkSmartPointer<vtkImageData> LevelAsImage(const vao::MomentLevel& level)
+{
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(static_cast<int>(level.dims[0]), static_cast<int>(level.dims[1]),
+    static_cast<int>(level.dims[2]));
+  image->SetOrigin(level.origin.data());
+  image->SetSpacing(level.spacing.data());
+  for (const auto& [name, values] : { std::make_pair("Mean", &level.mean), std::make_pair("Variance", &level.variance) })
+  {
+    vtkNew<vtkFloatArray> array;
+    array->SetName(name);
+    array->SetNumberOfTuples(static_cast<vtkIdType>(values->size()));
+    std::copy(values->begin(), values->end(), array->GetPointer(0));
+    image->GetPointData()->AddArray(array);
+  }
+  image->GetPointData()->SetActiveScalars("Mean");
+  return image;
 }
 
 } // namespace vtkAmbientOcclusionInput

@@ -5,6 +5,9 @@
 #define vtkAmbientOcclusionInput_h
 
 #include "vao/AmbientOcclusion.h"
+#include "vao/VarianceOcclusionMap.h"
+
+#include "vtkSmartPointer.h"
 
 #include <string>
 #include <vector>
@@ -12,6 +15,7 @@
 class vtkAlgorithm;
 class vtkDataArray;
 class vtkImageData;
+class vtkInformation;
 
 namespace vtkAmbientOcclusionInput
 {
@@ -37,6 +41,24 @@ bool CheckWholeExtent(const int whole[6], std::string& error);
 
 /// Makes `output` the input restricted to `outExt` (a shallow copy when they are equal).
 void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int outExt[6]);
+
+/// Asks the input for its whole extent, as one piece (global algorithms).
+void RequestWholeExtent(vtkInformation* inputInformation);
+
+/// The kernel's execution hooks for an algorithm: its progress and abort flag.
+vao::Execution ExecutionOf(vtkAlgorithm* algorithm);
+
+/// World position of the first voxel of the image's extent.
+std::array<double, 3> ExtentOrigin(vtkImageData* image);
+
+/// Builds the moment pyramid of Penner & Mitchell from prepared scalars (PrepareScalars)
+/// laid out on `input`'s grid. On failure returns false with the reason in `error`
+/// (empty when the user aborted).
+bool BuildPyramid(vtkAlgorithm* algorithm, const ScalarVolume& scalars, vtkImageData* input, int levels,
+  bool startAtHalfResolution, std::vector<vao::MomentLevel>& pyramid, std::string& error);
+
+/// One pyramid level as image data with float arrays "Mean" and "Variance".
+vtkSmartPointer<vtkImageData> LevelAsImage(const vao::MomentLevel& level);
 
 } // namespace vtkAmbientOcclusionInput
 

@@ -41,14 +41,7 @@ int vtkOcclusionSweeping::RequestUpdateExtent(
 {
   // Sweeping is global: an occluder anywhere shadows everything behind it, so every
   // piece is computed from the whole volume.
-  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
-  int whole[6];
-  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), whole, 6);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::EXACT_EXTENT(), 1);
+  vtkAmbientOcclusionInput::RequestWholeExtent(inputVector[0]->GetInformationObject(0));
   return 1;
 }
 
@@ -117,9 +110,7 @@ int vtkOcclusionSweeping::RequestData(
     octants = newArray("OctantVisibility", 8).Get();
   }
   const double* spacing = input->GetSpacing();
-  vao::Execution execution;
-  execution.progress = [this](double p) { this->UpdateProgress(p); };
-  execution.abortRequested = [this] { return this->GetAbortExecute() != 0; };
+  const vao::Execution execution = vtkAmbientOcclusionInput::ExecutionOf(this);
   vao::SweepReport report;
   const vao::Status status = vao::computeOcclusionSweeping(scalars.view, { spacing[0], spacing[1], spacing[2] },
     parameters, { distance->GetPointer(0), occlusion->GetPointer(0), octants ? octants->GetPointer(0) : nullptr },

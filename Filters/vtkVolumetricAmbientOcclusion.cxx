@@ -251,10 +251,8 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     variance->SetName("Variance");
     variance->SetNumberOfTuples(region.voxelCount());
   }
-  vao::Execution execution;
+  vao::Execution execution = vtkAmbientOcclusionInput::ExecutionOf(this);
   execution.threads = this->NumberOfThreads;
-  execution.progress = [this](double p) { this->UpdateProgress(p); };
-  execution.abortRequested = [this] { return this->GetAbortExecute() != 0; };
   const vao::AmbientOcclusionOutput arrays{ openness->GetPointer(0),
     variance ? variance->GetPointer(0) : nullptr };
   vao::Status status;

@@ -25,9 +25,9 @@ writer.SetFileName(source)
 writer.Write()
 
 
-def run(ranks):
-    target = os.path.join(out_dir, "mpi_ct_ao_np%d.pvti" % ranks)
-    command = [pvbatch, os.path.join(here, "mpi_run.py"), plugin, source, target]
+def run(ranks, script="mpi_run.py", extension="pvti"):
+    target = os.path.join(out_dir, "mpi_ct_%s_np%d.%s" % (script[:-3], ranks, extension))
+    command = [pvbatch, os.path.join(here, script), plugin, source, target]
     if ranks > 1:
         command = [mpiexec, "--allow-run-as-root", "--oversubscribe", "-np", str(ranks)] + command
     print("running: " + " ".join(command), flush=True)
@@ -57,4 +57,30 @@ for ranks in rank_counts:
     for name in names:
         difference = np.abs(array_of(distributed, name) - reference[name]).max()
         check(difference <= 1e-6, "np %d: %s equals serial (max difference %.3g)" % (ranks, name, difference))
+# Isosurface Ambient Occlusion: the shaded bone surface, matched point by point.
+from vtkmodules.vtkIOXML import vtkXMLPPolyDataReader  # noqa: E402
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+
+
+def shaded_points(path):
+    reader = vtkXMLPPolyDataReader()
+    reader.SetFileName(path)
+    reader.Update()
+    surface = reader.GetOutput()
+    points = vtk_to_numpy(surface.GetPoints().GetData()).astype("float64")
+    ao = vtk_to_numpy(surface.GetPointData().GetArray("AmbientOcclusion"))
+    shadow = vtk_to_numpy(surface.GetPointData().GetArray("Shadow"))
+    return {tuple(np.round(p, 4)): (a, s) for p, a, s in zip(points, ao, shadow)}
+
+
+serial_surface = shaded_points(run(1, "mpi_surface_run.py", "pvtp"))
+check(len(serial_surface) > 10000, "serial bone surface: %d points" % len(serial_surface))
+for ranks in rank_counts:
+    distributed = shaded_points(run(ranks, "mpi_surface_run.py", "pvtp"))
+    matched = [key for key in distributed if key in serial_surface]
+    check(len(matched) >= 0.999 * len(distributed), "np %d: %d of %d surface points found in the serial surface"
+          % (ranks, len(matched), len(distributed)))
+    worst = max(max(abs(distributed[k][0] - serial_surface[k][0]), abs(distributed[k][1] - serial_surface[k][1]))
+                for k in matched)
+    check(worst <= 1e-6, "np %d: surface AO and Shadow equal serial (max difference %.3g)" % (ranks, worst))
 print("all MPI checks passed")

@@ -122,6 +122,38 @@ check(surface.GetNumberOfPoints() > 10000 and surface_ao is not None, "the skin 
 Delete(skin)
 Delete(sweep)
 
+# Penner & Mitchell: the pyramid proxy and the Contour -> Isosurface Ambient Occlusion
+# pipeline on the CT head's bone, with shadows.
+vom = VarianceOcclusionMap(Input=ct)
+vom.Scalars = ["POINTS", "MetaImage"]
+levels = servermanager.Fetch(vom)
+check(levels.GetNumberOfBlocks() == 4, "VarianceOcclusionMap: 4 levels")
+level1 = levels.GetBlock(1)
+check(level1.GetDimensions() == (64, 64, 68) and abs(level1.GetSpacing()[0] - 2 * 1.953125) < 1e-9,
+      "VarianceOcclusionMap: level 1 halves the resolution (%s)" % (level1.GetDimensions(),))
+check(level1.GetPointData().GetArray("Mean") is not None and level1.GetPointData().GetArray("Variance") is not None,
+      "VarianceOcclusionMap: Mean and Variance")
+Delete(vom)
+bone = Contour(Input=ct, ContourBy=["POINTS", "MetaImage"], Isosurfaces=[400.0], ComputeNormals=1)
+shaded = IsosurfaceAmbientOcclusion(Input=bone, Volume=ct, ComputeShadows=1, LightDirection=[0.0, -1.0, 1.0])
+for name in ["Scalars", "QueryMode", "IsoValue", "NumberOfLevels", "OffsetFactor", "Combine", "Estimator",
+             "ComputeShadows", "LightDirection"]:
+    prop = shaded.GetProperty(name)
+    check(prop is not None and len(prop.SMProperty.GetDocumentation().GetDescription().strip()) > 20,
+          "IsosurfaceAmbientOcclusion property %s exists and is documented" % name)
+check(list(shaded.GetProperty("QueryMode").Available) == ["Half Voxel Inside", "Iso Value"] and
+      list(shaded.GetProperty("Combine").Available) == ["Max", "Mean"] and
+      list(shaded.GetProperty("Estimator").Available) == ["Chebyshev", "Gaussian CDF"],
+      "IsosurfaceAmbientOcclusion enumerations")
+surface = servermanager.Fetch(shaded)
+for name in ["AmbientOcclusion", "Shadow"]:
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    values = vtk_to_numpy(surface.GetPointData().GetArray(name))
+    check(values.size == surface.GetNumberOfPoints() > 10000 and values.min() >= 0 and values.max() <= 1
+          and values.std() > 0.05, "bone surface %s in [0, 1] with contrast (std %.3f)" % (name, values.std()))
+Delete(shaded)
+Delete(bone)
+
 # Write and read back (inline binary .vti: this VTK cannot read appended .vti).
 final = VolumetricAmbientOcclusion(Input=ct, Method="Gaussian CDF", Radius=5, ComputeVariance=1)
 final.UpdatePipeline()

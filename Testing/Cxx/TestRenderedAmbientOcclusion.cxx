@@ -1,11 +1,15 @@
-// Regression image: the CT head phantom's skin isosurface coloured by occlusion-sweeping
-// AO, rendered with VTK (under Xvfb in the test suite) and compared with the committed
-// baseline. A constant AO rendered the same way must differ: the comparison can fail.
+// Regression images, rendered with VTK (under Xvfb in the test suite) and compared with
+// committed baselines; a constant AO rendered the same way must differ, so the
+// comparison can fail.
+//   sweeping: the CT head phantom's skin isosurface coloured by occlusion-sweeping AO;
+//   penner:   its bone isosurface coloured by Penner & Mitchell AO times soft shadows.
 //
-// Usage: vaoSweepingRenderingTest CT.mha BASELINE.png OUTPUT.png [--write-baseline]
+// Usage: vaoRenderingTest sweeping|penner CT.mha BASELINE.png OUTPUT.png [--write-baseline]
+#include "vtkIsosurfaceAmbientOcclusion.h"
 #include "vtkOcclusionSweeping.h"
 
 #include "vtkActor.h"
+#include "vtkAlgorithmOutput.h"
 #include "vtkCamera.h"
 #include "vtkFloatArray.h"
 #include "vtkFlyingEdges3D.h"
@@ -101,17 +105,11 @@ double Difference(vtkImageData* image, vtkImageData* baseline)
 
 } // namespace
 
-int main(int argc, char* argv[])
+/// The skin (-300 HU) coloured by sweeping AO, sampled one voxel outside the surface.
+vtkSmartPointer<vtkPolyData> SweepingSkin(vtkAlgorithmOutput* ct)
 {
-  if (argc < 4)
-  {
-    std::fprintf(stderr, "usage: %s CT.mha BASELINE.png OUTPUT.png [--write-baseline]\n", argv[0]);
-    return 2;
-  }
-  vtkNew<vtkMetaImageReader> reader;
-  reader->SetFileName(argv[1]);
   vtkNew<vtkOcclusionSweeping> sweep;
-  sweep->SetInputConnection(reader->GetOutputPort());
+  sweep->SetInputConnection(ct);
   sweep->SetIsoValue(-300.0);
   sweep->UseGeometryTermOn(); // irradiance for the surface normal: a convex skin is bright
   vtkNew<vtkFlyingEdges3D> skin;
@@ -121,8 +119,8 @@ int main(int argc, char* argv[])
   skin->ComputeScalarsOff();
   skin->ComputeNormalsOn();
   // The AO of the surface is the AO just outside it: points moved one voxel outwards
-  // (FlyingEdges orients the normals towards lower values: outwards here) sample
-  // the field there, away from the inside voxels, whose visibility is dark by definition.
+  // (FlyingEdges orients the normals towards lower values: outwards here) sample the
+  // field there, away from the inside voxels, whose visibility is dark by definition.
   vtkNew<vtkWarpVector> outwards;
   outwards->SetInputConnection(skin->GetOutputPort());
   outwards->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "Normals");
@@ -131,31 +129,83 @@ int main(int argc, char* argv[])
   probe->SetInputConnection(outwards->GetOutputPort());
   probe->SetSourceConnection(sweep->GetOutputPort());
   probe->Update();
-  vtkNew<vtkPolyData> surface;
+  auto surface = vtkSmartPointer<vtkPolyData>::New();
   surface->DeepCopy(skin->GetOutput());
-  surface->GetPointData()->AddArray(probe->GetOutput()->GetPointData()->GetArray("AmbientOcclusion"));
-  if (!surface->GetPointData()->GetArray("AmbientOcclusion") || surface->GetNumberOfPoints() < 1000)
+  vtkDataArray* ao = probe->GetOutput()->GetPointData()->GetArray("AmbientOcclusion");
+  ao->SetName("Shade");
+  surface->GetPointData()->AddArray(ao);
+  return surface;
+}
+
+/// The bone (400 HU) coloured by Penner & Mitchell AO times the soft shadow of a light
+/// from the front and above.
+vtkSmartPointer<vtkPolyData> PennerBone(vtkAlgorithmOutput* ct)
+{
+  vtkNew<vtkFlyingEdges3D> bone;
+  bone->SetInputConnection(ct);
+  bone->SetValue(0, 400.0);
+  bone->ComputeNormalsOn();
+  vtkNew<vtkIsosurfaceAmbientOcclusion> shade;
+  shade->SetInputConnection(0, bone->GetOutputPort());
+  shade->SetVolumeConnection(ct);
+  shade->ComputeShadowsOn();
+  shade->SetLightDirection(0.3, -1.0, 1.0);
+  shade->Update();
+  auto surface = vtkSmartPointer<vtkPolyData>::New();
+  surface->DeepCopy(shade->GetOutput());
+  vtkDataArray* ao = surface->GetPointData()->GetArray("AmbientOcclusion");
+  vtkDataArray* shadow = surface->GetPointData()->GetArray("Shadow");
+  if (!ao || !shadow)
   {
-    std::fprintf(stderr, "FAILED: the skin surface carries no AmbientOcclusion\n");
+    return surface;
+  }
+  vtkNew<vtkFloatArray> product;
+  product->SetName("Shade");
+  product->SetNumberOfTuples(surface->GetNumberOfPoints());
+  for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i)
+  {
+    // Ambient light dimmed by AO, plus direct light dimmed by the shadow.
+    product->SetValue(i, static_cast<float>(ao->GetComponent(i, 0) * (0.5 + 0.5 * shadow->GetComponent(i, 0))));
+  }
+  surface->GetPointData()->AddArray(product);
+  return surface;
+}
+
+int main(int argc, char* argv[])
+{
+  if (argc < 5 || (std::strcmp(argv[1], "sweeping") != 0 && std::strcmp(argv[1], "penner") != 0))
+  {
+    std::fprintf(stderr, "usage: %s sweeping|penner CT.mha BASELINE.png OUTPUT.png [--write-baseline]\n", argv[0]);
+    return 2;
+  }
+  const bool sweeping = std::strcmp(argv[1], "sweeping") == 0;
+  const char* baselinePath = argv[3];
+  const char* outputPath = argv[4];
+  vtkNew<vtkMetaImageReader> reader;
+  reader->SetFileName(argv[2]);
+  auto surface = sweeping ? SweepingSkin(reader->GetOutputPort()) : PennerBone(reader->GetOutputPort());
+  if (!surface->GetPointData()->GetArray("Shade") || surface->GetNumberOfPoints() < 1000)
+  {
+    std::fprintf(stderr, "FAILED: the surface carries no shading\n");
     return 1;
   }
-  auto image = Render(surface, "AmbientOcclusion");
+  auto image = Render(surface, "Shade");
   vtkNew<vtkPNGWriter> writer;
   writer->SetInputData(image);
-  writer->SetFileName(argv[3]);
+  writer->SetFileName(outputPath);
   writer->Write();
-  if (argc > 4 && std::strcmp(argv[4], "--write-baseline") == 0)
+  if (argc > 5 && std::strcmp(argv[5], "--write-baseline") == 0)
   {
-    writer->SetFileName(argv[2]);
+    writer->SetFileName(baselinePath);
     writer->Write();
   }
-  if (!std::ifstream(argv[2]).good())
+  if (!std::ifstream(baselinePath).good())
   {
-    std::fprintf(stderr, "FAILED: missing baseline %s\n", argv[2]);
+    std::fprintf(stderr, "FAILED: missing baseline %s\n", baselinePath);
     return 1;
   }
   vtkNew<vtkPNGReader> baselineReader;
-  baselineReader->SetFileName(argv[2]);
+  baselineReader->SetFileName(baselinePath);
   baselineReader->Update();
   const double error = Difference(image, baselineReader->GetOutput());
 
@@ -167,7 +217,7 @@ int main(int argc, char* argv[])
   const double constantError = Difference(Render(surface, "Constant"), baselineReader->GetOutput());
   std::printf("regression image RMS difference %g (threshold 2), constant-AO RMS difference %g (must exceed 10); "
               "image %s\n",
-    error, constantError, argv[3]);
+    error, constantError, outputPath);
   if (error > 2.0 || constantError < 10.0)
   {
     std::printf("FAILED\n");

@@ -1,0 +1,174 @@
+// Variance occlusion maps (Penner & Mitchell 2008), host code: a pyramid of Gaussian-
+// blurred moments of the volume, sampled at points offset from an isosurface to estimate
+// its ambient occlusion and soft shadows. Definitions: the Penner & Mitchell section of
+// METHODS.md. The pyramid is built once; moving the iso value, the surface or the light
+// only samples it again.
+#pragma once
+
+#include "vao/AmbientOcclusion.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <new>
+#include <utility>
+#include <vector>
+
+namespace vao
+{
+
+namespace detail
+{
+/// Storage of the level arrays: large blocks are aligned to 2 MiB and, on Linux, advised
+/// to use transparent huge pages (a 512^3 level 0 is 1 GiB: 4 KiB page faults alone would
+/// cost more than the blur). Freed with freeLevelStorage.
+void* allocateLevelStorage(std::size_t bytes);
+void freeLevelStorage(void* block) noexcept;
+
+/// std::allocator without the value-initialisation of resize: the pyramid builder writes
+/// every element, in parallel, so a fresh array is first touched by the threads that fill
+/// it instead of by one serial zero-fill.
+template <class T>
+struct LevelAllocator
+{
+  using value_type = T;
+  LevelAllocator() = default;
+  template <class U>
+  LevelAllocator(const LevelAllocator<U>&) noexcept
+  {
+  }
+  T* allocate(std::size_t n)
+  {
+    void* block = allocateLevelStorage(n * sizeof(T));
+    if (!block)
+    {
+      throw std::bad_alloc();
+    }
+    return static_cast<T*>(block);
+  }
+  void deallocate(T* p, std::size_t) noexcept { freeLevelStorage(p); }
+  template <class U>
+  void construct(U* p) noexcept
+  {
+    ::new (static_cast<void*>(p)) U; // default-initialised: no zero-fill
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args)
+  {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+  template <class U>
+  bool operator==(const LevelAllocator<U>&) const noexcept
+  {
+    return true;
+  }
+  template <class U>
+  bool operator!=(const LevelAllocator<U>&) const noexcept
+  {
+    return false;
+  }
+};
+} // namespace detail
+
+/// A level's array: a std::vector<float> whose resize leaves new elements uninitialised.
+using LevelArray = std::vector<float, detail::LevelAllocator<float>>;
+
+/// One level of the pyramid: blurred first moment (the mean) and variance, x fastest.
+struct MomentLevel
+{
+  Index3 dims = { 0, 0, 0 };
+  std::array<double, 3> origin = { 0, 0, 0 };  // world position of voxel (0, 0, 0)
+  std::array<double, 3> spacing = { 1, 1, 1 }; // world units
+  double kernelRadius = 0.0;                   // r_l = 2 * largest spacing of this level (world)
+  LevelArray mean;
+  LevelArray variance; // E[v^2] - E[v]^2 of the blurred moments, clamped at 0
+};
+
+struct PyramidParameters
+{
+  int levels = 4;
+  bool startAtHalfResolution = false;
+};
+
+/// Level 0 blurs the volume with a separable normalised 5-tap Gaussian per axis (sigma = 1
+/// voxel; weights renormalised where the kernel leaves the volume, so a constant stays
+/// constant) at full resolution, or with startAtHalfResolution keeps every second voxel
+/// of that blur. Each next level blurs the previous one the same way and keeps voxels 0, 2,
+/// 4, ... per axis: dims (n + 1) / 2, spacing doubled, origin unchanged (the effective
+/// kernel doubles). Moments are taken about the volume's sampled mean and accumulated in
+/// double; levels store mean and variance as float. The volume must be 3-D (>= 2 voxels
+/// per axis) and finite, the spacing finite and positive, 1 <= levels <= 16; on failure
+/// the pyramid is left empty. A pyramid passed in from an earlier build of the same size
+/// is rebuilt in its own storage (no reallocation).
+Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
+  std::vector<MomentLevel>& pyramid, const Execution& execution = {});
+
+enum class SurfaceQuery : int
+{
+  HalfVoxelInside = 0, // q = v(p - h/2 n), the paper's default
+  IsoValue = 1,        // q = c
+};
+
+enum class SurfaceEstimator : int
+{
+  Chebyshev = 0,
+  GaussianCdf = 1,
+};
+
+enum class LevelCombination : int
+{
+  MaximumOcclusion = 0,
+  Mean = 1,
+};
+
+struct SurfaceOcclusionParameters
+{
+  SurfaceQuery query = SurfaceQuery::HalfVoxelInside;
+  double isoValue = 0.0;
+  double offsetFactor = 1.0; // k: samples at p + k r_l n
+  SurfaceEstimator estimator = SurfaceEstimator::Chebyshev;
+  LevelCombination combination = LevelCombination::MaximumOcclusion;
+  int levels = -1; // levels used, -1: all of the pyramid
+};
+
+/// Ambient occlusion (1 = open) of surface points p with outward normals n (towards lower
+/// values; normalised here, must be finite and non-zero). Query q = the iso value, or (the
+/// default) v(p - h/2 n): the volume trilinearly interpolated half a voxel inside, with
+/// `origin`/`spacing` the volume's geometry and h its smallest spacing (the volume is
+/// only read for that query). Level l (l < parameters.levels, -1: all) samples mean and
+/// variance at p + k r_l n; its occlusion is 1 - the Chebyshev (or Gaussian CDF, exact
+/// erf) openness of q; levels combine by maximum (default) or mean; out = 1 - occlusion.
+/// Points: 3 doubles each; normals: 3 doubles each; out: one float per point.
+Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const double* points,
+  const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
+  const Execution& execution = {});
+
+/// Soft shadow (1 = lit) of surface points towards the light direction L (need not be
+/// unit; must be finite and not zero): a march along L starting at p + r_0 n (off the
+/// surface); at distance t it samples level l = clamp(floor(log2(1 + t / r_0)), 0,
+/// levels - 1) and steps r_l / 2; occlusion = the maximum over the steps of 1 - the
+/// openness of q (the estimator of `parameters`); it stops on leaving level 0's bounds or
+/// at occlusion >= 0.999. There is no raw volume here, so the half-voxel-inside query reads
+/// level 0's (blurred) mean at p - h/2 n (h: level 0's smallest spacing); IsoValue gives
+/// q = c exactly. offsetFactor and combination are not used.
+Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* points, const double* normals,
+  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution = {});
+
+/// Trilinear value of the volume at a world position (clamped to its bounds), with
+/// `origin`/`spacing` its geometry: the interpolation of the half-voxel-inside query.
+double sampleVolume(const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const std::array<double, 3>& position);
+
+/// Trilinear sample of a level's mean and variance at a world position (clamped to the
+/// level's bounds).
+void sampleLevel(const MomentLevel& level, const std::array<double, 3>& position, double& mean, double& variance);
+
+/// Trilinear sample of the volume (any scalar type) at a world position, clamped to the
+/// volume: voxel (0, 0, 0) at `origin`, `spacing` per axis.
+double sampleVolume(const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const std::array<double, 3>& position);
+
+} // namespace vao

@@ -1,0 +1,143 @@
+/**
+ * @class   vtkIsosurfaceAmbientOcclusion
+ * @brief   Ambient occlusion and soft shadows of an isosurface (Penner & Mitchell 2008).
+ *
+ * Input 0: a surface (e.g. the Contour filter's output) with point normals; without a
+ * "Normals" array the normals are the volume's gradient at the points, oriented towards
+ * lower values. Input 1: the volume. The volume's moments are blurred into a pyramid (see
+ * vtkVarianceOcclusionMap) once; each surface point samples it at p + k r_l n on every
+ * level l and bounds the occluded fraction with Chebyshev's (Cantelli's) inequality, or
+ * estimates it with the Gaussian CDF of Ruiz et al.
+ *
+ * Outputs on the surface's points: float32 "AmbientOcclusion" (1 = open) and, with
+ * ComputeShadows, "Shadow" (1 = lit) towards LightDirection.
+ *
+ * The pyramid is cached: changing only the surface, the query, the combination, the
+ * estimator or the light re-samples it without rebuilding it (GetNumberOfPyramidBuilds()
+ * counts the builds).
+ */
+#ifndef vtkIsosurfaceAmbientOcclusion_h
+#define vtkIsosurfaceAmbientOcclusion_h
+
+#include "VolumetricAOFiltersModule.h" // for export macro
+#include "vtkPolyDataAlgorithm.h"
+
+#include <memory>
+#include <vector>
+
+class vtkDataArray;
+class vtkImageData;
+
+class VOLUMETRICAOFILTERS_EXPORT vtkIsosurfaceAmbientOcclusion : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkIsosurfaceAmbientOcclusion* New();
+  vtkTypeMacro(vtkIsosurfaceAmbientOcclusion, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum QueryModeType
+  {
+    HALF_VOXEL_INSIDE = 0,
+    ISO_VALUE = 1
+  };
+  enum CombineType
+  {
+    COMBINE_MAX = 0,
+    COMBINE_MEAN = 1
+  };
+  enum EstimatorType
+  {
+    CHEBYSHEV = 0,
+    GAUSSIAN_CDF = 1
+  };
+
+  /// The volume (input port 1).
+  void SetVolumeConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
+  void SetVolumeData(vtkDataObject* volume) { this->SetInputData(1, volume); }
+
+  /// The volume's point array (default: its active scalars); the same as
+  /// SetInputArrayToProcess(0, 1, 0, FIELD_ASSOCIATION_POINTS, name).
+  void SetVolumeScalars(const char* name);
+
+  ///@{
+  /// Query value: the volume half a voxel inside the surface (default, the paper) or IsoValue.
+  vtkSetMacro(QueryMode, int);
+  vtkGetMacro(QueryMode, int);
+  vtkSetMacro(IsoValue, double);
+  vtkGetMacro(IsoValue, double);
+  ///@}
+
+  ///@{
+  /// Pyramid levels (default 4) and their start at half resolution (default off).
+  vtkSetMacro(NumberOfLevels, int);
+  vtkGetMacro(NumberOfLevels, int);
+  vtkSetMacro(StartAtHalfResolution, vtkTypeBool);
+  vtkGetMacro(StartAtHalfResolution, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /// k: level l is sampled at p + k r_l n (default 1).
+  vtkSetMacro(OffsetFactor, double);
+  vtkGetMacro(OffsetFactor, double);
+  ///@}
+
+  ///@{
+  /// Combination of the levels (COMBINE_MAX: the largest occlusion, default) and the
+  /// estimator (CHEBYSHEV, default, or GAUSSIAN_CDF).
+  vtkSetMacro(Combine, int);
+  vtkGetMacro(Combine, int);
+  vtkSetMacro(Estimator, int);
+  vtkGetMacro(Estimator, int);
+  ///@}
+
+  ///@{
+  /// Soft shadows towards LightDirection (default off; light from +z).
+  vtkSetMacro(ComputeShadows, vtkTypeBool);
+  vtkGetMacro(ComputeShadows, vtkTypeBool);
+  vtkBooleanMacro(ComputeShadows, vtkTypeBool);
+  vtkSetVector3Macro(LightDirection, double);
+  vtkGetVector3Macro(LightDirection, double);
+  ///@}
+
+  ///@{
+  /// Component of a multi-component volume array; -1 (default): single-component only.
+  vtkSetMacro(Component, int);
+  vtkGetMacro(Component, int);
+  ///@}
+
+  /// How many times the pyramid was built (the cache's witness).
+  int GetNumberOfPyramidBuilds() const { return this->PyramidBuilds; }
+
+protected:
+  vtkIsosurfaceAmbientOcclusion();
+  ~vtkIsosurfaceAmbientOcclusion() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int QueryMode = HALF_VOXEL_INSIDE;
+  double IsoValue = 0.0;
+  int NumberOfLevels = 4;
+  vtkTypeBool StartAtHalfResolution = false;
+  double OffsetFactor = 1.0;
+  int Combine = COMBINE_MAX;
+  int Estimator = CHEBYSHEV;
+  vtkTypeBool ComputeShadows = false;
+  double LightDirection[3] = { 0.0, 0.0, 1.0 };
+  int Component = -1;
+  int PyramidBuilds = 0;
+
+private:
+  vtkIsosurfaceAmbientOcclusion(const vtkIsosurfaceAmbientOcclusion&) = delete;
+  void operator=(const vtkIsosurfaceAmbientOcclusion&) = delete;
+
+  struct Cache;
+  std::unique_ptr<Cache> Pyramid;
+
+  bool CheckParameters();
+  bool UpdatePyramid(vtkImageData* volume, vtkDataArray* chosen);
+  bool SurfaceNormals(vtkPolyData* surface, std::vector<double>& normals);
+};
+
+#endif

@@ -1,0 +1,62 @@
+/**
+ * @class   vtkVarianceOcclusionMap
+ * @brief   The moment pyramid of Penner & Mitchell 2008 (variance occlusion maps).
+ *
+ * Blurs the first two moments of the volume with a 5x5x5 Gaussian, then builds a
+ * pyramid: each level blurs the previous one and halves its resolution (the effective
+ * kernel doubles). The output is a multiblock of vtkImageData levels, each with its own
+ * origin and spacing and the float32 point arrays "Mean" and "Variance". Use it to look
+ * at the maps, or to sample them with the Probe filter; Isosurface Ambient Occlusion
+ * builds the same pyramid internally and keeps it between updates.
+ */
+#ifndef vtkVarianceOcclusionMap_h
+#define vtkVarianceOcclusionMap_h
+
+#include "VolumetricAOFiltersModule.h" // for export macro
+#include "vtkMultiBlockDataSetAlgorithm.h"
+
+class VOLUMETRICAOFILTERS_EXPORT vtkVarianceOcclusionMap : public vtkMultiBlockDataSetAlgorithm
+{
+public:
+  static vtkVarianceOcclusionMap* New();
+  vtkTypeMacro(vtkVarianceOcclusionMap, vtkMultiBlockDataSetAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// Number of pyramid levels (default 4, at most 16).
+  vtkSetMacro(NumberOfLevels, int);
+  vtkGetMacro(NumberOfLevels, int);
+  ///@}
+
+  ///@{
+  /// Start the pyramid at half resolution (default off): a quarter of the memory of
+  /// level 0 for large volumes.
+  vtkSetMacro(StartAtHalfResolution, vtkTypeBool);
+  vtkGetMacro(StartAtHalfResolution, vtkTypeBool);
+  vtkBooleanMacro(StartAtHalfResolution, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /// Component of a multi-component input array; -1 (default): single-component only.
+  vtkSetMacro(Component, int);
+  vtkGetMacro(Component, int);
+  ///@}
+
+protected:
+  vtkVarianceOcclusionMap();
+  ~vtkVarianceOcclusionMap() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int NumberOfLevels = 4;
+  vtkTypeBool StartAtHalfResolution = false;
+  int Component = -1;
+
+private:
+  vtkVarianceOcclusionMap(const vtkVarianceOcclusionMap&) = delete;
+  void operator=(const vtkVarianceOcclusionMap&) = delete;
+};
+
+#endif
