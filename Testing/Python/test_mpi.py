@@ -73,10 +73,28 @@ def shaded_points(path):
     return {tuple(np.round(p, 4)): (a, s) for p, a, s in zip(points, ao, shadow)}
 
 
-serial_surface = shaded_points(run(1, "mpi_surface_run.py", "pvtp"))
+def pyramid_summary(path):
+    import json
+    with open(path + ".pyramid.json") as f:
+        return json.load(f)
+
+
+serial_path = run(1, "mpi_surface_run.py", "pvtp")
+serial_surface = shaded_points(serial_path)
+serial_pyramid = pyramid_summary(serial_path)
+check(len(serial_pyramid) == 4 and all(level is not None for level in serial_pyramid),
+      "serial pyramid: 4 levels %s" % [level["dims"] for level in serial_pyramid])
 check(len(serial_surface) > 10000, "serial bone surface: %d points" % len(serial_surface))
 for ranks in rank_counts:
-    distributed = shaded_points(run(ranks, "mpi_surface_run.py", "pvtp"))
+    distributed_path = run(ranks, "mpi_surface_run.py", "pvtp")
+    fetched = pyramid_summary(distributed_path)
+    # Fetch's transport prints the spacing with 6 digits under MPI: compare it loosely.
+    same = len(fetched) == len(serial_pyramid) and all(
+        f["dims"] == r["dims"] and f["mean"] == r["mean"] and f["variance"] == r["variance"] and
+        all(abs(a - b) <= 1e-5 * b for a, b in zip(f["spacing"], r["spacing"]))
+        for f, r in zip(fetched, serial_pyramid))
+    check(same, "np %d: the fetched pyramid equals the serial one (sizes, sums of Mean and Variance)" % ranks)
+    distributed = shaded_points(distributed_path)
     matched = [key for key in distributed if key in serial_surface]
     check(len(matched) >= 0.999 * len(distributed), "np %d: %d of %d surface points found in the serial surface"
           % (ranks, len(matched), len(distributed)))
