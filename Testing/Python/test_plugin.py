@@ -151,6 +151,27 @@ for name in ["AmbientOcclusion", "Shadow"]:
     values = vtk_to_numpy(surface.GetPointData().GetArray(name))
     check(values.size == surface.GetNumberOfPoints() > 10000 and values.min() >= 0 and values.max() <= 1
           and values.std() > 0.05, "bone surface %s in [0, 1] with contrast (std %.3f)" % (name, values.std()))
+# Ambient Occlusion Shading on both data types, with default settings.
+colours = AmbientOcclusionShading(Input=shaded)
+lit_surface = servermanager.Fetch(colours)
+rgb = lit_surface.GetPointData().GetArray("ShadedRGB")
+check(rgb is not None and rgb.GetNumberOfComponents() == 3 and rgb.GetDataTypeAsString() == "unsigned char",
+      "AmbientOcclusionShading on the bone surface: ShadedRGB (3 x uint8)")
+Delete(colours)
+volume_ao = VolumetricAmbientOcclusion(Input=ct, Radius=5, ComputeVariance=1)
+volume_ao.Scalars = ["POINTS", "MetaImage"]
+lit_volume = AmbientOcclusionShading(Input=volume_ao, ModulateOpacity=1)
+for name in ["AmbientOcclusionArray", "Scalars", "ColorPreset", "ScalarRange", "OpacityRamp", "AmbientIntensity",
+             "Gamma", "ModulateOpacity", "VarianceMax"]:
+    prop = lit_volume.GetProperty(name)
+    check(prop is not None and len(prop.SMProperty.GetDocumentation().GetDescription().strip()) > 20,
+          "AmbientOcclusionShading property %s exists and is documented" % name)
+rgba_volume = servermanager.Fetch(lit_volume)
+rgba = vtk_to_numpy(rgba_volume.GetPointData().GetArray("ShadedRGBA"))
+check(rgba.shape == (ct_points, 4) and rgba[:, 3].max() == 255 and rgba[:, 3].min() == 0 and rgba[:, 0].std() > 5,
+      "AmbientOcclusionShading on the CT volume: ShadedRGBA with modulated opacity")
+Delete(lit_volume)
+Delete(volume_ao)
 Delete(shaded)
 Delete(bone)
 

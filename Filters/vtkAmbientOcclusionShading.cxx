@@ -1,0 +1,189 @@
+#include "vtkAmbientOcclusionShading.h"
+
+#include "vao/Shading.h"
+
+#include "vtkColorTransferFunction.h"
+#include "vtkDataArray.h"
+#include "vtkDataSet.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPointData.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+vtkStandardNewMacro(vtkAmbientOcclusionShading);
+
+namespace
+{
+
+vtkSmartPointer<vtkScalarsToColors> PresetColors(int preset, const double range[2])
+{
+  auto colors = vtkSmartPointer<vtkColorTransferFunction>::New();
+  const double lo = range[0], hi = range[1], mid = 0.5 * (lo + hi);
+  switch (preset)
+  {
+    case vtkAmbientOcclusionShading::BONE:
+      colors->AddRGBPoint(lo, 0.0, 0.0, 0.0);
+      colors->AddRGBPoint(mid, 0.85, 0.78, 0.66);
+      colors->AddRGBPoint(hi, 1.0, 1.0, 0.95);
+      break;
+    case vtkAmbientOcclusionShading::COOL_TO_WARM:
+      colors->SetColorSpaceToDiverging();
+      colors->AddRGBPoint(lo, 0.23, 0.30, 0.75);
+      colors->AddRGBPoint(hi, 0.71, 0.02, 0.15);
+      break;
+    default:
+      colors->AddRGBPoint(lo, 0.0, 0.0, 0.0);
+      colors->AddRGBPoint(hi, 1.0, 1.0, 1.0);
+  }
+  return colors;
+}
+
+vtkSmartPointer<vtkPiecewiseFunction> RampOpacity(const double ramp[2])
+{
+  auto opacity = vtkSmartPointer<vtkPiecewiseFunction>::New();
+  opacity->AddPoint(ramp[0], 0.0);
+  opacity->AddPoint(ramp[1], 1.0);
+  return opacity;
+}
+
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkAmbientOcclusionShading::vtkAmbientOcclusionShading() = default;
+vtkAmbientOcclusionShading::~vtkAmbientOcclusionShading() = default;
+
+void vtkAmbientOcclusionShading::SetColorTransferFunction(vtkScalarsToColors* colors)
+{
+  this->Colors = colors;
+  this->Modified();
+}
+
+void vtkAmbientOcclusionShading::SetOpacityTransferFunction(vtkPiecewiseFunction* opacity)
+{
+  this->Opacity = opacity;
+  this->Modified();
+}
+
+vtkMTimeType vtkAmbientOcclusionShading::GetMTime()
+{
+  vtkMTimeType time = this->Superclass::GetMTime();
+  time = this->Colors ? std::max(time, this->Colors->GetMTime()) : time;
+  return this->Opacity ? std::max(time, this->Opacity->GetMTime()) : time;
+}
+
+//------------------------------------------------------------------------------
+int vtkAmbientOcclusionShading::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkDataSet* input = vtkDataSet::GetData(inputVector[0]);
+  vtkDataSet* output = vtkDataSet::GetData(outputVector);
+  if (!input || !output)
+  {
+    return 1;
+  }
+  output->ShallowCopy(input);
+  std::ostringstream why;
+  vtkPointData* pd = input->GetPointData();
+  vtkDataArray* ao = pd->GetArray(this->AmbientOcclusionArrayName.c_str());
+  vtkDataArray* scalars =
+    this->ScalarsArrayName.empty() ? pd->GetScalars() : pd->GetArray(this->ScalarsArrayName.c_str());
+  const bool volume = vtkImageData::SafeDownCast(input) != nullptr;
+  if (!std::isfinite(this->AmbientIntensity) || this->AmbientIntensity < 0.0)
+    why << "AmbientIntensity must be a finite, non-negative number (got " << this->AmbientIntensity << ").";
+  else if (!std::isfinite(this->Gamma) || !(this->Gamma > 0.0))
+    why << "Gamma must be a finite, positive number (got " << this->Gamma << ").";
+  else if (!std::isfinite(this->VarianceMax))
+    why << "VarianceMax must be finite (0 or less: automatic).";
+  else if (this->ColorPreset < GRAYSCALE || this->ColorPreset > COOL_TO_WARM)
+    why << "Unknown ColorPreset " << this->ColorPreset << " (0 Grayscale, 1 Bone, 2 Cool to Warm).";
+  else if (!ao || ao->GetNumberOfComponents() != 1)
+    why << "No one-component point array '" << this->AmbientOcclusionArrayName
+        << "': apply an ambient occlusion filter first, or name its output array.";
+  else if ((volume || !this->ScalarsArrayName.empty()) && (!scalars || scalars->GetNumberOfComponents() != 1))
+    why << "No one-component point scalars to colour" << (this->ScalarsArrayName.empty() ? "" : " named '")
+        << this->ScalarsArrayName << (this->ScalarsArrayName.empty() ? "." : "'.");
+  else if (volume && this->ModulateOpacity && !pd->GetArray("Variance"))
+    why << "ModulateOpacity needs the point array 'Variance' (Volumetric Ambient Occlusion with Compute "
+           "Variance on).";
+  if (!why.str().empty())
+  {
+    vtkErrorMacro(<< why.str());
+    output->Initialize();
+    return 1;
+  }
+
+  double range[2] = { this->ScalarRange[0], this->ScalarRange[1] };
+  if (scalars && range[0] > range[1])
+  {
+    scalars->GetRange(range, 0);
+  }
+  vtkSmartPointer<vtkScalarsToColors> colors = this->Colors ? this->Colors : PresetColors(this->ColorPreset, range);
+  const vtkIdType n = input->GetNumberOfPoints();
+  vtkNew<vtkUnsignedCharArray> shaded;
+  shaded->SetNumberOfComponents(volume ? 4 : 3);
+  shaded->SetNumberOfTuples(n);
+  shaded->SetName(volume ? "ShadedRGBA" : "ShadedRGB");
+  vtkDataArray* shadow = volume ? nullptr : pd->GetArray("Shadow");
+  vtkDataArray* variance = volume && this->ModulateOpacity ? pd->GetArray("Variance") : nullptr;
+  double ramp[2] = { this->OpacityRamp[0], this->OpacityRamp[1] };
+  if (ramp[0] > ramp[1])
+  {
+    ramp[0] = 0.5 * (range[0] + range[1]);
+    ramp[1] = range[1];
+  }
+  vtkSmartPointer<vtkPiecewiseFunction> opacity = this->Opacity ? this->Opacity : RampOpacity(ramp);
+  const double varianceMax =
+    this->VarianceMax > 0.0 ? this->VarianceMax : std::pow((range[1] - range[0]) / 20.0, 2.0);
+  unsigned char* out = shaded->GetPointer(0);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    if (i % 65536 == 0)
+    {
+      this->UpdateProgress(static_cast<double>(i) / n);
+      if (this->GetAbortExecute())
+      {
+        output->Initialize();
+        return 1;
+      }
+    }
+    double rgb[3] = { 1.0, 1.0, 1.0 };
+    const double v = scalars ? scalars->GetComponent(i, 0) : 0.0;
+    if (scalars)
+    {
+      colors->GetColor(v, rgb);
+    }
+    const double o = ao->GetComponent(i, 0) * (shadow ? shadow->GetComponent(i, 0) : 1.0);
+    for (int c = 0; c < 3; ++c)
+    {
+      *out++ = vao::toByte(vao::ambientLighting(this->AmbientIntensity, o, rgb[c], this->Gamma));
+    }
+    if (volume)
+    {
+      const double m = variance ? vao::varianceModulation(variance->GetComponent(i, 0), varianceMax) : 1.0;
+      *out++ = vao::toByte(opacity->GetValue(v) * m);
+    }
+  }
+  output->GetPointData()->AddArray(shaded);
+  output->GetPointData()->SetActiveScalars(shaded->GetName());
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkAmbientOcclusionShading::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "AmbientOcclusionArrayName: " << this->AmbientOcclusionArrayName << "\n";
+  os << indent << "ScalarsArrayName: " << this->ScalarsArrayName << "\n";
+  os << indent << "AmbientIntensity: " << this->AmbientIntensity << ", Gamma: " << this->Gamma << "\n";
+  os << indent << "ModulateOpacity: " << this->ModulateOpacity << ", VarianceMax: " << this->VarianceMax << "\n";
+  os << indent << "ColorPreset: " << this->ColorPreset << ", ScalarRange: " << this->ScalarRange[0] << " "
+     << this->ScalarRange[1] << ", OpacityRamp: " << this->OpacityRamp[0] << " " << this->OpacityRamp[1] << "\n";
+}

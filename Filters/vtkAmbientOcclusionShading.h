@@ -1,0 +1,116 @@
+/**
+ * @class   vtkAmbientOcclusionShading
+ * @brief   Colours a volume or a surface with its ambient occlusion (Ruiz et al. Eq. 5).
+ *
+ * On image data: a 4-component unsigned char point array "ShadedRGBA" with
+ * RGB = k * O * C_TF(v) (AmbientIntensity k, O the AO array raised to 1/Gamma, C_TF the
+ * colour transfer function at the voxel's value) and A = alpha_TF(v), times
+ * min(s2 / VarianceMax, 1) when ModulateOpacity is on (the intensity variance s2 from the
+ * "Variance" array). Render it as a volume with dependent components (ParaView: Map
+ * Scalars off) to see the AO without any other lighting.
+ *
+ * On a surface (any other data set): a 3-component unsigned char "ShadedRGB", the
+ * colour map of its scalars (or white without scalars) times AO, and times "Shadow" when
+ * that array exists.
+ *
+ * The transfer functions: set them (SetColorTransferFunction, SetOpacityTransferFunction)
+ * or let the filter build them from ColorPreset over ScalarRange (the data range when
+ * ScalarRange is empty) and an opacity ramp from 0 at OpacityRamp[0] to 1 at
+ * OpacityRamp[1] (by default the upper half of the range).
+ */
+#ifndef vtkAmbientOcclusionShading_h
+#define vtkAmbientOcclusionShading_h
+
+#include "VolumetricAOFiltersModule.h" // for export macro
+#include "vtkPassInputTypeAlgorithm.h"
+#include "vtkSmartPointer.h"
+
+#include <string>
+
+class vtkPiecewiseFunction;
+class vtkScalarsToColors;
+
+class VOLUMETRICAOFILTERS_EXPORT vtkAmbientOcclusionShading : public vtkPassInputTypeAlgorithm
+{
+public:
+  static vtkAmbientOcclusionShading* New();
+  vtkTypeMacro(vtkAmbientOcclusionShading, vtkPassInputTypeAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum PresetType
+  {
+    GRAYSCALE = 0,
+    BONE = 1,
+    COOL_TO_WARM = 2
+  };
+
+  ///@{
+  /// The AO array (default "AmbientOcclusion") and the scalars coloured (default: the
+  /// active point scalars).
+  vtkSetStdStringFromCharMacro(AmbientOcclusionArrayName);
+  vtkGetCharFromStdStringMacro(AmbientOcclusionArrayName);
+  vtkSetStdStringFromCharMacro(ScalarsArrayName);
+  vtkGetCharFromStdStringMacro(ScalarsArrayName);
+  ///@}
+
+  ///@{
+  /// k of Eq. 5 (default 1) and the gamma applied to the AO (default 1).
+  vtkSetMacro(AmbientIntensity, double);
+  vtkGetMacro(AmbientIntensity, double);
+  vtkSetMacro(Gamma, double);
+  vtkGetMacro(Gamma, double);
+  ///@}
+
+  ///@{
+  /// Modulate the opacity by min(s2 / VarianceMax, 1) (default off). VarianceMax <= 0
+  /// (default) picks (range / 20)^2 of the scalars: variances of a twentieth of the range
+  /// count as a boundary.
+  vtkSetMacro(ModulateOpacity, vtkTypeBool);
+  vtkGetMacro(ModulateOpacity, vtkTypeBool);
+  vtkBooleanMacro(ModulateOpacity, vtkTypeBool);
+  vtkSetMacro(VarianceMax, double);
+  vtkGetMacro(VarianceMax, double);
+  ///@}
+
+  ///@{
+  /// The built-in transfer functions: colour preset over ScalarRange (empty, i.e.
+  /// min > max, = the data range) and the opacity ramp.
+  vtkSetMacro(ColorPreset, int);
+  vtkGetMacro(ColorPreset, int);
+  vtkSetVector2Macro(ScalarRange, double);
+  vtkGetVector2Macro(ScalarRange, double);
+  vtkSetVector2Macro(OpacityRamp, double);
+  vtkGetVector2Macro(OpacityRamp, double);
+  ///@}
+
+  ///@{
+  /// Explicit transfer functions (override the preset and the ramp when set).
+  void SetColorTransferFunction(vtkScalarsToColors* colors);
+  void SetOpacityTransferFunction(vtkPiecewiseFunction* opacity);
+  ///@}
+
+protected:
+  vtkAmbientOcclusionShading();
+  ~vtkAmbientOcclusionShading() override;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  vtkMTimeType GetMTime() override;
+
+  std::string AmbientOcclusionArrayName = "AmbientOcclusion";
+  std::string ScalarsArrayName;
+  double AmbientIntensity = 1.0;
+  double Gamma = 1.0;
+  vtkTypeBool ModulateOpacity = false;
+  double VarianceMax = 0.0;
+  int ColorPreset = GRAYSCALE;
+  double ScalarRange[2] = { 1.0, 0.0 };
+  double OpacityRamp[2] = { 1.0, 0.0 };
+  vtkSmartPointer<vtkScalarsToColors> Colors;
+  vtkSmartPointer<vtkPiecewiseFunction> Opacity;
+
+private:
+  vtkAmbientOcclusionShading(const vtkAmbientOcclusionShading&) = delete;
+  void operator=(const vtkAmbientOcclusionShading&) = delete;
+};
+
+#endif

@@ -1,0 +1,122 @@
+// The shading filter: Eq. 5 on volumes and surfaces, the variance modulation, bad input.
+#include "TestHelpers.h"
+
+#include "vtkAmbientOcclusionShading.h"
+
+#include "vtkDataSet.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkNew.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+using namespace vaotest;
+
+namespace
+{
+
+vtkSmartPointer<vtkFloatArray> Array(const char* name, std::vector<float> values)
+{
+  auto array = vtkSmartPointer<vtkFloatArray>::New();
+  array->SetName(name);
+  array->SetNumberOfTuples(static_cast<vtkIdType>(values.size()));
+  for (size_t i = 0; i < values.size(); ++i)
+    array->SetValue(static_cast<vtkIdType>(i), values[i]);
+  return array;
+}
+
+/// A 2x2x2 volume: values 0..700 (step 100), AO 1, 0.5, 0.25, ..., variance 0..7000.
+vtkSmartPointer<vtkImageData> SmallVolume()
+{
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(2, 2, 2);
+  image->GetPointData()->SetScalars(Array("Density", { 0, 100, 200, 300, 400, 500, 600, 700 }));
+  image->GetPointData()->AddArray(Array("AmbientOcclusion", { 1, 0.5f, 0.25f, 1, 0.5f, 0.25f, 1, 0 }));
+  image->GetPointData()->AddArray(Array("Variance", { 0, 1000, 2000, 3000, 4000, 5000, 6000, 7000 }));
+  return image;
+}
+
+TEST(AmbientOcclusionShadingFilter, VolumesGetRuizEquation5AndTheVarianceModulation)
+{
+  auto volume = SmallVolume();
+  vtkNew<vtkAmbientOcclusionShading> shading;
+  shading->SetInputData(volume);
+  shading->SetAmbientIntensity(0.8);
+  shading->ModulateOpacityOn();
+  shading->SetVarianceMax(4000);
+  vtkNew<vtkPiecewiseFunction> opacity; // constant 1: only the modulation shows
+  opacity->AddPoint(0, 1.0);
+  opacity->AddPoint(700, 1.0);
+  shading->SetOpacityTransferFunction(opacity);
+  shading->Update();
+  auto* rgba = vtkUnsignedCharArray::SafeDownCast(vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGBA"));
+  ASSERT_NE(rgba, nullptr);
+  ASSERT_EQ(rgba->GetNumberOfComponents(), 4);
+  for (vtkIdType i = 0; i < 8; ++i)
+  {
+    const double grey = i * 100.0 / 700.0; // the default grey-scale over the data range
+    const double ao = volume->GetPointData()->GetArray("AmbientOcclusion")->GetComponent(i, 0);
+    const double expected = std::min(1.0, 0.8 * ao * grey) * 255.0;
+    EXPECT_NEAR(rgba->GetComponent(i, 0), expected, 1.0) << i;
+    EXPECT_NEAR(rgba->GetComponent(i, 1), expected, 1.0) << i;
+    const double m = std::min(1.0, i * 1000.0 / 4000.0);
+    EXPECT_NEAR(rgba->GetComponent(i, 3), m * 255.0, 1.0) << i;
+  }
+  EXPECT_EQ(std::string(vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetScalars()->GetName()), "ShadedRGBA");
+}
+
+TEST(AmbientOcclusionShadingFilter, SurfacesGetColourTimesAmbientOcclusionTimesShadow)
+{
+  vtkNew<vtkPolyData> surface;
+  vtkNew<vtkPoints> points;
+  for (int i = 0; i < 4; ++i)
+    points->InsertNextPoint(i, 0, 0);
+  surface->SetPoints(points);
+  surface->GetPointData()->AddArray(Array("AmbientOcclusion", { 1, 0.5f, 0.2f, 0 }));
+  surface->GetPointData()->AddArray(Array("Shadow", { 1, 1, 0.5f, 1 }));
+  vtkNew<vtkAmbientOcclusionShading> shading;
+  shading->SetInputData(surface);
+  shading->Update();
+  vtkDataArray* rgb = vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGB");
+  ASSERT_NE(rgb, nullptr);
+  const double expected[] = { 255, 127.5, 25.5, 0 }; // white x AO x shadow
+  for (vtkIdType i = 0; i < 4; ++i)
+    EXPECT_NEAR(rgb->GetComponent(i, 2), expected[i], 1.0) << i;
+}
+
+TEST(AmbientOcclusionShadingFilter, RejectsBadInputWithAClearError)
+{
+  auto check = [](vtkDataSet* input, const std::function<void(vtkAmbientOcclusionShading*)>& configure,
+                 const std::string& words) {
+    vtkNew<vtkAmbientOcclusionShading> shading;
+    vtkNew<MessageCatcher> catcher;
+    catcher->Watch(shading);
+    shading->SetInputData(input);
+    configure(shading);
+    shading->Update();
+    ASSERT_FALSE(catcher->Errors.empty()) << words;
+    EXPECT_NE(catcher->Errors[0].find(words), std::string::npos) << catcher->Errors[0];
+    EXPECT_EQ(vtkDataSet::SafeDownCast(shading->GetOutput())->GetNumberOfPoints(), 0);
+  };
+  auto noAO = SmallVolume();
+  noAO->GetPointData()->RemoveArray("AmbientOcclusion");
+  check(noAO, [](vtkAmbientOcclusionShading*) {}, "AmbientOcclusion");
+  auto noVariance = SmallVolume();
+  noVariance->GetPointData()->RemoveArray("Variance");
+  check(noVariance, [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); }, "Variance");
+  check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetGamma(0); }, "Gamma");
+  check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetAmbientIntensity(-1); }, "AmbientIntensity");
+  check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetColorPreset(7); }, "ColorPreset");
+  check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetScalarsArrayName("Nope"); }, "Nope");
+}
+
+} // namespace
