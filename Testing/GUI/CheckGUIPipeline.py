@@ -1,0 +1,49 @@
+# Run inside the ParaView GUI's Python shell by AmbientOcclusionMenu.xml, after the
+# playback built the pipeline through the menus. It writes status.txt, whose last line is
+# VAO_GUI_OK only if every check passed (the shell swallows exceptions, so the CMake
+# driver RunGUITest.cmake reads the status file), and a screenshot of the render view.
+import os
+import traceback
+from paraview.simple import (ColorBy, GetActiveViewOrCreate, GetDisplayProperties,
+                             GetSources, Hide, SaveScreenshot, Show)
+
+out_dir = VAO_GUI_OUTPUT_DIR  # noqa: F821 (given by the exec() in the playback)
+lines = []
+try:
+    by_xml = {}
+    for (name, _), proxy in GetSources().items():
+        by_xml[proxy.GetXMLName()] = proxy
+        lines.append('source %s (%s)' % (name, proxy.GetXMLName()))
+    for xml_name in ('AmbientOcclusionHeadPhantom', 'VolumetricAmbientOcclusion',
+                     'OcclusionSweeping', 'VarianceOcclusionMap', 'AmbientOcclusionShading'):
+        if xml_name not in by_xml:
+            raise RuntimeError('the GUI did not create %s' % xml_name)
+    vao = by_xml['VolumetricAmbientOcclusion']
+    # The filter ran when Apply was pressed: its output carries the openness array.
+    info = vao.PointData['AmbientOcclusion']
+    lo, hi = info.GetRange()
+    lines.append('AmbientOcclusion range %g %g over %d points'
+                 % (lo, hi, vao.GetDataInformation().GetNumberOfPoints()))
+    if not (0.0 <= lo < hi <= 1.0):
+        raise RuntimeError('AmbientOcclusion range [%g, %g] is not inside [0, 1]' % (lo, hi))
+
+    view = GetActiveViewOrCreate('RenderView')
+    for proxy in GetSources().values():
+        Hide(proxy, view)
+    display = Show(vao, view)
+    display.SetRepresentationType('Slice')
+    ColorBy(display, ('POINTS', 'AmbientOcclusion'))
+    display.RescaleTransferFunctionToDataRange(True, False)
+    display.SetScalarBarVisibility(view, True)
+    view.ResetCamera()
+    png = os.path.join(out_dir, 'AmbientOcclusionGUI.png')
+    SaveScreenshot(png, view, ImageResolution=[800, 600])
+    if not os.path.isfile(png) or os.path.getsize(png) == 0:
+        raise RuntimeError('no screenshot written to %s' % png)
+    lines.append('screenshot %s' % png)
+    lines.append('VAO_GUI_OK')
+except Exception:
+    lines.append('VAO_GUI_FAILED')
+    lines.append(traceback.format_exc())
+with open(os.path.join(out_dir, 'status.txt'), 'w') as f:
+    f.write('\n'.join(lines) + '\n')
