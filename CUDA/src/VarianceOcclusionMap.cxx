@@ -715,18 +715,33 @@ void sampleLevel(const MomentLevel& level, const std::array<double, 3>& position
   variance = std::max(0.0, v);
 }
 
+namespace
+{
+
+/// The checks both surface queries share: the pyramid and the levels used, the
+/// parameters, the points and normals, and somewhere to write.
+Status checkQuery(const std::vector<MomentLevel>& pyramid, const SurfaceOcclusionParameters& parameters,
+  const double* points, const double* normals, std::int64_t count, const float* out, int& levels)
+{
+  Status status = checkPyramid(pyramid, parameters.levels, levels);
+  if (status.ok)
+    status = checkParameters(parameters);
+  if (status.ok)
+    status = checkPoints(points, normals, count);
+  if (status.ok && count > 0 && !out)
+    status = Status::failure("the output array must not be null");
+  return status;
+}
+
+} // namespace
+
 Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
   const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const double* points,
   const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
   const Execution& execution)
 {
   int levels = 0;
-  Status status = checkPyramid(pyramid, parameters.levels, levels);
-  if (!status.ok)
-  {
-    return status;
-  }
-  status = checkParameters(parameters);
+  Status status = checkQuery(pyramid, parameters, points, normals, count, out, levels);
   if (!status.ok)
   {
     return status;
@@ -745,15 +760,6 @@ Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const Vo
         return Status::failure("the volume's spacing must be finite and positive, its origin finite");
       }
     }
-  }
-  status = checkPoints(points, normals, count);
-  if (!status.ok)
-  {
-    return status;
-  }
-  if (count > 0 && !out)
-  {
-    return Status::failure("the output array must not be null");
   }
   const double h = std::min(spacing[0], std::min(spacing[1], spacing[2]));
   const int threads = detail::resolveThreadCount(execution.threads);
@@ -811,12 +817,7 @@ Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* poin
   float* out, const Execution& execution)
 {
   int levels = 0;
-  Status status = checkPyramid(pyramid, parameters.levels, levels);
-  if (!status.ok)
-  {
-    return status;
-  }
-  status = checkParameters(parameters);
+  const Status status = checkQuery(pyramid, parameters, points, normals, count, out, levels);
   if (!status.ok)
   {
     return status;
@@ -830,15 +831,6 @@ Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* poin
   if (!(lightLength > 0.0))
   {
     return Status::failure("the light direction must not be zero");
-  }
-  status = checkPoints(points, normals, count);
-  if (!status.ok)
-  {
-    return status;
-  }
-  if (count > 0 && !out)
-  {
-    return Status::failure("the output array must not be null");
   }
   const std::array<double, 3> light = { lightDirection[0] / lightLength,
     lightDirection[1] / lightLength, lightDirection[2] / lightLength };
