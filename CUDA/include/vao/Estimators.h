@@ -1,7 +1,7 @@
 // The openness estimators of ../shared/METHODS.md, written once for host and device.
 //
 // Every function here is a pure formula on the statistics of one neighbourhood, so the
-// CPU fallback and (later) the CUDA kernels include this header and call the same code.
+// CPU path and the CUDA kernels (src/cuda/Pipeline.h) include this header and call the same code.
 // Openness O = P(v <= q) over the neighbourhood: 1 = fully open, 0 = fully occluded.
 #pragma once
 
