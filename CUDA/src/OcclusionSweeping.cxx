@@ -439,13 +439,21 @@ struct VisibilityStore
   std::array<bool, 8> computed{};
   std::array<float*, 8> field{}; // when kept
   std::vector<float> storage;
-  std::vector<float> ring; // two planes, when not kept
-  float* sum = nullptr;    // sum of m_s V_s, when not kept
+  // When not kept, a ring of planes. Plane k of a sweep overwrites the slot of plane
+  // k - ringPlanes, which must be finished and no longer read (as the upwind plane of
+  // k - ringPlanes + 1). With T threads the planes in flight are at most the last T (thread
+  // t sweeps planes t, t + T, ... in order, and a plane waits for its upwind one), so T + 1
+  // slots are enough; two slots would let a third thread overwrite a row of plane k - 1
+  // while plane k - 1 still reads it as its upwind row.
+  std::vector<float> ring;
+  std::int64_t ringPlanes = 0;
+  float* sum = nullptr; // sum of m_s V_s, when not kept
   bool kept = false;
 
   float* plane(int s, std::int64_t z, const Grid& grid)
   {
-    return this->kept ? this->field[s] + z * grid.plane : this->ring.data() + (z & 1) * grid.plane;
+    return this->kept ? this->field[s] + z * grid.plane
+                      : this->ring.data() + (z % this->ringPlanes) * grid.plane;
   }
 };
 
@@ -464,7 +472,7 @@ public:
     , D(distance)
     , Fixed(fixed)
     , Vis(visibility)
-    , Threads(static_cast<int>(std::min<std::int64_t>(threads, grid.nz)))
+    , Threads(threads)
     , SkyD(grid.nx, kInfinity)
     , SkyV(grid.nx, 1.0f)
   {}
@@ -678,7 +686,8 @@ struct Combiner
 
 /// What the request needs: the octants whose V is computed, and whether V is kept per
 /// octant (OctantVisibility, or the geometry term that needs the final N).
-VisibilityStore planVisibility(const Grid& grid, const SweepParameters& p, const SweepOutput& out)
+VisibilityStore planVisibility(
+  const Grid& grid, const SweepParameters& p, const SweepOutput& out, int sweepThreads)
 {
   VisibilityStore vis;
   int computedCount = 0;
@@ -701,7 +710,8 @@ VisibilityStore planVisibility(const Grid& grid, const SweepParameters& p, const
   }
   else if (computedCount > 0)
   {
-    vis.ring.resize(static_cast<std::size_t>(2 * grid.plane));
+    vis.ringPlanes = std::min<std::int64_t>(grid.nz, sweepThreads + 1);
+    vis.ring.resize(static_cast<std::size_t>(vis.ringPlanes * grid.plane));
     vis.sum = out.ambientOcclusion;
   }
   return vis;
@@ -772,7 +782,8 @@ Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& 
     distance = ownDistance.data();
   }
   std::vector<std::uint8_t> fixed(static_cast<std::size_t>(grid.count));
-  VisibilityStore vis = planVisibility(grid, p, out);
+  const int sweepThreads = static_cast<int>(std::min<std::int64_t>(threads, grid.nz));
+  VisibilityStore vis = planVisibility(grid, p, out, sweepThreads);
   double maskCount = 0.0;
   for (bool m : p.octantMask)
     maskCount += m;
@@ -786,7 +797,7 @@ Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& 
   if (report.surfaceFound)
   {
     const SweepConstants constants(spacing, p.opacity);
-    Sweeper sweeper(grid, constants, distance, fixed.data(), vis, threads);
+    Sweeper sweeper(grid, constants, distance, fixed.data(), vis, sweepThreads);
     const Status status =
       runPasses(sweeper, grid, p, vis, detail::stageExecution(execution, 0.0, 0.95), report);
     if (!status.ok)

@@ -370,6 +370,28 @@ TEST(SweepDistance, ThreadCountDoesNotChangeAnyBit)
   }
 }
 
+TEST(SweepOcclusion, ThreadCountDoesNotChangeAnyBitWithoutKeptOctants)
+{
+  // Without the octant output (and without the geometry term) V lives in a ring of planes
+  // that the pipelined planes overwrite; with more threads than slots a plane would
+  // overwrite a row its upwind plane still reads. Flat planes (few rows, many planes) and
+  // more threads than cores make that overlap likely; the result must stay bit for bit.
+  const Sdf a = sphere(4.1, 3.2, 12.3, 3.1), b = sphere(3.7, 2.9, 31.6, 2.4),
+            c = box(4.2, 3.1, 48.2, 2.5, 9.0, 4.1);
+  const Scene scene = makeScene({ 9, 7, 61 }, { 1, 1, 1 }, [=](double x, double y, double z) {
+    return std::min({ a(x, y, z), b(x, y, z), c(x, y, z) });
+  });
+  vao::SweepParameters p = withIterations(2);
+  const Result one = sweep(scene.view(), scene.spacing, p, 1, false);
+  for (int repeat = 0; repeat < 20; ++repeat)
+    for (int threads : { 3, 5, 8, 16 })
+    {
+      const Result many = sweep(scene.view(), scene.spacing, p, threads, false);
+      ASSERT_EQ(one.distance, many.distance) << threads << " threads";
+      ASSERT_EQ(one.occlusion, many.occlusion) << threads << " threads, repeat " << repeat;
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // Visibility (Eq. 6)
 
