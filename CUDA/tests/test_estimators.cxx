@@ -62,6 +62,24 @@ TEST(Estimators, FlatNeighbourhoodGivesTheExactAnswerForEveryEstimator)
   EXPECT_EQ(vao::opennessGaussianCdf(1e6 - 0.5, almost, ErfMode::Exact), 0.0);
 }
 
+TEST(Estimators, FlatRuleIgnoresTheRoundingOfTheMean)
+{
+  // One voxel (radius 0) of a float volume: vmin = vmax = q exactly, but the streamed sums
+  // give a mean a few ulps away, on either side (seen on an H100: the GPU's and the CPU's
+  // means straddled q). The answer must be 1 whichever side it lands.
+  const double q = 0.7316485643386841; // a float32 value
+  for (double mean : { q * (1 + 4e-16), q * (1 - 4e-16) })
+  {
+    const NeighbourhoodStats one{ mean, 3e-17, q, q };
+    for (auto method : { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev })
+      for (auto erf : { ErfMode::Exact, ErfMode::Winitzki })
+      {
+        EXPECT_EQ(vao::opennessFromStats(method, q, one, erf), 1.0) << static_cast<int>(method);
+        EXPECT_EQ(vao::opennessFromStats(method, q * (1 - 1e-6), one, erf), 0.0);
+      }
+  }
+}
+
 TEST(Estimators, ChebyshevIsExactForTwoValuedNeighbourhoodAtItsUpperValue)
 {
   // Fraction p at the lower value a, 1 - p at the upper value b: Cantelli's bound on

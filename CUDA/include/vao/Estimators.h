@@ -59,10 +59,18 @@ VAO_HD bool isFlatVariance(double mean, double variance)
   return variance <= kFlatEpsilon * scale;
 }
 
-/// The exact answer on a flat neighbourhood, which every estimator returns there.
+/// How far from mu the values of a flat neighbourhood can lie, relative to max(1, |mu|):
+/// sqrt(kFlatEpsilon), since their variance is at most kFlatEpsilon * max(1, mu^2).
+constexpr double kFlatSpread = 1e-7;
+
+/// The exact answer on a flat neighbourhood, which every estimator returns there:
+/// O = (q >= mu). The computed mu carries the rounding of streamed sums (the CPU's and the
+/// GPU's differ by a few ulps), so a query equal to the common value may land a hair below
+/// it. A query within the flat spread of mu is one of the neighbourhood's values: q >= mu.
 VAO_HD double flatOpenness(double query, double mean)
 {
-  return query >= mean ? 1.0 : 0.0;
+  const double scale = mean > 1.0 ? mean : (mean < -1.0 ? -mean : 1.0);
+  return query >= mean - kFlatSpread * scale ? 1.0 : 0.0;
 }
 
 VAO_HD double clamp01(double x)
@@ -87,7 +95,7 @@ VAO_HD double opennessCdfReconstruction(double query, const NeighbourhoodStats& 
 {
   if (s.maximum <= s.minimum)
   {
-    return flatOpenness(query, s.mean);
+    return query >= s.minimum ? 1.0 : 0.0; // every value is vmin, which is exact
   }
   const double t = (query - s.minimum) / (s.maximum - s.minimum);
   if (t >= 1.0)
