@@ -29,6 +29,20 @@ double Ellipsoid(double x, double y, double z, double cx, double cy, double cz, 
   return u * u + v * v + w * w;
 }
 
+/// The mean density over the voxel's cell, from 3 x 3 x 3 samples: the partial volume
+/// effect of a real scanner. Point samples would give every boundary a staircase, which
+/// isosurfaces show as terraces and the AO of boundary voxels as moire rings.
+double PartialVolume(double x, double y, double z, const double spacing[3])
+{
+  double sum = 0.0;
+  for (int c = -1; c <= 1; ++c)
+    for (int b = -1; b <= 1; ++b)
+      for (int a = -1; a <= 1; ++a)
+        sum += vtkAmbientOcclusionPhantom::Density(
+          x + a * spacing[0] / 3.0, y + b * spacing[1] / 3.0, z + c * spacing[2] / 3.0);
+  return sum / 27.0;
+}
+
 /// Deterministic noise in [-1, 1] from a voxel index (splitmix64).
 double HashNoise(std::uint64_t index, std::uint64_t seed)
 {
@@ -201,8 +215,8 @@ int vtkAmbientOcclusionPhantom::RequestData(
       for (int i = ext[0]; i <= ext[1]; ++i)
       {
         // Patient axes: image y runs front to back, image z foot to head.
-        const double hu = Density(origin[0] + i * spacing[0], origin[1] + j * spacing[1],
-          origin[2] + k * spacing[2]);
+        const double hu = PartialVolume(origin[0] + i * spacing[0], origin[1] + j * spacing[1],
+          origin[2] + k * spacing[2], spacing);
         // Air stays clean, as in a CT whose air is clipped at the bottom of its range.
         const double noisy = hu <= -1000.0 ? hu : hu + this->NoiseAmplitude * SmoothNoise(i, j, k, this->Seed);
         *out++ = static_cast<short>(std::lround(std::max(-1024.0, std::min(3000.0, noisy))));
