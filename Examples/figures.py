@@ -197,8 +197,12 @@ def ruiz(source, array, tag, spacing):
 
     panels = []
     for i, modulate in enumerate([0, 1]):
-        shaded = AmbientOcclusionShading(Input=gaussian, ModulateOpacity=modulate, VarianceMax=300.0 ** 2,
-                                         **shading_args)
+        # Soft tissue made visible (the ramp starts at -600 HU) so that the modulation has
+        # something to fade: homogeneous regions (s2 << s2max) become transparent. In the
+        # R = 10 boxes of the CT head the standard deviation is ~320 HU (median) in soft
+        # tissue and ~470 HU at bone: s2max = 600^2 fades the first and keeps the second.
+        shaded = AmbientOcclusionShading(Input=gaussian, ModulateOpacity=modulate, VarianceMax=600.0 ** 2,
+                                         **dict(shading_args, OpacityRamp=[-600.0, 1500.0]))
         shaded.Scalars = array
         panels.append(render_rgba(shaded, "Gaussian CDF, opacity %s" % ("x variance" if modulate else "as is"),
                                   os.path.join(out_dir, "_panel%d.png" % i)))
@@ -215,7 +219,7 @@ def singh(source, array, tag, spacing):
         t0 = time.time()
         sweep = OcclusionSweeping(Input=source, IsoValue=SKIN_HU, UseGeometryTerm=1, OctantMask=mask)
         sweep.Scalars = ["POINTS", array]
-        skin = Contour(Input=sweep, ContourBy=["POINTS", array], Isosurfaces=[SKIN_HU], ComputeNormals=1,
+        skin = Contour(Input=source, ContourBy=["POINTS", array], Isosurfaces=[SKIN_HU], ComputeNormals=1,
                        ComputeScalars=0)
         # The normals point outwards (towards lower values): sample the field 1.5 voxels out
         # away from the inside voxels, which are dark by definition; then move back.

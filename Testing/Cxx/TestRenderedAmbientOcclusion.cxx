@@ -29,6 +29,8 @@
 #include "vtkPolyDataMapper.h"
 #include "vtkProp3D.h"
 #include "vtkSmartVolumeMapper.h"
+
+#include <algorithm>
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 #include "vtkProperty.h"
@@ -112,6 +114,12 @@ vtkSmartPointer<vtkImageData> RenderShadedVolume(vtkImageData* shaded)
   property->IndependentComponentsOff();
   property->SetScalarOpacity(alpha);
   property->ShadeOff(); // the AO is the only lighting
+  // Trilinear samples at a quarter of the smallest spacing: nearest-voxel samples at the
+  // default distance turn the thin skin into wood-grain rings that hide the AO.
+  property->SetInterpolationTypeToLinear();
+  const double* h = shaded->GetSpacing();
+  mapper->SetAutoAdjustSampleDistances(0);
+  mapper->SetSampleDistance(0.25 * std::min({ h[0], h[1], h[2] }));
   vtkNew<vtkVolume> volume;
   volume->SetMapper(mapper);
   volume->SetProperty(property);
