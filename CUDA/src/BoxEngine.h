@@ -390,26 +390,28 @@ struct VoxelNeighbourhood
   NeighbourhoodStats stats; // minimum/maximum only when asked for
 };
 
-/// The separable statistics of every region voxel, handed to visit(VoxelNeighbourhood)
-/// slice by slice on worker threads: the extrema passes first when withExtrema, then the
-/// streamed moments. Returns false when cancelled.
+/// forEachNeighbourhood on one band (band.region, a slab of rows of `whole`): voxel
+/// indices are those of the whole region.
 template <class T, class Visit>
-bool forEachNeighbourhood(const TypedVolume<T>& volume, const BoxGeometry& geometry,
+bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Region& whole,
   bool withExtrema, const Execution& execution, Visit&& visit)
 {
-  const Region& region = geometry.region;
+  const Region& region = band.region;
   BoxExtrema<T> extrema;
   const double split = withExtrema ? 0.5 : 0.0;
-  if (withExtrema && !computeBoxExtrema(volume, geometry, stageExecution(execution, 0.0, split), extrema))
+  if (withExtrema && !computeBoxExtrema(volume, band, stageExecution(execution, 0.0, split), extrema))
   {
     return false;
   }
-  const auto countX = geometry.windowCounts(0);
-  const auto countY = geometry.windowCounts(1);
+  const auto countX = band.windowCounts(0);
+  const auto countY = band.windowCounts(1);
   const std::int64_t nx = region.size[0], ny = region.size[1];
-  return streamMoments(volume, geometry, stageExecution(execution, split, 1.0),
+  const std::int64_t wholePlane = whole.size[0] * whole.size[1];
+  const std::int64_t firstRow = region.begin[1] - whole.begin[1];
+  return streamMoments(volume, band, stageExecution(execution, split, 1.0),
     [&](const MomentSlice<T>& slice) {
-      const std::int64_t base = (slice.z - region.begin[2]) * nx * ny;
+      const std::int64_t bandBase = (slice.z - region.begin[2]) * nx * ny;
+      const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
       VoxelNeighbourhood voxel{ 0, 0.0, 0, { 0.0, 0.0, 0.0, 0.0 } };
       for (std::int64_t j = 0; j < ny; ++j)
       {
@@ -424,13 +426,49 @@ bool forEachNeighbourhood(const TypedVolume<T>& volume, const BoxGeometry& geome
             voxel.stats.mean, voxel.stats.variance);
           if (withExtrema)
           {
-            voxel.stats.minimum = static_cast<double>(extrema.minimum(voxel.index));
-            voxel.stats.maximum = static_cast<double>(extrema.maximum(voxel.index));
+            voxel.stats.minimum = static_cast<double>(extrema.minimum(bandBase + p));
+            voxel.stats.maximum = static_cast<double>(extrema.maximum(bandBase + p));
           }
           visit(voxel);
         }
       }
     });
+}
+
+/// Rows of region per band when the extrema are needed: a band's extrema planes hold
+/// 2 x (slices read) x rows x width values, so bands of 1/16 of the volume's rows keep
+/// them at 1/8 of the input's size (issue 7's bar: working memory <= 25% of the input),
+/// at the price of re-reading R rows above and below each band in the x passes; bands
+/// of at least 2R + 1 rows keep that price under 2x.
+inline std::int64_t extremaBandRows(const BoxGeometry& geometry)
+{
+  return std::max<std::int64_t>({ 8, geometry.dims[1] / 16, 2 * std::int64_t(geometry.radius.y) + 1 });
+}
+
+/// The separable statistics of every region voxel, handed to visit(VoxelNeighbourhood)
+/// slice by slice on worker threads: the streamed moments, after the extrema passes when
+/// withExtrema. With the extrema the region goes band by band of rows (extremaBandRows),
+/// each band's extrema first, then its moments. Returns false when cancelled.
+template <class T, class Visit>
+bool forEachNeighbourhood(const TypedVolume<T>& volume, const BoxGeometry& geometry,
+  bool withExtrema, const Execution& execution, Visit&& visit)
+{
+  const Region& region = geometry.region;
+  const std::int64_t ny = region.size[1];
+  const std::int64_t bandRows = withExtrema ? std::min(ny, extremaBandRows(geometry)) : ny;
+  const std::int64_t bands = (ny + bandRows - 1) / bandRows;
+  for (std::int64_t b = 0; b < bands; ++b)
+  {
+    Region band = region;
+    band.begin[1] = region.begin[1] + b * bandRows;
+    band.size[1] = std::min(bandRows, ny - b * bandRows);
+    const Execution stage = stageExecution(execution, double(b) / bands, double(b + 1) / bands);
+    if (!visitBand(volume, BoxGeometry(geometry.dims, band, geometry.radius), region, withExtrema, stage, visit))
+    {
+      return false;
+    }
+  }
+  return true;
 }
 
 } // namespace detail
