@@ -57,8 +57,9 @@ std::array<double, 3> ExtentOrigin(vtkImageData* image);
 bool BuildPyramid(vtkAlgorithm* algorithm, const ScalarVolume& scalars, vtkImageData* input, int levels,
   bool startAtHalfResolution, std::vector<vao::MomentLevel>& pyramid, std::string& error);
 
-/// One pyramid level as image data with float arrays "Mean" and "Variance".
-vtkSmartPointer<vtkImageData> LevelAsImage(const vao::MomentLevel& level);
+/// One pyramid level as image data with float arrays "Mean" and "Variance", which take
+/// over the level's storage (the level's arrays are left empty).
+vtkSmartPointer<vtkImageData> LevelAsImage(vao::MomentLevel& level);
 
 } // namespace vtkAmbientOcclusionInput
 

@@ -291,12 +291,14 @@ TEST(PyramidSampling, TrilinearAndClamped)
   level.origin = { 1, 2, 3 };
   level.spacing = { 2, 1, 0.5 };
   level.kernelRadius = 4;
-  for (std::int64_t z = 0; z < 5; ++z)
+  level.mean.resize(60);
+  level.variance.resize(60);
+  for (std::int64_t z = 0, i = 0; z < 5; ++z)
     for (std::int64_t y = 0; y < 4; ++y)
-      for (std::int64_t x = 0; x < 3; ++x)
+      for (std::int64_t x = 0; x < 3; ++x, ++i)
       {
-        level.mean.push_back(static_cast<float>(x + 10 * y + 100 * z));
-        level.variance.push_back(static_cast<float>(2 * x));
+        level.mean[i] = static_cast<float>(x + 10 * y + 100 * z);
+        level.variance[i] = static_cast<float>(2 * x);
       }
   double mean = 0, variance = 0;
   vao::sampleLevel(level, { 2.0, 3.5, 3.75 }, mean, variance); // index (0.5, 1.5, 1.5)

@@ -25,53 +25,80 @@ namespace detail
 void* allocateLevelStorage(std::size_t bytes);
 void freeLevelStorage(void* block) noexcept;
 
-/// std::allocator without the value-initialisation of resize: the pyramid builder writes
-/// every element, in parallel, so a fresh array is first touched by the threads that fill
-/// it instead of by one serial zero-fill.
-template <class T>
-struct LevelAllocator
-{
-  using value_type = T;
-  LevelAllocator() = default;
-  template <class U>
-  LevelAllocator(const LevelAllocator<U>&) noexcept
-  {
-  }
-  T* allocate(std::size_t n)
-  {
-    void* block = allocateLevelStorage(n * sizeof(T));
-    if (!block)
-    {
-      throw std::bad_alloc();
-    }
-    return static_cast<T*>(block);
-  }
-  void deallocate(T* p, std::size_t) noexcept { freeLevelStorage(p); }
-  template <class U>
-  void construct(U* p) noexcept
-  {
-    ::new (static_cast<void*>(p)) U; // default-initialised: no zero-fill
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args)
-  {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-  template <class U>
-  bool operator==(const LevelAllocator<U>&) const noexcept
-  {
-    return true;
-  }
-  template <class U>
-  bool operator!=(const LevelAllocator<U>&) const noexcept
-  {
-    return false;
-  }
-};
 } // namespace detail
 
-/// A level's array: a std::vector<float> whose resize leaves new elements uninitialised.
-using LevelArray = std::vector<float, detail::LevelAllocator<float>>;
+/// A level's array of floats in level storage. resize leaves the elements uninitialised:
+/// the pyramid builder writes every one, in parallel, so a fresh array is first touched by
+/// the threads that fill it instead of by one serial zero-fill. release() hands the block
+/// to a new owner (a vtkFloatArray, without a copy), who frees it with freeLevelStorage.
+class LevelArray
+{
+public:
+  LevelArray() = default;
+  LevelArray(const LevelArray& other) { *this = other; }
+  LevelArray(LevelArray&& other) noexcept { this->swap(other); }
+  ~LevelArray() { detail::freeLevelStorage(this->Data); }
+  LevelArray& operator=(const LevelArray& other)
+  {
+    if (this != &other)
+    {
+      this->resize(other.Size);
+      for (std::size_t i = 0; i < other.Size; ++i)
+        this->Data[i] = other.Data[i];
+    }
+    return *this;
+  }
+  LevelArray& operator=(LevelArray&& other) noexcept
+  {
+    LevelArray moved(std::move(other));
+    this->swap(moved);
+    return *this;
+  }
+  void swap(LevelArray& other) noexcept
+  {
+    std::swap(this->Data, other.Data);
+    std::swap(this->Size, other.Size);
+  }
+  /// Keeps the block when the size is unchanged (a rebuild of the same pyramid).
+  void resize(std::size_t n)
+  {
+    if (n == this->Size)
+      return;
+    float* block = n > 0 ? static_cast<float*>(detail::allocateLevelStorage(n * sizeof(float))) : nullptr;
+    if (n > 0 && !block)
+      throw std::bad_alloc();
+    detail::freeLevelStorage(this->Data);
+    this->Data = block;
+    this->Size = n;
+  }
+  void assign(std::size_t n, float value)
+  {
+    this->resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      this->Data[i] = value;
+  }
+  float* release() noexcept
+  {
+    float* block = this->Data;
+    this->Data = nullptr;
+    this->Size = 0;
+    return block;
+  }
+  std::size_t size() const noexcept { return this->Size; }
+  bool empty() const noexcept { return this->Size == 0; }
+  float* data() noexcept { return this->Data; }
+  const float* data() const noexcept { return this->Data; }
+  float& operator[](std::size_t i) noexcept { return this->Data[i]; }
+  const float& operator[](std::size_t i) const noexcept { return this->Data[i]; }
+  float* begin() noexcept { return this->Data; }
+  float* end() noexcept { return this->Data + this->Size; }
+  const float* begin() const noexcept { return this->Data; }
+  const float* end() const noexcept { return this->Data + this->Size; }
+
+private:
+  float* Data = nullptr;
+  std::size_t Size = 0;
+};
 
 /// One level of the pyramid: blurred first moment (the mean) and variance, x fastest.
 struct MomentLevel
