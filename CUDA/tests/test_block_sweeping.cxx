@@ -395,8 +395,9 @@ TEST(BlockSweepingRounds, GeneratedSceneInZSlabs)
     std::cout << "[ rounds   ] " << n << "^3 scene, " << slabs << " z-slabs: " << d.rounds
               << " rounds (serial " << serial.report.passes << " passes); max |dD| " << dD
               << " (relative " << dDRelative << "), |dA| " << dA << ", |dV| " << dV << "\n";
-    // D up to n voxels: a few ulps of it.
-    EXPECT_LE(dDRelative, 1e-6);
+    // D up to ~0.7 n voxels: a few ulps of it, from other rounding paths to the same
+    // fixed point (measured relative 5e-7 at 64^3, 9.5e-7 at 256^3; V and A identical).
+    EXPECT_LE(dDRelative, 2e-6);
     EXPECT_LE(dA, 1e-5);
     EXPECT_LE(dV, 1e-5);
   }
