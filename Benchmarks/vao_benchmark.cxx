@@ -265,16 +265,7 @@ void BenchmarkSweeping(const Options& options, vtkImageData* ct)
   for (const auto& size : sizes)
   {
     const int nx = size[0], ny = size[1], nz = size[2];
-    std::vector<float> volume(static_cast<size_t>(nx) * ny * nz);
-    for (int z = 0; z < nz; ++z)
-      for (int y = 0; y < ny; ++y)
-        for (int x = 0; x < nx; ++x)
-        {
-          // The 100^3 scene stretched over the grid, a one-voxel occupancy ramp.
-          const double scale = (nx - 1) / 99.0;
-          const double d = vaotest::SceneDistance(x * 99.0 / (nx - 1), y * 99.0 / (ny - 1), z * 99.0 / (nz - 1));
-          volume[(static_cast<size_t>(z) * ny + y) * nx + x] = static_cast<float>(std::min(1.0, std::max(0.0, 0.5 - d * scale)));
-        }
+    const std::vector<float> volume = vaotest::SceneVolume(nx, ny, nz);
     const std::string raw = "/tmp/vao_sweep_" + std::to_string(nx) + "x" + std::to_string(ny) + "x" +
       std::to_string(nz) + "_float32.raw";
     std::ofstream(raw, std::ios::binary).write(reinterpret_cast<const char*>(volume.data()), volume.size() * sizeof(float));

@@ -12,6 +12,7 @@
 #include "vao/OcclusionSweeping.h"
 
 #include "Parallel.h"
+#include "SweepingCore.h"
 #include "VolumeAccess.h"
 
 #include <algorithm>
@@ -24,6 +25,10 @@
 #include <vector>
 
 namespace vao
+{
+namespace detail
+{
+namespace sweeping
 {
 namespace
 {
@@ -134,34 +139,12 @@ void allGeometryTerms(const std::array<double, 3>& n, bool twoSided, double g[8]
 // ---------------------------------------------------------------------------------------
 // Problem set-up
 
-struct Grid
-{
-  std::int64_t nx, ny, nz, plane, count;
-  std::array<double, 3> h;
-
-  Grid(const Index3& dims, const std::array<double, 3>& spacing)
-    : nx(dims[0])
-    , ny(dims[1])
-    , nz(dims[2])
-    , plane(dims[0] * dims[1])
-    , count(dims[0] * dims[1] * dims[2])
-    , h(spacing)
-  {}
-  std::int64_t index(std::int64_t x, std::int64_t y, std::int64_t z) const
-  {
-    return (z * ny + y) * nx + x;
-  }
-  double diagonal() const
-  {
-    const double ex = (nx - 1) * h[0], ey = (ny - 1) * h[1], ez = (nz - 1) * h[2];
-    return std::sqrt(ex * ex + ey * ey + ez * ez);
-  }
-};
-
 bool finitePositive(double value)
 {
   return std::isfinite(value) && value > 0.0;
 }
+
+} // namespace
 
 Status validateSweep(const VolumeView& volume, const std::array<double, 3>& spacing,
   const SweepParameters& p, const SweepOutput& output)
@@ -230,34 +213,40 @@ Status validateSweep(const VolumeView& volume, const std::array<double, 3>& spac
 // ---------------------------------------------------------------------------------------
 // Initialisation
 
+namespace
+{
+
 /// D of the grid points next to the iso surface: on every axis edge whose ends straddle
 /// the iso value, the linearly interpolated distance to the crossing (the minimum over the
 /// point's edges); these points are fixed. All others get +-infinity. The distance is
 /// computed from each point's own end of the edge, so that mirrored data give mirrored
 /// bits. Returns the number of fixed points.
 template <class T>
-std::int64_t initialiseDistance(const VolumeView& view, const Grid& grid, const SweepParameters& p,
-  float* distance, std::uint8_t* fixed, int threads)
+std::int64_t initialiseDistanceOf(const VolumeView& view, const Index3& scalarOffset,
+  const SweepLayout& layout, const SweepParameters& p, float* distance, std::uint8_t* fixed,
+  int threads)
 {
   const detail::TypedVolume<T> volume(view);
   const double c = p.isoValue;
   const bool above = p.insideIsAbove;
   auto inside = [c, above](double v) { return above ? v > c : v < c; };
-  const std::int64_t steps[3] = { 1, grid.nx, grid.plane };
+  const Index3& extent = view.dims;
+  const std::int64_t steps[3] = { 1, extent[0], extent[0] * extent[1] };
+  const std::array<double, 3>& h = layout.storage.h;
   std::atomic<std::int64_t> fixedCount{ 0 };
   detail::parallelChunks(
-    grid.nz, threads,
+    layout.size[2], threads,
     [&](std::int64_t z0, std::int64_t z1, bool) {
       std::int64_t local = 0;
       for (std::int64_t z = z0; z < z1; ++z)
-        for (std::int64_t y = 0; y < grid.ny; ++y)
-          for (std::int64_t x = 0; x < grid.nx; ++x)
+        for (std::int64_t y = 0; y < layout.size[1]; ++y)
+          for (std::int64_t x = 0; x < layout.size[0]; ++x)
           {
-            const std::int64_t i = grid.index(x, y, z);
+            const std::int64_t position[3] = { x + scalarOffset[0], y + scalarOffset[1],
+              z + scalarOffset[2] };
+            const std::int64_t i = volume.index(position[0], position[1], position[2]);
             const double v = static_cast<double>(volume.data[i * volume.stride]);
             const bool in = inside(v);
-            const std::int64_t position[3] = { x, y, z };
-            const std::int64_t extent[3] = { grid.nx, grid.ny, grid.nz };
             double nearest = std::numeric_limits<double>::infinity();
             for (int a = 0; a < 3; ++a)
               for (int side = -1; side <= 1; side += 2)
@@ -268,12 +257,13 @@ std::int64_t initialiseDistance(const VolumeView& view, const Grid& grid, const 
                 const double w =
                   static_cast<double>(volume.data[(i + side * steps[a]) * volume.stride]);
                 if (inside(w) != in)
-                  nearest = std::min(nearest, (c - v) / (w - v) * grid.h[a]);
+                  nearest = std::min(nearest, (c - v) / (w - v) * h[a]);
               }
             const bool isFixed = nearest < std::numeric_limits<double>::infinity();
             const float magnitude = isFixed ? static_cast<float>(nearest) : kInfinity;
-            distance[i] = in ? -magnitude : magnitude;
-            fixed[i] = isFixed ? 1 : 0;
+            const std::int64_t o = layout.index(x, y, z);
+            distance[o] = in ? -magnitude : magnitude;
+            fixed[o] = isFixed ? 1 : 0;
             local += isFixed;
           }
       fixedCount += local;
@@ -281,6 +271,21 @@ std::int64_t initialiseDistance(const VolumeView& view, const Grid& grid, const 
     threads);
   return fixedCount.load();
 }
+
+} // namespace
+
+std::int64_t initialiseDistance(const VolumeView& scalars, const Index3& scalarOffset,
+  const SweepLayout& layout, const SweepParameters& p, float* distance, std::uint8_t* fixed,
+  int threads)
+{
+  return detail::dispatchScalarType(scalars.type, [&](auto tag) {
+    return initialiseDistanceOf<decltype(tag)>(
+      scalars, scalarOffset, layout, p, distance, fixed, threads);
+  });
+}
+
+namespace
+{
 
 // ---------------------------------------------------------------------------------------
 // The sweeps
@@ -357,7 +362,8 @@ inline float godunov(float ax, float ay, float az, const SweepConstants& k)
 
 /// One row of a sweep. Pointers are at the row's first voxel in sweep order; the row
 /// advances by Step (+1 or -1). dy/dz and vy/vz are the upwind row and plane (a row of
-/// open sky, D = +inf and V = 1, outside the volume).
+/// open sky, D = +inf and V = 1, outside the volume); startD/startV, the x-upwind
+/// neighbour of the first voxel (the open sky, or a ghost voxel of a block).
 struct RowView
 {
   float* d;
@@ -367,6 +373,8 @@ struct RowView
   float* v;
   const float* vy;
   const float* vz;
+  float startD;
+  float startV;
 };
 
 struct RowResult
@@ -379,8 +387,8 @@ template <int Step, bool Visibility>
 RowResult sweepRow(const RowView& row, std::int64_t count, const SweepConstants& k)
 {
   RowResult result;
-  float previousD = kInfinity; // the x-upwind neighbour, open sky at the row start
-  float previousV = 1.0f;
+  float previousD = row.startD; // the x-upwind neighbour
+  float previousV = row.startV;
   for (std::int64_t i = 0; i < count; ++i)
   {
     const std::int64_t x = i * Step;
@@ -429,34 +437,6 @@ RowFunction rowFunction(int xDirection, bool visibility)
   return visibility ? &sweepRow<-1, true> : &sweepRow<-1, false>;
 }
 
-/// Where the octant visibilities live. Kept: one full field per computed octant (for
-/// OctantVisibility and the geometry term). Otherwise a sweep needs only its current and
-/// previous plane (two alternating planes suffice even with the pipeline, since plane
-/// k + 2 writes row j only after plane k + 1 has read row j of plane k), and the masked
-/// octants are summed into `sum` as the rows complete.
-struct VisibilityStore
-{
-  std::array<bool, 8> computed{};
-  std::array<float*, 8> field{}; // when kept
-  std::vector<float> storage;
-  // When not kept, a ring of planes. Plane k of a sweep overwrites the slot of plane
-  // k - ringPlanes, which must be finished and no longer read (as the upwind plane of
-  // k - ringPlanes + 1). With T threads the planes in flight are at most the last T (thread
-  // t sweeps planes t, t + T, ... in order, and a plane waits for its upwind one), so T + 1
-  // slots are enough; two slots would let a third thread overwrite a row of plane k - 1
-  // while plane k - 1 still reads it as its upwind row.
-  std::vector<float> ring;
-  std::int64_t ringPlanes = 0;
-  float* sum = nullptr; // sum of m_s V_s, when not kept
-  bool kept = false;
-
-  float* plane(int s, std::int64_t z, const Grid& grid)
-  {
-    return this->kept ? this->field[s] + z * grid.plane
-                      : this->ring.data() + (z % this->ringPlanes) * grid.plane;
-  }
-};
-
 struct alignas(64) RowCounter
 {
   std::atomic<std::int64_t> done{ 0 };
@@ -465,24 +445,26 @@ struct alignas(64) RowCounter
 class Sweeper
 {
 public:
-  Sweeper(const Grid& grid, const SweepConstants& constants, float* distance,
+  Sweeper(const SweepLayout& layout, const SweepConstants& constants, float* distance,
     const std::uint8_t* fixed, VisibilityStore& visibility, int threads)
-    : G(grid)
+    : L(layout)
+    , G(layout.storage)
     , K(constants)
     , D(distance)
     , Fixed(fixed)
     , Vis(visibility)
     , Threads(threads)
-    , SkyD(grid.nx, kInfinity)
-    , SkyV(grid.nx, 1.0f)
+    , SkyD(layout.size[0], kInfinity)
+    , SkyV(layout.size[0], 1.0f)
   {}
 
-  /// Sweep s over the whole volume. Returns false when cancelled.
+  /// Sweep s over the own voxels. Returns false when cancelled.
   bool sweep(int s, bool visibility, const Execution& execution, RowResult& total)
   {
-    SweepState state(s, visibility, execution, this->G.nz);
+    const std::int64_t planes = this->L.size[2];
+    SweepState state(s, visibility, execution, planes);
     detail::parallelChunks(
-      this->G.nz, static_cast<int>(this->G.nz),
+      planes, static_cast<int>(planes),
       [&](std::int64_t k0, std::int64_t k1, bool caller) {
         for (std::int64_t k = k0; k < k1 && !state.control.stopped(); ++k)
         {
@@ -528,23 +510,26 @@ private:
   bool sweepPlane(SweepState& state, std::int64_t k)
   {
     const Grid& g = this->G;
-    const std::int64_t z = state.dir[2] > 0 ? k : g.nz - 1 - k;
+    const Index3& n = this->L.size;
+    const std::int64_t z = this->L.offset[2] + (state.dir[2] > 0 ? k : n[2] - 1 - k);
+    const bool ghosted = this->L.ghosted;
     RowResult& result = state.planeResults[k];
-    for (std::int64_t j = 0; j < g.ny; ++j)
+    for (std::int64_t j = 0; j < n[1]; ++j)
     {
       if (k > 0 && !waitForRow(state.rowsDone[k - 1], j, state.control))
       {
         return false;
       }
-      const std::int64_t y = state.dir[1] > 0 ? j : g.ny - 1 - j;
-      const RowResult r = state.rowKernel(this->rowView(state, y, z, j > 0, k > 0), g.nx, this->K);
+      const std::int64_t y = this->L.offset[1] + (state.dir[1] > 0 ? j : n[1] - 1 - j);
+      const RowResult r = state.rowKernel(
+        this->rowView(state, y, z, ghosted || j > 0, ghosted || k > 0), n[0], this->K);
       result.largestChange = std::max(result.largestChange, r.largestChange);
       result.reachedNew = result.reachedNew || r.reachedNew;
       if (state.visibility && !this->Vis.kept)
       {
-        float* sum = this->Vis.sum + g.index(0, y, z);
-        const float* v = this->Vis.plane(state.s, z, g) + y * g.nx;
-        for (std::int64_t x = 0; x < g.nx; ++x)
+        float* sum = this->Vis.sum + g.index(this->L.offset[0], y, z);
+        const float* v = this->Vis.plane(state.s, z, g) + y * g.nx + this->L.offset[0];
+        for (std::int64_t x = 0; x < n[0]; ++x)
         {
           sum[x] += v[x];
         }
@@ -554,23 +539,29 @@ private:
     return true;
   }
 
-  /// Row (y, z) with its upwind row and plane, or the open sky where they are outside.
+  /// Row (y, z) (storage coordinates) with its upwind row and plane, or the open sky where
+  /// they are outside; the x-upwind neighbour of its first voxel likewise (from storage when
+  /// the layout is ghosted).
   RowView rowView(
     const SweepState& state, std::int64_t y, std::int64_t z, bool hasUpwindRow, bool hasUpwindPlane)
   {
     const Grid& g = this->G;
-    const std::int64_t x0 = state.dir[0] > 0 ? 0 : g.nx - 1;
+    const std::int64_t sky0 = state.dir[0] > 0 ? 0 : this->L.size[0] - 1; // in the sky rows
+    const std::int64_t x0 = this->L.offset[0] + sky0;
     const std::int64_t rowStep = state.dir[1] * g.nx, planeStep = state.dir[2] * g.plane;
     const std::int64_t i = g.index(x0, y, z);
-    RowView row{ this->D + i, hasUpwindRow ? this->D + i - rowStep : this->SkyD.data() + x0,
-      hasUpwindPlane ? this->D + i - planeStep : this->SkyD.data() + x0, this->Fixed + i, nullptr,
-      nullptr, nullptr };
+    const bool ghosted = this->L.ghosted;
+    RowView row{ this->D + i, hasUpwindRow ? this->D + i - rowStep : this->SkyD.data() + sky0,
+      hasUpwindPlane ? this->D + i - planeStep : this->SkyD.data() + sky0, this->Fixed + i, nullptr,
+      nullptr, nullptr, ghosted ? this->D[i - state.dir[0]] : kInfinity, 1.0f };
     if (state.visibility)
     {
-      row.v = this->Vis.plane(state.s, z, g) + y * g.nx + x0;
-      row.vy = hasUpwindRow ? row.v - rowStep : this->SkyV.data() + x0;
-      row.vz = hasUpwindPlane ? this->Vis.plane(state.s, z - state.dir[2], g) + y * g.nx + x0
-                              : this->SkyV.data() + x0;
+      const std::int64_t inPlane = y * g.nx + x0;
+      row.v = this->Vis.plane(state.s, z, g) + inPlane;
+      row.vy = hasUpwindRow ? row.v - rowStep : this->SkyV.data() + sky0;
+      row.vz = hasUpwindPlane ? this->Vis.plane(state.s, z - state.dir[2], g) + inPlane
+                              : this->SkyV.data() + sky0;
+      row.startV = ghosted ? row.v[-state.dir[0]] : 1.0f;
     }
     return row;
   }
@@ -589,6 +580,7 @@ private:
     return true;
   }
 
+  const SweepLayout& L;
   const Grid& G;
   const SweepConstants& K;
   float* D;
@@ -602,15 +594,17 @@ private:
 // ---------------------------------------------------------------------------------------
 // Combination into the outputs
 
-/// N at voxel (x, y, z): the normalised central-difference gradient of D (one-sided at the
-/// borders), pointing outward.
+/// N at own voxel (x, y, z): the normalised central-difference gradient of D (one-sided at
+/// the whole volume's borders; a block reads its ghost layer elsewhere), pointing outward.
 std::array<double, 3> distanceNormal(
-  const float* d, const Grid& g, std::int64_t x, std::int64_t y, std::int64_t z)
+  const float* d, const SweepLayout& layout, std::int64_t x, std::int64_t y, std::int64_t z)
 {
-  const std::int64_t position[3] = { x, y, z };
-  const std::int64_t extent[3] = { g.nx, g.ny, g.nz };
+  const Grid& g = layout.storage;
+  const std::int64_t position[3] = { layout.begin[0] + x, layout.begin[1] + y,
+    layout.begin[2] + z };
+  const Index3& extent = layout.whole;
   const std::int64_t step[3] = { 1, g.nx, g.plane };
-  const std::int64_t i = g.index(x, y, z);
+  const std::int64_t i = layout.index(x, y, z);
   double gradient[3];
   for (int a = 0; a < 3; ++a)
   {
@@ -624,14 +618,14 @@ std::array<double, 3> distanceNormal(
 
 struct Combiner
 {
-  const Grid& grid;
+  const SweepLayout& layout;
   const SweepParameters& p;
   const SweepOutput& out;
   const float* distance;
   const VisibilityStore& vis;
   double maskCount;
 
-  /// The unclamped A of voxel (x, y, z), index i.
+  /// The unclamped A of own voxel (x, y, z), storage index i.
   double occlusion(std::int64_t i, std::int64_t x, std::int64_t y, std::int64_t z) const
   {
     if (!this->p.useGeometryTerm)
@@ -648,7 +642,7 @@ struct Combiner
     }
     const bool twoSided = this->p.opacity < 1.0;
     double g[8];
-    allGeometryTerms(distanceNormal(this->distance, this->grid, x, y, z), twoSided, g);
+    allGeometryTerms(distanceNormal(this->distance, this->layout, x, y, z), twoSided, g);
     double sum = 0.0;
     for (int s = 0; s < 8; ++s)
       if (this->p.octantMask[s])
@@ -659,14 +653,16 @@ struct Combiner
   void plane(std::int64_t z) const
   {
     const double exponent = 1.0 / this->p.gamma;
-    for (std::int64_t y = 0; y < this->grid.ny; ++y)
-      for (std::int64_t x = 0; x < this->grid.nx; ++x)
+    const Index3& n = this->layout.size;
+    for (std::int64_t y = 0; y < n[1]; ++y)
+      for (std::int64_t x = 0; x < n[0]; ++x)
       {
-        const std::int64_t i = this->grid.index(x, y, z);
+        const std::int64_t i = this->layout.index(x, y, z);
+        const std::int64_t o = (z * n[1] + y) * n[0] + x;
         if (this->out.octantVisibility)
         {
           for (int s = 0; s < 8; ++s)
-            this->out.octantVisibility[8 * i + s] = this->vis.field[s][i];
+            this->out.octantVisibility[8 * o + s] = this->vis.field[s][i];
         }
         if (this->out.ambientOcclusion)
         {
@@ -675,14 +671,105 @@ struct Combiner
           {
             a = exponent == 0.5 ? std::sqrt(a) : std::pow(a, exponent); // the paper's gamma 2, fast
           }
-          this->out.ambientOcclusion[i] = static_cast<float>(a);
+          this->out.ambientOcclusion[o] = static_cast<float>(a);
         }
       }
   }
 };
 
+} // namespace
+
 // ---------------------------------------------------------------------------------------
-// Driver
+// Stages (SweepingCore.h)
+
+void fillWithoutSurface(
+  const SweepLayout& layout, bool allInside, float* distance, VisibilityStore& vis, double maskCount)
+{
+  const double diagonal = Grid(layout.whole, layout.storage.h).diagonal();
+  const float d = static_cast<float>(allInside ? -diagonal : diagonal);
+  const float v = allInside ? 0.0f : 1.0f;
+  const std::int64_t count = layout.storage.count;
+  std::fill(distance, distance + count, d);
+  if (vis.kept)
+  {
+    for (float* field : vis.field)
+      if (field)
+        std::fill(field, field + count, v);
+  }
+  else if (vis.sum)
+  {
+    std::fill(vis.sum, vis.sum + count, static_cast<float>(v * maskCount));
+  }
+}
+
+Status runPasses(const SweepLayout& layout, const SweepParameters& p, float* distance,
+  const std::uint8_t* fixed, VisibilityStore& vis, int threads, const Execution& execution,
+  SweepReport& report)
+{
+  const SweepConstants constants(layout.storage.h, p.opacity);
+  Sweeper sweeper(layout, constants, distance, fixed, vis, threads);
+  for (int pass = 0; pass < p.iterations; ++pass)
+  {
+    if (vis.sum)
+    {
+      // V is recomputed in every pass
+      std::fill(vis.sum, vis.sum + layout.storage.count, 0.0f);
+    }
+    RowResult total;
+    for (int s = 0; s < 8; ++s)
+    {
+      const double step = 1.0 / (8.0 * p.iterations);
+      const Execution stage =
+        detail::stageExecution(execution, (pass * 8 + s) * step, (pass * 8 + s + 1) * step);
+      if (!sweeper.sweep(s, vis.computed[s], stage, total))
+      {
+        return Status::cancelled();
+      }
+    }
+    report.passes = pass + 1;
+    report.lastChange = total.largestChange;
+    if (p.tolerance > 0.0 && !total.reachedNew && total.largestChange < p.tolerance)
+    {
+      break;
+    }
+  }
+  return Status::success();
+}
+
+Status combine(const SweepLayout& layout, const SweepParameters& p, const SweepOutput& out,
+  const float* distance, const VisibilityStore& vis, double maskCount, int threads,
+  const Execution& execution)
+{
+  if (!out.ambientOcclusion && !out.octantVisibility)
+  {
+    return Status::success();
+  }
+  const Combiner combiner{ layout, p, out, distance, vis, maskCount };
+  const std::int64_t planes = layout.size[2];
+  detail::LoopControl control(execution, planes);
+  detail::parallelChunks(
+    planes, threads,
+    [&](std::int64_t z0, std::int64_t z1, bool caller) {
+      for (std::int64_t z = z0; z < z1 && !control.stopped(); ++z)
+      {
+        combiner.plane(z);
+        control.advance(1, caller);
+      }
+    },
+    threads);
+  return control.stopped() ? Status::cancelled() : Status::success();
+}
+
+} // namespace sweeping
+} // namespace detail
+
+// ---------------------------------------------------------------------------------------
+// The whole volume
+
+namespace
+{
+
+using namespace detail::sweeping;
 
 /// What the request needs: the octants whose V is computed, and whether V is kept per
 /// octant (OctantVisibility, or the geometry term that needs the final N).
@@ -717,62 +804,11 @@ VisibilityStore planVisibility(
   return vis;
 }
 
-/// No edge crosses the iso value: D = +-(the volume's diagonal) with the sign of inside,
-/// and every octant open (all outside) or closed (all inside), whatever the opacity.
-void fillWithoutSurface(
-  const Grid& grid, bool allInside, float* distance, VisibilityStore& vis, double maskCount)
-{
-  const float d = static_cast<float>(allInside ? -grid.diagonal() : grid.diagonal());
-  const float v = allInside ? 0.0f : 1.0f;
-  std::fill(distance, distance + grid.count, d);
-  if (vis.kept)
-  {
-    for (float* field : vis.field)
-      if (field)
-        std::fill(field, field + grid.count, v);
-  }
-  else if (vis.sum)
-  {
-    std::fill(vis.sum, vis.sum + grid.count, static_cast<float>(v * maskCount));
-  }
-}
-
-/// Up to p.iterations passes of the 8 sweeps (Table 1 order). With a tolerance, stop after
-/// a pass that reached no new voxel and changed no finite |D| by as much as the tolerance.
-Status runPasses(Sweeper& sweeper, const Grid& grid, const SweepParameters& p, VisibilityStore& vis,
-  const Execution& execution, SweepReport& report)
-{
-  for (int pass = 0; pass < p.iterations; ++pass)
-  {
-    if (vis.sum)
-    {
-      std::fill(vis.sum, vis.sum + grid.count, 0.0f); // V is recomputed in every pass
-    }
-    RowResult total;
-    for (int s = 0; s < 8; ++s)
-    {
-      const double step = 1.0 / (8.0 * p.iterations);
-      const Execution stage =
-        detail::stageExecution(execution, (pass * 8 + s) * step, (pass * 8 + s + 1) * step);
-      if (!sweeper.sweep(s, vis.computed[s], stage, total))
-      {
-        return Status::cancelled();
-      }
-    }
-    report.passes = pass + 1;
-    report.lastChange = total.largestChange;
-    if (p.tolerance > 0.0 && !total.reachedNew && total.largestChange < p.tolerance)
-    {
-      break;
-    }
-  }
-  return Status::success();
-}
-
 Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& spacing,
   const SweepParameters& p, const SweepOutput& out, const Execution& execution, SweepReport& report)
 {
-  const Grid grid(volume.dims, spacing);
+  const SweepLayout layout = SweepLayout::wholeVolume(volume.dims, spacing);
+  const Grid& grid = layout.storage;
   const int threads = detail::resolveThreadCount(execution.threads);
   std::vector<float> ownDistance;
   float* distance = out.signedDistance;
@@ -788,18 +824,15 @@ Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& 
   for (bool m : p.octantMask)
     maskCount += m;
 
-  const std::int64_t fixedCount = detail::dispatchScalarType(volume.type, [&](auto tag) {
-    return initialiseDistance<decltype(tag)>(volume, grid, p, distance, fixed.data(), threads);
-  });
+  const std::int64_t fixedCount =
+    initialiseDistance(volume, { 0, 0, 0 }, layout, p, distance, fixed.data(), threads);
   report.surfaceFound = fixedCount > 0;
   report.passes = 0;
   report.lastChange = 0.0;
   if (report.surfaceFound)
   {
-    const SweepConstants constants(spacing, p.opacity);
-    Sweeper sweeper(grid, constants, distance, fixed.data(), vis, sweepThreads);
-    const Status status =
-      runPasses(sweeper, grid, p, vis, detail::stageExecution(execution, 0.0, 0.95), report);
+    const Status status = runPasses(layout, p, distance, fixed.data(), vis, sweepThreads,
+      detail::stageExecution(execution, 0.0, 0.95), report);
     if (!status.ok)
     {
       return status;
@@ -807,27 +840,13 @@ Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& 
   }
   else
   {
-    fillWithoutSurface(grid, distance[0] < 0.0f, distance, vis, maskCount);
+    fillWithoutSurface(layout, distance[0] < 0.0f, distance, vis, maskCount);
   }
-  if (out.ambientOcclusion || out.octantVisibility)
+  const Status status = combine(layout, p, out, distance, vis, maskCount, threads,
+    detail::stageExecution(execution, 0.95, 1.0));
+  if (!status.ok)
   {
-    const Combiner combiner{ grid, p, out, distance, vis, maskCount };
-    const Execution stage = detail::stageExecution(execution, 0.95, 1.0);
-    detail::LoopControl control(stage, grid.nz);
-    detail::parallelChunks(
-      grid.nz, threads,
-      [&](std::int64_t z0, std::int64_t z1, bool caller) {
-        for (std::int64_t z = z0; z < z1 && !control.stopped(); ++z)
-        {
-          combiner.plane(z);
-          control.advance(1, caller);
-        }
-      },
-      threads);
-    if (control.stopped())
-    {
-      return Status::cancelled();
-    }
+    return status;
   }
   if (execution.progress)
   {
@@ -850,7 +869,8 @@ double geometryTerm(int octant, const std::array<double, 3>& normal, bool twoSid
     return 0.0;
   }
   double g[8];
-  allGeometryTerms(unitNormal(normal[0], normal[1], normal[2]), twoSided, g);
+  detail::sweeping::allGeometryTerms(
+    detail::sweeping::unitNormal(normal[0], normal[1], normal[2]), twoSided, g);
   return g[octant];
 }
 

@@ -1,0 +1,129 @@
+// The stages of occlusion sweeping (OcclusionSweeping.cxx), shared by the whole-volume
+// driver computeOcclusionSweeping and the block driver BlockSweeper (BlockSweeping.cxx).
+//
+// A SweepLayout says where the swept voxels lie in the arrays (D, fixed, V) and in the whole
+// volume. The whole volume: the arrays are the volume, and upwind neighbours outside it are
+// the open sky (D = +inf, V = tau = 1). A block: the arrays hold the block's own voxels plus
+// a one-voxel ghost layer on every face, the sweeps update only the own voxels, and the
+// upwind neighbours outside them are read from the ghost layer (the neighbouring block's
+// values, or the open sky written there at the whole volume's border).
+#pragma once
+
+#include "vao/OcclusionSweeping.h"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace vao
+{
+namespace detail
+{
+namespace sweeping
+{
+
+struct Grid
+{
+  std::int64_t nx, ny, nz, plane, count;
+  std::array<double, 3> h;
+
+  Grid(const Index3& dims, const std::array<double, 3>& spacing)
+    : nx(dims[0])
+    , ny(dims[1])
+    , nz(dims[2])
+    , plane(dims[0] * dims[1])
+    , count(dims[0] * dims[1] * dims[2])
+    , h(spacing)
+  {}
+  std::int64_t index(std::int64_t x, std::int64_t y, std::int64_t z) const
+  {
+    return (z * ny + y) * nx + x;
+  }
+  double diagonal() const
+  {
+    const double ex = (nx - 1) * h[0], ey = (ny - 1) * h[1], ez = (nz - 1) * h[2];
+    return std::sqrt(ex * ex + ey * ey + ez * ez);
+  }
+};
+
+struct SweepLayout
+{
+  Grid storage;  // the arrays D, fixed and (kept) V
+  Index3 offset; // storage position of the first own voxel
+  Index3 size;   // own voxels per axis
+  Index3 begin;  // first own voxel in the whole volume
+  Index3 whole;  // the whole volume's dimensions
+  bool ghosted;  // upwind neighbours outside the own voxels come from storage, not the sky
+
+  /// The whole volume: storage = own voxels, no ghosts.
+  static SweepLayout wholeVolume(const Index3& dims, const std::array<double, 3>& spacing)
+  {
+    return { Grid(dims, spacing), { 0, 0, 0 }, dims, { 0, 0, 0 }, dims, false };
+  }
+  /// Storage index of own voxel (x, y, z) (own coordinates).
+  std::int64_t index(std::int64_t x, std::int64_t y, std::int64_t z) const
+  {
+    return this->storage.index(x + this->offset[0], y + this->offset[1], z + this->offset[2]);
+  }
+};
+
+/// Where the octant visibilities live. Kept: one full field per computed octant (for
+/// OctantVisibility and the geometry term). Otherwise a sweep needs only its current and
+/// previous plane, and the masked octants are summed into `sum` as the rows complete.
+struct VisibilityStore
+{
+  std::array<bool, 8> computed{};
+  std::array<float*, 8> field{}; // when kept, storage-sized
+  std::vector<float> storage;
+  // When not kept, a ring of planes. Plane k of a sweep overwrites the slot of plane
+  // k - ringPlanes, which must be finished and no longer read (as the upwind plane of
+  // k - ringPlanes + 1). With T threads the planes in flight are at most the last T (thread
+  // t sweeps planes t, t + T, ... in order, and a plane waits for its upwind one), so T + 1
+  // slots are enough; two slots would let a third thread overwrite a row of plane k - 1
+  // while plane k - 1 still reads it as its upwind row.
+  std::vector<float> ring;
+  std::int64_t ringPlanes = 0;
+  float* sum = nullptr; // sum of m_s V_s, when not kept (the whole volume only)
+  bool kept = false;
+
+  float* plane(int s, std::int64_t z, const Grid& grid)
+  {
+    return this->kept ? this->field[s] + z * grid.plane
+                      : this->ring.data() + (z % this->ringPlanes) * grid.plane;
+  }
+};
+
+/// Rejects bad volumes (under 2 voxels per axis, non-finite values) and parameters.
+Status validateSweep(const VolumeView& volume, const std::array<double, 3>& spacing,
+  const SweepParameters& p, const SweepOutput& output);
+
+/// Initial D (and the fixed flags) of the own voxels, from scalars whose voxel
+/// scalarOffset is own voxel (0, 0, 0): an edge to a scalar neighbour is considered
+/// wherever the scalars have one. Returns the number of fixed voxels.
+std::int64_t initialiseDistance(const VolumeView& scalars, const Index3& scalarOffset,
+  const SweepLayout& layout, const SweepParameters& p, float* distance, std::uint8_t* fixed,
+  int threads);
+
+/// Up to p.iterations passes of the 8 sweeps over the own voxels (Table 1 order); with a
+/// tolerance, stops after a pass that reached no new voxel and changed no finite |D| by as
+/// much as the tolerance. report: passes and lastChange.
+Status runPasses(const SweepLayout& layout, const SweepParameters& p, float* distance,
+  const std::uint8_t* fixed, VisibilityStore& vis, int threads, const Execution& execution,
+  SweepReport& report);
+
+/// No edge of the whole volume crosses the iso value: D = +-(the whole volume's diagonal)
+/// with the sign of inside, every octant open (all outside) or closed (all inside).
+void fillWithoutSurface(
+  const SweepLayout& layout, bool allInside, float* distance, VisibilityStore& vis, double maskCount);
+
+/// Writes the outputs of the own voxels (x fastest over layout.size): OctantVisibility and
+/// AmbientOcclusion (not D). N of the geometry term: central differences of D, one-sided
+/// only at the whole volume's border.
+Status combine(const SweepLayout& layout, const SweepParameters& p, const SweepOutput& out,
+  const float* distance, const VisibilityStore& vis, double maskCount, int threads,
+  const Execution& execution);
+
+} // namespace sweeping
+} // namespace detail
+} // namespace vao
