@@ -1,17 +1,20 @@
 #include "vtkAmbientOcclusionInput.h"
 
 #include "vtkAlgorithm.h"
+#include "vtkCommunicator.h"
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <algorithm>
 #include <sstream>
+#include <vector>
 
 namespace vtkAmbientOcclusionInput
 {
@@ -178,15 +181,162 @@ void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int ou
   output->GetFieldData()->ShallowCopy(input->GetFieldData());
 }
 
-void RequestWholeExtent(vtkInformation* info)
+void RequestExactExtent(vtkInformation* info, const int extent[6])
 {
-  int whole[6];
-  info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), whole, 6);
+  info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent, 6);
   info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
   info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
   info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
   info->Set(vtkStreamingDemandDrivenPipeline::EXACT_EXTENT(), 1);
+}
+
+void RequestWholeExtent(vtkInformation* info)
+{
+  int whole[6];
+  info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  RequestExactExtent(info, whole);
+}
+
+namespace
+{
+
+/// a and b overlap in `common` (false when they do not, or either is empty).
+bool IntersectExtents(const int* a, const int* b, int common[6])
+{
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    common[2 * axis] = std::max(a[2 * axis], b[2 * axis]);
+    common[2 * axis + 1] = std::min(a[2 * axis + 1], b[2 * axis + 1]);
+    if (common[2 * axis] > common[2 * axis + 1])
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+/// Copies the point arrays of `piece` (extent `pieceExt`, inside output's extent) into
+/// output's arrays of the same names, row by row.
+void PasteExtent(vtkImageData* piece, const int pieceExt[6], vtkImageData* output)
+{
+  const int* outExt = output->GetExtent();
+  const vtkIdType pnx = pieceExt[1] - pieceExt[0] + 1, pny = pieceExt[3] - pieceExt[2] + 1;
+  const vtkIdType onx = outExt[1] - outExt[0] + 1, ony = outExt[3] - outExt[2] + 1;
+  vtkPointData* to = output->GetPointData();
+  for (int a = 0; a < to->GetNumberOfArrays(); ++a)
+  {
+    vtkDataArray* target = to->GetArray(a);
+    vtkDataArray* source = target ? piece->GetPointData()->GetArray(target->GetName()) : nullptr;
+    if (!source || source->GetDataType() != target->GetDataType() ||
+      source->GetNumberOfComponents() != target->GetNumberOfComponents())
+    {
+      continue;
+    }
+    const vtkIdType tupleBytes = target->GetNumberOfComponents() * target->GetDataTypeSize();
+    const auto* from = static_cast<const char*>(source->GetVoidPointer(0));
+    auto* into = static_cast<char*>(target->GetVoidPointer(0));
+    for (int k = pieceExt[4]; k <= pieceExt[5]; ++k)
+      for (int j = pieceExt[2]; j <= pieceExt[3]; ++j)
+      {
+        const vtkIdType src = ((k - pieceExt[4]) * pny + (j - pieceExt[2])) * pnx;
+        const vtkIdType dst = ((k - outExt[4]) * ony + (j - outExt[2])) * onx + (pieceExt[0] - outExt[0]);
+        std::copy(from + src * tupleBytes, from + (src + pnx) * tupleBytes, into + dst * tupleBytes);
+      }
+  }
+}
+
+} // namespace
+
+void GlobalRange(vtkMultiProcessController* controller, double range[2])
+{
+  if (!controller || controller->GetNumberOfProcesses() < 2)
+  {
+    return;
+  }
+  const double local[2] = { range[0], range[1] };
+  controller->AllReduce(&local[0], &range[0], 1, vtkCommunicator::MIN_OP);
+  controller->AllReduce(&local[1], &range[1], 1, vtkCommunicator::MAX_OP);
+}
+
+void RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
+  const int wanted[6], vtkImageData* output)
+{
+  const int ranks = controller->GetNumberOfProcesses(), rank = controller->GetLocalProcessId();
+  std::vector<int> heldExtents(6 * ranks), wantedExtents(6 * ranks);
+  controller->AllGather(held->GetExtent(), heldExtents.data(), 6);
+  controller->AllGather(wanted, wantedExtents.data(), 6);
+
+  output->Initialize();
+  int common[6];
+  const bool wantsSomething = IntersectExtents(wanted, wanted, common);
+  if (wantsSomething)
+  {
+    const vtkIdType points = static_cast<vtkIdType>(wanted[1] - wanted[0] + 1) *
+      (wanted[3] - wanted[2] + 1) * (wanted[5] - wanted[4] + 1);
+    output->SetExtent(const_cast<int*>(wanted));
+    output->SetOrigin(held->GetOrigin());
+    output->SetSpacing(held->GetSpacing());
+    output->SetDirectionMatrix(held->GetDirectionMatrix());
+    vtkPointData* from = held->GetPointData();
+    for (int a = 0; a < from->GetNumberOfArrays(); ++a)
+    {
+      vtkDataArray* array = from->GetArray(a);
+      if (!array)
+        continue;
+      vtkSmartPointer<vtkDataArray> copy;
+      copy.TakeReference(array->NewInstance());
+      copy->SetName(array->GetName());
+      copy->SetNumberOfComponents(array->GetNumberOfComponents());
+      copy->SetNumberOfTuples(points);
+      output->GetPointData()->AddArray(copy);
+    }
+    if (from->GetScalars())
+      output->GetPointData()->SetActiveScalars(from->GetScalars()->GetName());
+    output->GetFieldData()->ShallowCopy(held->GetFieldData());
+    if (IntersectExtents(held->GetExtent(), wanted, common))
+    {
+      vtkNew<vtkImageData> own;
+      CopyRequestedExtent(held, own, common);
+      PasteExtent(own, common, output);
+    }
+  }
+  // Pairs in one global order, the lower rank sending first: no two wait on each other.
+  constexpr int kPieceTag = 7102;
+  for (int a = 0; a < ranks; ++a)
+    for (int b = a + 1; b < ranks; ++b)
+    {
+      if (rank != a && rank != b)
+        continue;
+      const int other = rank == a ? b : a;
+      auto send = [&] {
+        int part[6];
+        if (IntersectExtents(held->GetExtent(), &wantedExtents[6 * other], part))
+        {
+          vtkNew<vtkImageData> piece;
+          CopyRequestedExtent(held, piece, part);
+          controller->Send(piece.Get(), other, kPieceTag);
+        }
+      };
+      auto receive = [&] {
+        int part[6];
+        if (wantsSomething && IntersectExtents(&heldExtents[6 * other], wanted, part))
+        {
+          vtkNew<vtkImageData> piece;
+          controller->Receive(piece.Get(), other, kPieceTag);
+          PasteExtent(piece, part, output); // the extent is known: the transport may not keep it
+        }
+      };
+      if (rank == a)
+      {
+        send();
+        receive();
+      }
+      else
+      {
+        receive();
+        send();
+      }
+    }
 }
 
 vao::Execution ExecutionOf(vtkAlgorithm* algorithm)

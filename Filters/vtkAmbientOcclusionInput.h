@@ -16,6 +16,7 @@ class vtkAlgorithm;
 class vtkDataArray;
 class vtkImageData;
 class vtkInformation;
+class vtkMultiProcessController;
 
 namespace vtkAmbientOcclusionInput
 {
@@ -42,8 +43,23 @@ bool CheckWholeExtent(const int whole[6], std::string& error);
 /// Makes `output` the input restricted to `outExt` (a shallow copy when they are equal).
 void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int outExt[6]);
 
+/// Asks the input for exactly `extent`, as one piece without ghost levels.
+void RequestExactExtent(vtkInformation* inputInformation, const int extent[6]);
+
 /// Asks the input for its whole extent, as one piece (global algorithms).
 void RequestWholeExtent(vtkInformation* inputInformation);
+
+/// range = [min, max] over every process of the controller (unchanged with one process
+/// or none). Collective.
+void GlobalRange(vtkMultiProcessController* controller, double range[2]);
+
+/// Distributed data held as blocks to distributed data as requested: every process holds
+/// `held` (its block, any extent) and wants `wanted` (its requested extent, possibly
+/// empty); each receives the parts of the others' blocks that overlap what it wants.
+/// `output` gets the wanted extent with held's geometry and point arrays. Collective:
+/// every process of the controller must call it.
+void RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
+  const int wanted[6], vtkImageData* output);
 
 /// The kernel's execution hooks for an algorithm: its progress and abort flag.
 vao::Execution ExecutionOf(vtkAlgorithm* algorithm);

@@ -2,9 +2,14 @@
 
 #include "vtkAmbientOcclusionInput.h"
 
+#include "vao/BlockSweeping.h"
 #include "vao/OcclusionSweeping.h"
 
+#include "vtkCommunicator.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
+#include "vtkIntArray.h"
+#include "vtkMultiProcessController.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -15,15 +20,149 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <sstream>
+#include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkOcclusionSweeping);
+vtkCxxSetObjectMacro(vtkOcclusionSweeping, Controller, vtkMultiProcessController);
+
+namespace
+{
+
+/// The axis along which the processes split the volume into slabs: the longest (z on a
+/// tie, the usual slice axis).
+int SlabAxis(const int whole[6])
+{
+  int axis = 2;
+  for (int a = 1; a >= 0; --a)
+    if (whole[2 * a + 1] - whole[2 * a] > whole[2 * axis + 1] - whole[2 * axis])
+      axis = a;
+  return axis;
+}
+
+/// The slab of process `rank` of `ranks`: the whole extent with the slab axis cut evenly.
+void SlabExtent(const int whole[6], int rank, int ranks, int slab[6])
+{
+  std::copy(whole, whole + 6, slab);
+  const int axis = SlabAxis(whole);
+  const long long n = whole[2 * axis + 1] - whole[2 * axis] + 1;
+  slab[2 * axis] = whole[2 * axis] + static_cast<int>(n * rank / ranks);
+  slab[2 * axis + 1] = whole[2 * axis] + static_cast<int>(n * (rank + 1) / ranks) - 1;
+}
+
+/// The slab grown by the one ghost layer of scalars that the block sweeper reads across
+/// each face with a neighbour.
+void SlabInputExtent(const int whole[6], int rank, int ranks, int ext[6])
+{
+  SlabExtent(whole, rank, ranks, ext);
+  const int axis = SlabAxis(whole);
+  ext[2 * axis] = std::max(whole[2 * axis], ext[2 * axis] - 1);
+  ext[2 * axis + 1] = std::min(whole[2 * axis + 1], ext[2 * axis + 1] + 1);
+}
+
+/// Max over the processes (a flag or a change).
+double GlobalMax(vtkMultiProcessController* controller, double value)
+{
+  double result = value;
+  controller->AllReduce(&value, &result, 1, vtkCommunicator::MAX_OP);
+  return result;
+}
+
+/// Exchanges the face buffers with the slab neighbours (rank - 1 across the lower face,
+/// rank + 1 across the upper). Pairs go in rank order, the lower one sending first, so no
+/// two processes wait on each other. Returns the largest change of a ghost value here.
+double ExchangeFaces(vtkMultiProcessController* controller, vao::BlockSweeper& block, int axis)
+{
+  const int rank = controller->GetLocalProcessId();
+  constexpr int kFaceTag = 7101;
+  double change = 0.0;
+  for (int face : { 2 * axis, 2 * axis + 1 }) // the pair below first, then the pair above
+  {
+    const vtkIdType count = block.faceValueCount(face);
+    if (count == 0)
+    {
+      continue;
+    }
+    const int neighbour = (face & 1) ? rank + 1 : rank - 1;
+    std::vector<float> out(static_cast<std::size_t>(count)), in(static_cast<std::size_t>(count));
+    block.exportFace(face, out.data());
+    if (face & 1) // the lower of the pair
+    {
+      controller->Send(out.data(), count, neighbour, kFaceTag);
+      controller->Receive(in.data(), count, neighbour, kFaceTag);
+    }
+    else
+    {
+      controller->Receive(in.data(), count, neighbour, kFaceTag);
+      controller->Send(out.data(), count, neighbour, kFaceTag);
+    }
+    change = std::max(change, block.importFace(face, in.data()));
+  }
+  return change;
+}
+
+/// Adds the float arrays of the outputs to `image` (one tuple per point) and returns
+/// where the kernel writes them.
+vao::SweepOutput AddOutputArrays(vtkImageData* image, bool withOctants)
+{
+  auto add = [image](const char* name, int components) {
+    vtkNew<vtkFloatArray> array;
+    array->SetName(name);
+    array->SetNumberOfComponents(components);
+    array->SetNumberOfTuples(image->GetNumberOfPoints());
+    image->GetPointData()->AddArray(array);
+    return array->GetPointer(0);
+  };
+  vao::SweepOutput output;
+  output.signedDistance = add("SignedDistance", 1);
+  output.ambientOcclusion = add("AmbientOcclusion", 1);
+  output.octantVisibility = withOctants ? add("OctantVisibility", 8) : nullptr;
+  return output;
+}
+
+} // namespace
 
 //------------------------------------------------------------------------------
 vtkOcclusionSweeping::vtkOcclusionSweeping()
 {
   this->SetInputArrayToProcess(
     0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+  this->SetController(vtkMultiProcessController::GetGlobalController());
+}
+
+//------------------------------------------------------------------------------
+vtkOcclusionSweeping::~vtkOcclusionSweeping()
+{
+  this->SetController(nullptr);
+}
+
+//------------------------------------------------------------------------------
+vao::SweepParameters vtkOcclusionSweeping::Parameters() const
+{
+  vao::SweepParameters parameters;
+  parameters.isoValue = this->IsoValue;
+  parameters.insideIsAbove = this->InsideIsAbove != 0;
+  parameters.iterations = this->NumberOfIterations;
+  parameters.tolerance = this->ConvergenceTolerance;
+  for (int s = 0; s < 8; ++s)
+  {
+    parameters.octantMask[s] = this->OctantMask[s] != 0;
+  }
+  parameters.useGeometryTerm = this->UseGeometryTerm != 0;
+  parameters.gamma = this->Gamma;
+  parameters.opacity = this->Opacity;
+  return parameters;
+}
+
+//------------------------------------------------------------------------------
+bool vtkOcclusionSweeping::IsDistributed(const int whole[6]) const
+{
+  // Slabs of at least two voxels; a smaller volume is swept whole by every process.
+  const int ranks = this->Controller ? this->Controller->GetNumberOfProcesses() : 1;
+  const int axis = SlabAxis(whole);
+  return ranks > 1 && whole[2 * axis + 1] - whole[2 * axis] + 1 >= 2 * ranks;
 }
 
 //------------------------------------------------------------------------------
@@ -39,9 +178,22 @@ int vtkOcclusionSweeping::RequestInformation(
 int vtkOcclusionSweeping::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
 {
-  // Sweeping is global: an occluder anywhere shadows everything behind it, so every
-  // piece is computed from the whole volume.
-  vtkAmbientOcclusionInput::RequestWholeExtent(inputVector[0]->GetInformationObject(0));
+  // Sweeping is global: an occluder anywhere shadows everything behind it. One process
+  // sweeps the whole volume; several sweep a slab each (plus its ghost layer).
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  int whole[6];
+  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  if (this->IsDistributed(whole))
+  {
+    int ext[6];
+    SlabInputExtent(whole, this->Controller->GetLocalProcessId(),
+      this->Controller->GetNumberOfProcesses(), ext);
+    vtkAmbientOcclusionInput::RequestExactExtent(inInfo, ext);
+  }
+  else
+  {
+    vtkAmbientOcclusionInput::RequestWholeExtent(inInfo);
+  }
   return 1;
 }
 
@@ -67,6 +219,11 @@ int vtkOcclusionSweeping::RequestData(
     vtkErrorMacro(<< error);
     return 1;
   }
+  if (this->IsDistributed(whole))
+  {
+    return this->RequestDistributedData(input, output, whole, outExt, inputVector);
+  }
+  this->LastRounds = 0;
   const int* inExt = input->GetExtent();
   if (!std::equal(whole, whole + 6, inExt))
   {
@@ -81,40 +238,14 @@ int vtkOcclusionSweeping::RequestData(
     return 1;
   }
 
-  vao::SweepParameters parameters;
-  parameters.isoValue = this->IsoValue;
-  parameters.insideIsAbove = this->InsideIsAbove != 0;
-  parameters.iterations = this->NumberOfIterations;
-  parameters.tolerance = this->ConvergenceTolerance;
-  for (int s = 0; s < 8; ++s)
-  {
-    parameters.octantMask[s] = this->OctantMask[s] != 0;
-  }
-  parameters.useGeometryTerm = this->UseGeometryTerm != 0;
-  parameters.gamma = this->Gamma;
-  parameters.opacity = this->Opacity;
-
-  const vtkIdType points = input->GetNumberOfPoints();
-  auto newArray = [points](const char* name, int components) {
-    vtkNew<vtkFloatArray> array;
-    array->SetName(name);
-    array->SetNumberOfComponents(components);
-    array->SetNumberOfTuples(points);
-    return array;
-  };
-  auto distance = newArray("SignedDistance", 1);
-  auto occlusion = newArray("AmbientOcclusion", 1);
-  vtkSmartPointer<vtkFloatArray> octants;
-  if (this->OutputOctantVisibility)
-  {
-    octants = newArray("OctantVisibility", 8).Get();
-  }
+  // Computed on the whole volume; the output is the requested extent.
+  vtkNew<vtkImageData> whole3d;
+  whole3d->ShallowCopy(input);
+  const vao::SweepOutput arrays = AddOutputArrays(whole3d, this->OutputOctantVisibility != 0);
   const double* spacing = input->GetSpacing();
-  const vao::Execution execution = vtkAmbientOcclusionInput::ExecutionOf(this);
   vao::SweepReport report;
   const vao::Status status = vao::computeOcclusionSweeping(scalars.view, { spacing[0], spacing[1], spacing[2] },
-    parameters, { distance->GetPointer(0), occlusion->GetPointer(0), octants ? octants->GetPointer(0) : nullptr },
-    execution, &report);
+    this->Parameters(), arrays, vtkAmbientOcclusionInput::ExecutionOf(this), &report);
   if (!status.ok)
   {
     if (!status.aborted)
@@ -132,16 +263,118 @@ int vtkOcclusionSweeping::RequestData(
   this->LastPasses = report.passes;
   this->LastChange = report.lastChange;
 
-  // Computed on the whole volume; the output is the requested extent.
-  vtkNew<vtkImageData> whole3d;
-  whole3d->ShallowCopy(input);
-  whole3d->GetPointData()->AddArray(distance);
-  whole3d->GetPointData()->AddArray(occlusion);
-  if (octants)
-  {
-    whole3d->GetPointData()->AddArray(octants);
-  }
   vtkAmbientOcclusionInput::CopyRequestedExtent(whole3d, output, outExt);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkOcclusionSweeping::RequestDistributedData(vtkImageData* input, vtkImageData* output,
+  const int whole[6], const int outExt[6], vtkInformationVector** inputVector)
+{
+  vtkMultiProcessController* controller = this->Controller;
+  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
+  const int axis = SlabAxis(whole);
+  int slab[6], expected[6];
+  SlabExtent(whole, rank, ranks, slab);
+  SlabInputExtent(whole, rank, ranks, expected);
+
+  // Every process checks its slab, then all agree: one that stopped alone would leave
+  // the others waiting at the first exchange.
+  std::string error;
+  vtkAmbientOcclusionInput::ScalarVolume scalars;
+  const int* inExt = input->GetExtent();
+  if (!std::equal(expected, expected + 6, inExt))
+  {
+    std::ostringstream why;
+    why << "Occlusion sweeping under MPI needs its slab and one ghost layer (" << expected[0] << ".."
+        << expected[1] << ", " << expected[2] << ".." << expected[3] << ", " << expected[4] << ".."
+        << expected[5] << "); the upstream source delivered (" << inExt[0] << ".." << inExt[1] << ", "
+        << inExt[2] << ".." << inExt[3] << ", " << inExt[4] << ".." << inExt[5] << ").";
+    error = why.str();
+  }
+  else
+  {
+    vtkAmbientOcclusionInput::PrepareScalars(
+      this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error);
+  }
+  vao::SweepParameters parameters = this->Parameters();
+  const double* spacing = input->GetSpacing();
+  // The rounds stop when no ghost value moves by the tolerance; so does each round's
+  // sweeping of its slab (one pass per round would need as many rounds as passes).
+  const double smallest = std::min({ spacing[0], spacing[1], spacing[2] });
+  parameters.tolerance = this->ConvergenceTolerance > 0.0 ? this->ConvergenceTolerance : 1e-3 * smallest;
+  const int passesPerRound = std::max(this->NumberOfIterations, 64);
+  vao::BlockPlacement placement;
+  for (int a = 0; a < 3; ++a)
+  {
+    placement.whole[a] = whole[2 * a + 1] - whole[2 * a] + 1;
+    placement.begin[a] = slab[2 * a] - whole[2 * a];
+    placement.size[a] = slab[2 * a + 1] - slab[2 * a] + 1;
+  }
+  std::unique_ptr<vao::BlockSweeper> block;
+  if (error.empty())
+  {
+    block.reset(new vao::BlockSweeper(scalars.view, placement, { spacing[0], spacing[1], spacing[2] },
+      parameters, vtkAmbientOcclusionInput::ExecutionOf(this)));
+    const vao::Status status = block->initialise();
+    if (!status.ok)
+    {
+      error = "Occlusion sweeping failed: " + status.message + ".";
+    }
+  }
+  if (GlobalMax(controller, error.empty() ? 0.0 : 1.0) > 0.0)
+  {
+    vtkErrorMacro(<< (error.empty() ? std::string("Occlusion sweeping stopped: another process "
+                                                  "failed (see its message).")
+                                    : error));
+    return 1;
+  }
+
+  // Rounds: sweep the slab with the ghosts as they are, exchange the faces, until the
+  // ghosts settle everywhere (or the process aborts, everywhere).
+  int rounds = 0;
+  if (GlobalMax(controller, block->surfaceFound() ? 1.0 : 0.0) == 0.0)
+  {
+    block->fillWithoutSurface();
+    vtkWarningMacro(<< "IsoValue " << this->IsoValue << " does not cross array '" << scalars.name
+                    << "': there is no surface; every voxel is entirely inside or outside.");
+  }
+  else
+  {
+    const int maxRounds = 4 * ranks + 32;
+    double change = 0.0;
+    do
+    {
+      vao::SweepReport report;
+      const vao::Status status = block->runRound(passesPerRound, &report);
+      const double stop = GlobalMax(controller, status.ok ? 0.0 : 1.0);
+      if (stop > 0.0)
+      {
+        return 1; // aborted (an abort is not an error)
+      }
+      change = GlobalMax(controller, ExchangeFaces(controller, *block, axis));
+      this->LastPasses = report.passes;
+      this->LastChange = change;
+      this->UpdateProgress(std::min(0.9, 0.9 * (rounds + 1) / (ranks + 2.0)));
+    } while (++rounds < maxRounds && change > parameters.tolerance);
+    if (change > parameters.tolerance)
+    {
+      vtkWarningMacro(<< "Occlusion sweeping: the slabs still changed by " << change << " after "
+                      << rounds << " rounds of exchanges.");
+    }
+  }
+  this->LastRounds = rounds;
+
+  // The slab's results with the input's arrays, then to whatever extent was requested.
+  vtkNew<vtkImageData> held;
+  vtkAmbientOcclusionInput::CopyRequestedExtent(input, held, slab);
+  block->finish(AddOutputArrays(held, this->OutputOctantVisibility != 0));
+  vtkNew<vtkIntArray> roundsArray;
+  roundsArray->SetName("SweepingExchangeRounds");
+  roundsArray->InsertNextValue(rounds);
+  held->GetFieldData()->AddArray(roundsArray);
+  vtkAmbientOcclusionInput::RedistributeExtents(controller, held, outExt, output);
+  this->UpdateProgress(1.0);
   return 1;
 }
 

@@ -17,14 +17,21 @@
  *
  * OctantMask selects the sky: all eight octants (skylight), the upper four (4..7, an
  * overcast sky), or one (a low-frequency shadow from that octant). Opacity < 1 makes the
- * occluders translucent. The filter needs the whole volume on every process (sweeping is
- * global), so a distributed run reproduces the serial result.
+ * occluders translucent. Sweeping is global: in one process the filter reads the whole
+ * volume; under MPI each process sweeps a slab and the slabs exchange their faces until
+ * they agree (see SetController).
  */
 #ifndef vtkOcclusionSweeping_h
 #define vtkOcclusionSweeping_h
 
 #include "VolumetricAOFiltersModule.h" // for export macro
 #include "vtkImageAlgorithm.h"
+
+class vtkMultiProcessController;
+namespace vao
+{
+struct SweepParameters;
+}
 
 class VOLUMETRICAOFILTERS_EXPORT vtkOcclusionSweeping : public vtkImageAlgorithm
 {
@@ -98,9 +105,27 @@ public:
   int GetLastNumberOfPasses() const { return this->LastPasses; }
   double GetLastChange() const { return this->LastChange; }
 
+  ///@{
+  /// The processes of a distributed run (default: the global controller). With more
+  /// than one process each one sweeps a slab of the volume along its longest axis (its
+  /// input: that slab and one ghost layer, never the whole volume); signed distance and
+  /// octant visibility cross the slab faces in rounds of exchanges until no ghost value
+  /// changes by more than the tolerance (ConvergenceTolerance, or 1e-3 of the smallest
+  /// spacing when it is 0); then every process receives the requested extent from the
+  /// slabs that hold it. The result is the converged sweeping, equal to a serial run
+  /// that converges (NumberOfIterations large, ConvergenceTolerance > 0). Every process
+  /// must execute the filter. nullptr: each process sweeps the whole volume.
+  virtual void SetController(vtkMultiProcessController*);
+  vtkGetObjectMacro(Controller, vtkMultiProcessController);
+  ///@}
+
+  /// Rounds of face exchanges of the last distributed execution (0 when serial); also in
+  /// the output's field data as "SweepingExchangeRounds".
+  int GetLastNumberOfExchangeRounds() const { return this->LastRounds; }
+
 protected:
   vtkOcclusionSweeping();
-  ~vtkOcclusionSweeping() override = default;
+  ~vtkOcclusionSweeping() override;
 
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
@@ -118,8 +143,16 @@ protected:
   int Component = -1;
   int LastPasses = 0;
   double LastChange = 0.0;
+  int LastRounds = 0;
+  vtkMultiProcessController* Controller = nullptr;
 
 private:
+  vao::SweepParameters Parameters() const;
+  bool IsDistributed(const int whole[6]) const;
+  /// The distributed execution (Controller with several processes).
+  int RequestDistributedData(vtkImageData* input, vtkImageData* output, const int whole[6],
+    const int outExt[6], vtkInformationVector** inputVector);
+
   vtkOcclusionSweeping(const vtkOcclusionSweeping&) = delete;
   void operator=(const vtkOcclusionSweeping&) = delete;
 };
