@@ -1,5 +1,7 @@
 #include "vtkAmbientOcclusionShading.h"
 
+#include "vtkAmbientOcclusionInput.h"
+
 #include "vao/Shading.h"
 
 #include "vtkColorTransferFunction.h"
@@ -9,6 +11,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkNew.h"
+#include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkPointData.h"
@@ -16,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 vtkStandardNewMacro(vtkAmbientOcclusionShading);
@@ -57,8 +61,26 @@ vtkSmartPointer<vtkPiecewiseFunction> RampOpacity(const double ramp[2])
 } // namespace
 
 //------------------------------------------------------------------------------
-vtkAmbientOcclusionShading::vtkAmbientOcclusionShading() = default;
+vtkAmbientOcclusionShading::vtkAmbientOcclusionShading()
+  : Controller(vtkMultiProcessController::GetGlobalController())
+{
+}
+
 vtkAmbientOcclusionShading::~vtkAmbientOcclusionShading() = default;
+
+vtkMultiProcessController* vtkAmbientOcclusionShading::GetController() const
+{
+  return this->Controller;
+}
+
+void vtkAmbientOcclusionShading::SetController(vtkMultiProcessController* controller)
+{
+  if (this->Controller != controller)
+  {
+    this->Controller = controller;
+    this->Modified();
+  }
+}
 
 void vtkAmbientOcclusionShading::SetColorTransferFunction(vtkScalarsToColors* colors)
 {
@@ -113,17 +135,24 @@ int vtkAmbientOcclusionShading::RequestData(
   else if (volume && this->ModulateOpacity && !pd->GetArray("Variance"))
     why << "ModulateOpacity needs the point array 'Variance' (Volumetric Ambient Occlusion with Compute "
            "Variance on).";
+  // The automatic range is the data's range over every process (each holds a piece):
+  // reduced before any error return, since every process must take part.
+  double range[2] = { this->ScalarRange[0], this->ScalarRange[1] };
+  if (range[0] > range[1])
+  {
+    range[0] = std::numeric_limits<double>::infinity();
+    range[1] = -range[0];
+    if (scalars && scalars->GetNumberOfTuples() > 0)
+    {
+      scalars->GetRange(range, 0);
+    }
+    vtkAmbientOcclusionInput::GlobalRange(this->Controller, range);
+  }
   if (!why.str().empty())
   {
     vtkErrorMacro(<< why.str());
     output->Initialize();
     return 1;
-  }
-
-  double range[2] = { this->ScalarRange[0], this->ScalarRange[1] };
-  if (scalars && range[0] > range[1])
-  {
-    scalars->GetRange(range, 0);
   }
   vtkSmartPointer<vtkScalarsToColors> colors = this->Colors ? this->Colors : PresetColors(this->ColorPreset, range);
   const vtkIdType n = input->GetNumberOfPoints();

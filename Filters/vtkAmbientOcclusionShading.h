@@ -27,6 +27,7 @@
 
 #include <string>
 
+class vtkMultiProcessController;
 class vtkPiecewiseFunction;
 class vtkScalarsToColors;
 
@@ -89,6 +90,14 @@ public:
   void SetOpacityTransferFunction(vtkPiecewiseFunction* opacity);
   ///@}
 
+  ///@{
+  /// The processes of a distributed run (default: the global controller): the automatic
+  /// ScalarRange is the range over all of them, so every piece is coloured alike. Every
+  /// process must execute the filter; nullptr: each piece's own range.
+  void SetController(vtkMultiProcessController* controller);
+  vtkMultiProcessController* GetController() const;
+  ///@}
+
 protected:
   vtkAmbientOcclusionShading();
   ~vtkAmbientOcclusionShading() override;
@@ -107,6 +116,7 @@ protected:
   double OpacityRamp[2] = { 1.0, 0.0 };
   vtkSmartPointer<vtkScalarsToColors> Colors;
   vtkSmartPointer<vtkPiecewiseFunction> Opacity;
+  vtkSmartPointer<vtkMultiProcessController> Controller;
 
 private:
   vtkAmbientOcclusionShading(const vtkAmbientOcclusionShading&) = delete;
