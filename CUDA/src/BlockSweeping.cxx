@@ -82,7 +82,7 @@ struct BlockSweeper::State
   bool initialised = false;
   bool surfaceFound = false;
   std::vector<float> distance; // storage-sized, ghosts included
-  std::vector<std::uint8_t> fixed;
+  FixedMask fixed;
   VisibilityStore vis; // all eight octants, kept
 
   State(const VolumeView& v, const BlockPlacement& b, const std::array<double, 3>& h,
@@ -152,7 +152,6 @@ Status BlockSweeper::initialise()
   {
     const std::int64_t count = s.layout.storage.count;
     s.distance.assign(static_cast<std::size_t>(count), kInfinity); // ghosts: the open sky
-    s.fixed.assign(static_cast<std::size_t>(count), 0);
     s.vis = VisibilityStore();
     s.vis.kept = true;
     s.vis.storage.assign(static_cast<std::size_t>(8 * count), 1.0f);
@@ -170,8 +169,9 @@ Status BlockSweeper::initialise()
   const BlockPlacement& b = s.placement;
   const Index3 scalarOffset = { b.begin[0] > 0 ? 1 : 0, b.begin[1] > 0 ? 1 : 0,
     b.begin[2] > 0 ? 1 : 0 };
-  s.surfaceFound = initialiseDistance(s.scalars, scalarOffset, s.layout, s.parameters,
-                     s.distance.data(), s.fixed.data(), s.threads) > 0;
+  s.surfaceFound =
+    initialiseDistance(s.scalars, scalarOffset, s.layout, s.parameters, s.distance.data(), s.threads) > 0;
+  s.fixed.build(s.distance.data(), s.layout.storage.count, s.threads);
   s.initialised = true;
   return Status::success();
 }
@@ -211,7 +211,7 @@ Status BlockSweeper::runRound(int maxPasses, SweepReport* report)
   r.surfaceFound = s.surfaceFound;
   const int sweepThreads = static_cast<int>(std::min<std::int64_t>(s.threads, s.layout.size[2]));
   return runPasses(
-    s.layout, p, s.distance.data(), s.fixed.data(), s.vis, sweepThreads, s.execution, r);
+    s.layout, p, s.distance.data(), s.fixed, s.vis, sweepThreads, s.execution, r);
 }
 
 std::int64_t BlockSweeper::faceValueCount(int face) const

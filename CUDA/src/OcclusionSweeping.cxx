@@ -223,8 +223,7 @@ namespace
 /// bits. Returns the number of fixed points.
 template <class T>
 std::int64_t initialiseDistanceOf(const VolumeView& view, const Index3& scalarOffset,
-  const SweepLayout& layout, const SweepParameters& p, float* distance, std::uint8_t* fixed,
-  int threads)
+  const SweepLayout& layout, const SweepParameters& p, float* distance, int threads)
 {
   const detail::TypedVolume<T> volume(view);
   const double c = p.isoValue;
@@ -263,7 +262,6 @@ std::int64_t initialiseDistanceOf(const VolumeView& view, const Index3& scalarOf
             const float magnitude = isFixed ? static_cast<float>(nearest) : kInfinity;
             const std::int64_t o = layout.index(x, y, z);
             distance[o] = in ? -magnitude : magnitude;
-            fixed[o] = isFixed ? 1 : 0;
             local += isFixed;
           }
       fixedCount += local;
@@ -275,13 +273,31 @@ std::int64_t initialiseDistanceOf(const VolumeView& view, const Index3& scalarOf
 } // namespace
 
 std::int64_t initialiseDistance(const VolumeView& scalars, const Index3& scalarOffset,
-  const SweepLayout& layout, const SweepParameters& p, float* distance, std::uint8_t* fixed,
-  int threads)
+  const SweepLayout& layout, const SweepParameters& p, float* distance, int threads)
 {
   return detail::dispatchScalarType(scalars.type, [&](auto tag) {
-    return initialiseDistanceOf<decltype(tag)>(
-      scalars, scalarOffset, layout, p, distance, fixed, threads);
+    return initialiseDistanceOf<decltype(tag)>(scalars, scalarOffset, layout, p, distance, threads);
   });
+}
+
+void FixedMask::build(const float* distance, std::int64_t count, int threads)
+{
+  const std::int64_t words = (count + 63) / 64;
+  this->Words.assign(static_cast<std::size_t>(words), 0);
+  std::uint64_t* out = this->Words.data();
+  detail::parallelChunks(
+    words, threads,
+    [&](std::int64_t w0, std::int64_t w1, bool) {
+      for (std::int64_t w = w0; w < w1; ++w)
+      {
+        std::uint64_t bits = 0;
+        const std::int64_t end = std::min<std::int64_t>(64, count - 64 * w);
+        for (std::int64_t b = 0; b < end; ++b)
+          bits |= std::uint64_t(std::abs(distance[64 * w + b]) < kInfinity) << b;
+        out[w] = bits;
+      }
+    },
+    threads);
 }
 
 namespace
@@ -369,7 +385,8 @@ struct RowView
   float* d;
   const float* dy;
   const float* dz;
-  const std::uint8_t* fixed;
+  const std::uint64_t* fixedWords; // FixedMask, bit fixedIndex + x for voxel x of the row
+  std::int64_t fixedIndex;
   float* v;
   const float* vy;
   const float* vz;
@@ -404,7 +421,9 @@ RowResult sweepRow(const RowView& row, std::int64_t count, const SweepConstants&
     float d = row.d[x];
     const float ax = std::abs(previousD), ay = std::abs(dy), az = std::abs(dz);
     const float old = std::abs(d);
-    if (!row.fixed[x] && old > std::min({ ax, ay, az }) + k.lowerBound)
+    const std::int64_t f = row.fixedIndex + x;
+    const bool fixed = (row.fixedWords[f >> 6] >> (f & 63)) & 1u;
+    if (!fixed && old > std::min({ ax, ay, az }) + k.lowerBound)
     {
       const float candidate = godunov(ax, ay, az, k);
       if (candidate < old)
@@ -446,12 +465,12 @@ class Sweeper
 {
 public:
   Sweeper(const SweepLayout& layout, const SweepConstants& constants, float* distance,
-    const std::uint8_t* fixed, VisibilityStore& visibility, int threads)
+    const FixedMask& fixed, VisibilityStore& visibility, int threads)
     : L(layout)
     , G(layout.storage)
     , K(constants)
     , D(distance)
-    , Fixed(fixed)
+    , Fixed(fixed.words())
     , Vis(visibility)
     , Threads(threads)
     , SkyD(layout.size[0], kInfinity)
@@ -552,7 +571,7 @@ private:
     const std::int64_t i = g.index(x0, y, z);
     const bool ghosted = this->L.ghosted;
     RowView row{ this->D + i, hasUpwindRow ? this->D + i - rowStep : this->SkyD.data() + sky0,
-      hasUpwindPlane ? this->D + i - planeStep : this->SkyD.data() + sky0, this->Fixed + i, nullptr,
+      hasUpwindPlane ? this->D + i - planeStep : this->SkyD.data() + sky0, this->Fixed, i, nullptr,
       nullptr, nullptr, ghosted ? this->D[i - state.dir[0]] : kInfinity, 1.0f };
     if (state.visibility)
     {
@@ -584,7 +603,7 @@ private:
   const Grid& G;
   const SweepConstants& K;
   float* D;
-  const std::uint8_t* Fixed;
+  const std::uint64_t* Fixed;
   VisibilityStore& Vis;
   int Threads;
   std::vector<float> SkyD;
@@ -703,7 +722,7 @@ void fillWithoutSurface(
 }
 
 Status runPasses(const SweepLayout& layout, const SweepParameters& p, float* distance,
-  const std::uint8_t* fixed, VisibilityStore& vis, int threads, const Execution& execution,
+  const FixedMask& fixed, VisibilityStore& vis, int threads, const Execution& execution,
   SweepReport& report)
 {
   const SweepConstants constants(layout.storage.h, p.opacity);
@@ -817,21 +836,21 @@ Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& 
     ownDistance.resize(static_cast<std::size_t>(grid.count));
     distance = ownDistance.data();
   }
-  std::vector<std::uint8_t> fixed(static_cast<std::size_t>(grid.count));
   const int sweepThreads = static_cast<int>(std::min<std::int64_t>(threads, grid.nz));
   VisibilityStore vis = planVisibility(grid, p, out, sweepThreads);
   double maskCount = 0.0;
   for (bool m : p.octantMask)
     maskCount += m;
 
-  const std::int64_t fixedCount =
-    initialiseDistance(volume, { 0, 0, 0 }, layout, p, distance, fixed.data(), threads);
+  const std::int64_t fixedCount = initialiseDistance(volume, { 0, 0, 0 }, layout, p, distance, threads);
+  FixedMask fixed;
+  fixed.build(distance, grid.count, threads);
   report.surfaceFound = fixedCount > 0;
   report.passes = 0;
   report.lastChange = 0.0;
   if (report.surfaceFound)
   {
-    const Status status = runPasses(layout, p, distance, fixed.data(), vis, sweepThreads,
+    const Status status = runPasses(layout, p, distance, fixed, vis, sweepThreads,
       detail::stageExecution(execution, 0.0, 0.95), report);
     if (!status.ok)
     {

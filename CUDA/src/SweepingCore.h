@@ -98,18 +98,32 @@ struct VisibilityStore
 Status validateSweep(const VolumeView& volume, const std::array<double, 3>& spacing,
   const SweepParameters& p, const SweepOutput& output);
 
-/// Initial D (and the fixed flags) of the own voxels, from scalars whose voxel
-/// scalarOffset is own voxel (0, 0, 0): an edge to a scalar neighbour is considered
-/// wherever the scalars have one. Returns the number of fixed voxels.
+/// Initial D of the own voxels, from scalars whose voxel scalarOffset is own voxel
+/// (0, 0, 0): an edge to a scalar neighbour is considered wherever the scalars have one.
+/// The voxels next to the surface get a finite D and are fixed; all others +-infinity.
+/// Returns the number of fixed voxels.
 std::int64_t initialiseDistance(const VolumeView& scalars, const Index3& scalarOffset,
-  const SweepLayout& layout, const SweepParameters& p, float* distance, std::uint8_t* fixed,
-  int threads);
+  const SweepLayout& layout, const SweepParameters& p, float* distance, int threads);
+
+/// One bit per storage voxel: the fixed voxels, whose D the sweeps never change. Bits,
+/// not bytes: 1/16 of an int16 volume instead of 1/2 (the working-memory bar of issue 7).
+/// Built from D right after initialiseDistance, where they are exactly the finite values
+/// (the others, ghosts included, are +-infinity).
+class FixedMask
+{
+public:
+  void build(const float* distance, std::int64_t count, int threads);
+  const std::uint64_t* words() const { return this->Words.data(); }
+
+private:
+  std::vector<std::uint64_t> Words;
+};
 
 /// Up to p.iterations passes of the 8 sweeps over the own voxels (Table 1 order); with a
 /// tolerance, stops after a pass that reached no new voxel and changed no finite |D| by as
 /// much as the tolerance. report: passes and lastChange.
 Status runPasses(const SweepLayout& layout, const SweepParameters& p, float* distance,
-  const std::uint8_t* fixed, VisibilityStore& vis, int threads, const Execution& execution,
+  const FixedMask& fixed, VisibilityStore& vis, int threads, const Execution& execution,
   SweepReport& report);
 
 /// No edge of the whole volume crosses the iso value: D = +-(the whole volume's diagonal)
