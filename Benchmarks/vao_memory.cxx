@@ -9,6 +9,7 @@
 // so one method's freed memory does not hide the next one's peak. The child reads the
 // volume, resets the kernel's high-water mark (/proc/self/clear_refs, "5"), runs the filter
 // and reads VmHWM from /proc/self/status.
+#include "ProcessMemory.h"
 #include "vtkAmbientOcclusionShading.h"
 #include "vtkOcclusionSweeping.h"
 #include "vtkVarianceOcclusionMap.h"
@@ -38,29 +39,8 @@
 namespace
 {
 
-/// A field of /proc/self/status in bytes (VmRSS, VmHWM).
-long long StatusBytes(const char* field)
-{
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-  {
-    if (line.rfind(field, 0) == 0)
-    {
-      return std::atoll(line.c_str() + std::strlen(field) + 1) * 1024LL;
-    }
-  }
-  return -1;
-}
-
-/// Resets VmHWM to the current RSS (Linux >= 4.0). False when the kernel refuses.
-bool ResetPeak()
-{
-  std::ofstream clear("/proc/self/clear_refs");
-  clear << "5";
-  clear.close();
-  return !clear.fail();
-}
+using vao_bench::ResetPeak;
+using vao_bench::StatusBytes;
 
 /// Bytes of the arrays of `data` (an image, or the images of a multiblock) that are not
 /// among `known` (the input's arrays, shared by reference).
