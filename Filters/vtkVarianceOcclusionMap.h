@@ -7,7 +7,9 @@
  * kernel doubles). The output is a multiblock of vtkImageData levels, each with its own
  * origin and spacing and the float32 point arrays "Mean" and "Variance". Use it to look
  * at the maps, or to sample them with the Probe filter; Isosurface Ambient Occlusion
- * builds the same pyramid internally and keeps it between updates.
+ * builds the same pyramid internally and keeps it between updates. Distributed or
+ * streamed, a piece reads its extent grown by the pyramid's reach (2^levels input voxels;
+ * 2^(levels+1) - 2 from half resolution) and outputs the level voxels of its piece.
  */
 #ifndef vtkVarianceOcclusionMap_h
 #define vtkVarianceOcclusionMap_h
@@ -55,6 +57,10 @@ protected:
   int Component = -1;
 
 private:
+  /// The input extent a piece needs: the piece grown by the pyramid's reach, its lower
+  /// end aligned on the coarsest level's voxels.
+  void InputExtentOf(const int whole[6], const int piece[6], int ext[6]) const;
+
   vtkVarianceOcclusionMap(const vtkVarianceOcclusionMap&) = delete;
   void operator=(const vtkVarianceOcclusionMap&) = delete;
 };

@@ -2,6 +2,7 @@
 // multiblock, the cache, shadows, bad input, and Monte-Carlo AO on the CT head's bone.
 #include "TestHelpers.h"
 
+#include "vtkAmbientOcclusionPhantom.h"
 #include "vtkIsosurfaceAmbientOcclusion.h"
 #include "vtkVarianceOcclusionMap.h"
 
@@ -85,6 +86,72 @@ TEST(VarianceOcclusionMapFilter, OutputsOneImagePerLevelWithItsGeometry)
     ASSERT_NE(vtkFloatArray::SafeDownCast(level->GetPointData()->GetArray("Variance")), nullptr);
     expected = (expected + 1) / 2;
   }
+}
+
+/// Value of `name` at global index (i, j, k) of a level image with any extent.
+double LevelValue(vtkImageData* level, const char* name, int i, int j, int k)
+{
+  int ijk[3] = { i, j, k };
+  const vtkIdType id = level->ComputePointId(ijk);
+  return level->GetPointData()->GetArray(name)->GetTuple1(id);
+}
+
+TEST(VarianceOcclusionMapFilter, PiecesReadLessAndEqualTheWholePyramid)
+{
+  // Streamed (or distributed) pieces: each reads its extent grown by the pyramid's reach,
+  // never the whole volume, and its level voxels equal the whole pyramid's.
+  for (bool half : { false, true })
+    for (int pieces : { 2, 3, 5 })
+    {
+      SCOPED_TRACE(std::string(half ? "half resolution, " : "") + std::to_string(pieces) + " pieces");
+      vtkNew<vtkAmbientOcclusionPhantom> phantom;
+      phantom->SetDimensions(45, 39, 161);
+      vtkNew<vtkVarianceOcclusionMap> whole;
+      whole->SetInputConnection(phantom->GetOutputPort());
+      whole->SetStartAtHalfResolution(half);
+      whole->Update();
+      vtkNew<vtkMultiBlockDataSet> reference;
+      reference->DeepCopy(whole->GetOutput());
+
+      vtkNew<vtkVarianceOcclusionMap> map;
+      map->SetInputConnection(phantom->GetOutputPort());
+      map->SetStartAtHalfResolution(half);
+      std::vector<std::vector<int>> covered(4);
+      for (int p = 0; p < pieces; ++p)
+      {
+        map->UpdatePiece(p, pieces, 0);
+        const int* read = vtkImageData::SafeDownCast(map->GetInputDataObject(0, 0))->GetExtent();
+        EXPECT_LT((read[5] - read[4] + 1) * (read[3] - read[2] + 1), 39 * 161) << "piece " << p << " read it all";
+        for (unsigned l = 0; l < 4; ++l)
+        {
+          auto* level = vtkImageData::SafeDownCast(map->GetOutput()->GetBlock(l));
+          auto* full = vtkImageData::SafeDownCast(reference->GetBlock(l));
+          ASSERT_NE(level, nullptr);
+          covered[l].resize(full->GetNumberOfPoints());
+          if (level->GetNumberOfPoints() == 0)
+            continue;
+          EXPECT_DOUBLE_EQ(level->GetSpacing()[2], full->GetSpacing()[2]);
+          EXPECT_DOUBLE_EQ(level->GetOrigin()[2], full->GetOrigin()[2]);
+          const int* e = level->GetExtent();
+          for (int k = e[4]; k <= e[5]; ++k)
+            for (int j = e[2]; j <= e[3]; ++j)
+              for (int i = e[0]; i <= e[1]; ++i)
+              {
+                for (const char* name : { "Mean", "Variance" })
+                {
+                  const double want = LevelValue(full, name, i, j, k);
+                  ASSERT_NEAR(LevelValue(level, name, i, j, k), want, 1e-6 * std::max(1.0, std::abs(want)))
+                    << name << " of level " << l << " at " << i << "," << j << "," << k << ", piece " << p;
+                }
+                int ijk[3] = { i, j, k };
+                covered[l][full->ComputePointId(ijk)] = 1;
+              }
+        }
+      }
+      for (unsigned l = 0; l < 4; ++l)
+        EXPECT_EQ(std::count(covered[l].begin(), covered[l].end(), 1), static_cast<long>(covered[l].size()))
+          << "level " << l << ": every voxel in some piece";
+    }
 }
 
 struct ShadeRun
