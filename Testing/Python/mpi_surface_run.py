@@ -18,25 +18,38 @@ shaded = IsosurfaceAmbientOcclusion(Input=bone, Volume=whole, ComputeShadows=1, 
 shaded.Scalars = "MetaImage"
 SaveData(target, proxy=shaded, DataMode="Binary")
 
-# The pyramid (Variance Occlusion Map), fetched to the client: per level its size and
-# the sums of Mean and Variance, for the test to compare with the serial run.
-import json  # noqa: E402
-
-from paraview import servermanager  # noqa: E402
-from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
-
-pyramid = VarianceOcclusionMap(Input=whole)
-fetched = servermanager.Fetch(pyramid)  # under MPI: one block per rank, each a pyramid
-iterator = fetched.NewIterator()
-iterator.InitTraversal()
-summary = []
-while not iterator.IsDoneWithTraversal():
-    level = iterator.GetCurrentDataObject()
-    iterator.GoToNextItem()
-    if level.GetNumberOfPoints() == 0:
-        continue  # the empty blocks of ranks > 0
-    summary.append({"dims": list(level.GetDimensions()), "spacing": list(level.GetSpacing()),
-                    "mean": float(vtk_to_numpy(level.GetPointData().GetArray("Mean")).astype("float64").sum()),
-                    "variance": float(vtk_to_numpy(level.GetPointData().GetArray("Variance")).astype("float64").sum())})
-with open(target + ".pyramid.json", "w") as f:
-    json.dump(summary, f)
+# The pyramid (Variance Occlusion Map), distributed: each rank computes the level voxels
+# of its piece from its piece grown by the pyramid's reach. A pass-through writes, per
+# rank, every level's extent and arrays (<OUT>.pyramid.<rank>.npz) and the extent the
+# map received (<OUT>.pyramid.<rank>.read).
+read = ProgrammableFilter(Input=XMLImageDataReader(FileName=[source]))
+read.Script = """
+from vtkmodules.vtkParallelCore import vtkMultiProcessController
+controller = vtkMultiProcessController.GetGlobalController()
+rank = controller.GetLocalProcessId() if controller else 0
+data = self.GetInputDataObject(0, 0)
+self.GetOutputDataObject(0).ShallowCopy(data)
+with open(TARGET + ".pyramid.%d.read" % rank, "w") as log:
+    log.write(" ".join(str(e) for e in data.GetExtent()))
+""".replace("TARGET", repr(target))
+dump = ProgrammableFilter(Input=VarianceOcclusionMap(Input=read))
+dump.Script = """
+import numpy as np
+from vtkmodules.vtkParallelCore import vtkMultiProcessController
+from vtkmodules.util.numpy_support import vtk_to_numpy
+controller = vtkMultiProcessController.GetGlobalController()
+rank = controller.GetLocalProcessId() if controller else 0
+blocks = self.GetInputDataObject(0, 0)
+self.GetOutputDataObject(0).ShallowCopy(blocks)
+arrays = {}
+for l in range(blocks.GetNumberOfBlocks()):
+    level = blocks.GetBlock(l)
+    if level is None or level.GetNumberOfPoints() == 0:
+        continue
+    arrays["extent%d" % l] = np.array(level.GetExtent())
+    arrays["spacing%d" % l] = np.array(level.GetSpacing())
+    for name in ("Mean", "Variance"):
+        arrays["%s%d" % (name, l)] = vtk_to_numpy(level.GetPointData().GetArray(name))
+np.savez(TARGET + ".pyramid.%d.npz" % rank, **arrays)
+""".replace("TARGET", repr(target))
+dump.UpdatePipeline()
