@@ -3,6 +3,7 @@
 #include "vtkAlgorithm.h"
 #include "vtkCommunicator.h"
 #include "vtkDataArray.h"
+#include "vtkExtentTranslator.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -179,6 +180,55 @@ void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int ou
   output->GetPointData()->CopyAllocate(input->GetPointData(), points);
   output->GetPointData()->CopyStructuredData(input->GetPointData(), inExt, outExt);
   output->GetFieldData()->ShallowCopy(input->GetFieldData());
+}
+
+int PyramidReach(int levels, bool half)
+{
+  // Level 0 blurs the input (2 taps each side); level l >= 1 blurs level l - 1, whose
+  // spacing is 2^(l - 1) input voxels (2^l from half resolution), 2 taps each side.
+  int reach = 2;
+  for (int l = 1; l < levels; ++l)
+  {
+    reach += 2 << (l - 1 + (half ? 1 : 0));
+  }
+  return reach;
+}
+
+int PyramidAlignment(int levels, bool half)
+{
+  return 1 << (std::max(levels, 1) - 1 + (half ? 1 : 0));
+}
+
+void PieceOfWhole(int piece, int pieces, const int whole[6], int ext[6])
+{
+  vtkNew<vtkExtentTranslator> translator;
+  if (!translator->PieceToExtentThreadSafe(
+        piece, std::max(pieces, 1), 0, const_cast<int*>(whole), ext, vtkExtentTranslator::BLOCK_MODE, 0))
+  {
+    ext[0] = ext[2] = ext[4] = 0; // more pieces than voxels: an empty piece
+    ext[1] = ext[3] = ext[5] = -1;
+  }
+}
+
+void RequestedPiece(vtkInformation* outInfo, const int whole[6], int ext[6])
+{
+  int index = 0, count = 1;
+  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()))
+  {
+    index = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
+    count = std::max(1, outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()));
+  }
+  PieceOfWhole(index, count, whole, ext);
+}
+
+void GrowForPyramid(const int whole[6], const int piece[6], const int reach[3], int alignment, int ext[6])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    const int lo = std::max(whole[2 * a], piece[2 * a] - reach[a]);
+    ext[2 * a] = whole[2 * a] + (lo - whole[2 * a]) / alignment * alignment;
+    ext[2 * a + 1] = std::min(whole[2 * a + 1], piece[2 * a + 1] + reach[a]);
+  }
 }
 
 void RequestExactExtent(vtkInformation* info, const int extent[6])
@@ -391,6 +441,32 @@ vtkSmartPointer<vtkImageData> LevelAsImage(vao::MomentLevel& level)
   }
   image->GetPointData()->SetActiveScalars("Mean");
   return image;
+}
+
+
+vtkSmartPointer<vtkImageData> LevelPiece(
+  vao::MomentLevel& level, const int whole[6], const int inputExt[6], const int piece[6], int step)
+{
+  vtkSmartPointer<vtkImageData> image = LevelAsImage(level);
+  int levelExt[6], wanted[6];
+  double origin[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const int first = (inputExt[2 * a] - whole[2 * a]) / step; // in the whole level's grid
+    levelExt[2 * a] = first;
+    levelExt[2 * a + 1] = first + image->GetDimensions()[a] - 1;
+    origin[a] = image->GetOrigin()[a] - first * image->GetSpacing()[a];
+    wanted[2 * a] = (piece[2 * a] - whole[2 * a] + step - 1) / step;
+    wanted[2 * a + 1] = std::min(levelExt[2 * a + 1], (piece[2 * a + 1] - whole[2 * a]) / step);
+  }
+  image->SetExtent(levelExt);
+  image->SetOrigin(origin);
+  auto part = vtkSmartPointer<vtkImageData>::New();
+  if (wanted[0] <= wanted[1] && wanted[2] <= wanted[3] && wanted[4] <= wanted[5])
+  {
+    CopyRequestedExtent(image, part, wanted);
+  }
+  return part;
 }
 
 } // namespace vtkAmbientOcclusionInput

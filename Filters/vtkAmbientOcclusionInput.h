@@ -43,6 +43,26 @@ bool CheckWholeExtent(const int whole[6], std::string& error);
 /// Makes `output` the input restricted to `outExt` (a shallow copy when they are equal).
 void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int outExt[6]);
 
+/// Input voxels between a pyramid level voxel and the farthest input voxel it depends on,
+/// for `levels` levels: 2^levels (2^(levels+1) - 2 from half resolution).
+int PyramidReach(int levels, bool half);
+
+/// Input voxels between two voxels of the coarsest of `levels` levels: a piece's input
+/// must start on a multiple of it so that its levels keep the whole volume's voxels.
+int PyramidAlignment(int levels, bool half);
+
+/// Piece `piece` of `pieces` of the whole extent, as ParaView splits it (block mode);
+/// an empty extent when there are more pieces than voxels.
+void PieceOfWhole(int piece, int pieces, const int whole[6], int ext[6]);
+
+/// The piece of the whole extent asked of an output (UPDATE_PIECE_NUMBER of
+/// UPDATE_NUMBER_OF_PIECES; the whole extent without them).
+void RequestedPiece(vtkInformation* outputInformation, const int whole[6], int ext[6]);
+
+/// The piece grown by reach[a] voxels per axis, clipped to the whole extent, its lower end
+/// moved down to a multiple of `alignment` from the whole extent's start.
+void GrowForPyramid(const int whole[6], const int piece[6], const int reach[3], int alignment, int ext[6]);
+
 /// Asks the input for exactly `extent`, as one piece without ghost levels.
 void RequestExactExtent(vtkInformation* inputInformation, const int extent[6]);
 
@@ -72,6 +92,12 @@ std::array<double, 3> ExtentOrigin(vtkImageData* image);
 /// (empty when the user aborted).
 bool BuildPyramid(vtkAlgorithm* algorithm, const ScalarVolume& scalars, vtkImageData* input, int levels,
   bool startAtHalfResolution, std::vector<vao::MomentLevel>& pyramid, std::string& error);
+
+/// The voxels of level `level` (built from the input extent inputExt, which keeps every
+/// step-th input voxel from its start) whose input voxel lies in `piece`, as an image in
+/// the whole level's grid (its extent and origin global). Takes over the level's storage.
+vtkSmartPointer<vtkImageData> LevelPiece(
+  vao::MomentLevel& level, const int whole[6], const int inputExt[6], const int piece[6], int step);
 
 /// One pyramid level as image data with float arrays "Mean" and "Variance", which take
 /// over the level's storage (the level's arrays are left empty).

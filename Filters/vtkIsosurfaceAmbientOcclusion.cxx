@@ -4,11 +4,13 @@
 
 #include "vao/VarianceOcclusionMap.h"
 
+#include "vtkCommunicator.h"
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -22,6 +24,12 @@
 #include <vector>
 
 vtkStandardNewMacro(vtkIsosurfaceAmbientOcclusion);
+
+namespace
+{
+/// Voxels a distributed surface piece may reach beyond its volume piece (ghost cells).
+constexpr int kSurfaceSlack = 2;
+}
 
 /// The pyramid of the last volume, and what it was built from.
 struct vtkIsosurfaceAmbientOcclusion::Cache
@@ -38,18 +46,34 @@ struct vtkIsosurfaceAmbientOcclusion::Cache
   vtkAmbientOcclusionInput::ScalarVolume scalars;
   std::array<double, 3> origin{};
   std::array<double, 3> spacing{};
+  vtkSmartPointer<vtkMultiProcessController> controller;
 };
 
 //------------------------------------------------------------------------------
 vtkIsosurfaceAmbientOcclusion::vtkIsosurfaceAmbientOcclusion()
   : Pyramid(new Cache)
 {
+  this->Pyramid->controller = vtkMultiProcessController::GetGlobalController();
   this->SetNumberOfInputPorts(2);
   this->SetInputArrayToProcess(
     0, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
 }
 
 vtkIsosurfaceAmbientOcclusion::~vtkIsosurfaceAmbientOcclusion() = default;
+
+void vtkIsosurfaceAmbientOcclusion::SetController(vtkMultiProcessController* controller)
+{
+  if (this->Pyramid->controller != controller)
+  {
+    this->Pyramid->controller = controller;
+    this->Modified();
+  }
+}
+
+vtkMultiProcessController* vtkIsosurfaceAmbientOcclusion::GetController() const
+{
+  return this->Pyramid->controller;
+}
 
 //------------------------------------------------------------------------------
 void vtkIsosurfaceAmbientOcclusion::SetVolumeScalars(const char* name)
@@ -75,9 +99,23 @@ int vtkIsosurfaceAmbientOcclusion::FillInputPortInformation(int port, vtkInforma
 int vtkIsosurfaceAmbientOcclusion::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
 {
-  // Each piece of the surface samples the pyramid anywhere along its normals and light
-  // rays: every process reads the whole volume (the pyramid is not distributed).
-  vtkAmbientOcclusionInput::RequestWholeExtent(inputVector[1]->GetInformationObject(0));
+  // One process reads the whole volume. Several read their piece grown by the reach of
+  // the finer levels' queries; the coarsest level is shared (UpdateDistributedPyramid).
+  vtkInformation* volumeInfo = inputVector[1]->GetInformationObject(0);
+  if (!this->IsDistributed())
+  {
+    vtkAmbientOcclusionInput::RequestWholeExtent(volumeInfo);
+    return 1;
+  }
+  int whole[6], piece[6], ext[6];
+  double spacing[3] = { 1.0, 1.0, 1.0 };
+  volumeInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  if (volumeInfo->Has(vtkDataObject::SPACING()))
+  {
+    volumeInfo->Get(vtkDataObject::SPACING(), spacing);
+  }
+  this->VolumeExtentOf(whole, spacing, piece, ext);
+  vtkAmbientOcclusionInput::RequestExactExtent(volumeInfo, ext);
   return 1;
 }
 
@@ -153,6 +191,169 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
 }
 
 //------------------------------------------------------------------------------
+bool vtkIsosurfaceAmbientOcclusion::IsDistributed() const
+{
+  const vtkMultiProcessController* controller = this->Pyramid->controller;
+  return controller && const_cast<vtkMultiProcessController*>(controller)->GetNumberOfProcesses() > 1 &&
+    this->NumberOfLevels >= 2;
+}
+
+//------------------------------------------------------------------------------
+void vtkIsosurfaceAmbientOcclusion::VolumeExtentOf(
+  const int whole[6], const double spacing[3], int piece[6], int ext[6]) const
+{
+  vtkMultiProcessController* controller = this->Pyramid->controller;
+  vtkAmbientOcclusionInput::PieceOfWhole(
+    controller->GetLocalProcessId(), controller->GetNumberOfProcesses(), whole, piece);
+  if (piece[0] > piece[1] || piece[2] > piece[3] || piece[4] > piece[5])
+  {
+    std::copy(piece, piece + 6, ext);
+    return;
+  }
+  // How far from a surface point the finer levels (0 .. L-2) are sampled: AO at
+  // k * r_l along the normal, shadows from r_0 out to r_0 * 2^(l+1) (where level l + 1
+  // takes over), the gradient and the half-voxel query within a voxel; plus the
+  // trilinear reach of the level's grid. Every voxel of those levels there must be right:
+  // plus their own reach in the input. The coarsest level must be right over the piece.
+  const bool half = this->StartAtHalfResolution != 0;
+  const int levels = std::max(2, std::min(this->NumberOfLevels, 16));
+  const double largest = std::max({ spacing[0], spacing[1], spacing[2] });
+  const double r0 = 2.0 * largest * (half ? 2 : 1);
+  double reach = 2.0 * largest;
+  for (int l = 0; l + 1 < levels; ++l)
+  {
+    const double step = static_cast<double>((half ? 2 : 1) << l);
+    const double r = r0 * (1 << l);
+    reach = std::max(reach, std::max(this->OffsetFactor * r, r0 * (2 << l)) + step * largest);
+  }
+  int reaches[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    reaches[a] = std::max(vtkAmbientOcclusionInput::PyramidReach(levels, half),
+      static_cast<int>(std::ceil(reach / spacing[a])) + 1 + kSurfaceSlack +
+        vtkAmbientOcclusionInput::PyramidReach(levels - 1, half));
+  }
+  vtkAmbientOcclusionInput::GrowForPyramid(
+    whole, piece, reaches, vtkAmbientOcclusionInput::PyramidAlignment(levels, half), ext);
+}
+
+//------------------------------------------------------------------------------
+bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
+  vtkImageData* volume, vtkDataArray* chosen, const int whole[6], int piece[6])
+{
+  Cache& cache = *this->Pyramid;
+  vtkMultiProcessController* controller = cache.controller;
+  cache.levels.clear();
+  cache.volume = nullptr; // not reused: the pieces follow the decomposition
+  std::string error;
+  int expected[6];
+  this->VolumeExtentOf(whole, volume->GetSpacing(), piece, expected);
+  const bool empty = piece[0] > piece[1] || piece[2] > piece[3] || piece[4] > piece[5];
+  const int levels = this->NumberOfLevels;
+  const bool half = this->StartAtHalfResolution != 0;
+  const int coarsestStep = (half ? 2 : 1) << (levels - 1);
+  int coarseExt[6] = { 0, -1, 0, -1, 0, -1 };
+  std::vector<float> mine;
+  if (!empty && !std::equal(expected, expected + 6, volume->GetExtent()))
+  {
+    error = "The volume input delivered another extent than this process's piece and its reach: under MPI, "
+            "feed the Volume input from its own reader.";
+  }
+  else if (!empty &&
+    vtkAmbientOcclusionInput::CheckWholeExtent(whole, error) &&
+    vtkAmbientOcclusionInput::PrepareScalars(this, chosen, volume, this->Component, cache.scalars, error) &&
+    vtkAmbientOcclusionInput::BuildPyramid(this, cache.scalars, volume, levels, half, cache.levels, error))
+  {
+    // This piece's voxels of the coarsest level, for every process.
+    auto part = vtkAmbientOcclusionInput::LevelPiece(cache.levels[levels - 1], whole, expected, piece, coarsestStep);
+    if (part->GetNumberOfPoints() > 0)
+    {
+      part->GetExtent(coarseExt);
+      for (const char* name : { "Mean", "Variance" })
+      {
+        vtkDataArray* values = part->GetPointData()->GetArray(name);
+        for (vtkIdType i = 0; i < values->GetNumberOfTuples(); ++i)
+          mine.push_back(static_cast<float>(values->GetTuple1(i)));
+      }
+    }
+  }
+  const int ranks = controller->GetNumberOfProcesses();
+  std::vector<int> extents(static_cast<size_t>(6 * ranks));
+  controller->AllGather(coarseExt, extents.data(), 6);
+  std::vector<vtkIdType> lengths(ranks), offsets(ranks);
+  vtkIdType total = 0;
+  for (int r = 0; r < ranks; ++r)
+  {
+    const int* e = &extents[6 * r];
+    lengths[r] = e[1] < e[0] ? 0 : 2 * static_cast<vtkIdType>(e[1] - e[0] + 1) * (e[3] - e[2] + 1) * (e[5] - e[4] + 1);
+    offsets[r] = total;
+    total += lengths[r];
+  }
+  std::vector<float> all(static_cast<size_t>(std::max<vtkIdType>(total, 1)));
+  controller->AllGatherV(mine.data(), all.data(), static_cast<vtkIdType>(mine.size()), lengths.data(), offsets.data());
+  double failed = error.empty() && (empty || !cache.levels.empty()) ? 0.0 : 1.0, anyFailed = 0.0;
+  controller->AllReduce(&failed, &anyFailed, 1, vtkCommunicator::MAX_OP);
+  if (anyFailed > 0.0 || empty)
+  {
+    if (anyFailed > 0.0)
+    {
+      vtkErrorMacro(<< (error.empty() ? std::string("The pyramid failed on another process (see its message).") : error));
+    }
+    cache.levels.clear();
+    return false;
+  }
+
+  // The whole coarsest level, from the pieces (they overlap where pieces share a face).
+  vao::MomentLevel coarsest;
+  const double* h = volume->GetSpacing();
+  const double* origin = volume->GetOrigin();
+  for (int a = 0; a < 3; ++a)
+  {
+    vao::Index3::value_type n = whole[2 * a + 1] - whole[2 * a] + 1;
+    for (int step = 1; step < coarsestStep; step *= 2)
+      n = (n + 1) / 2; // each halving keeps voxels 0, 2, 4, ...
+    coarsest.dims[a] = n;
+    coarsest.origin[a] = origin[a] + whole[2 * a] * h[a];
+    coarsest.spacing[a] = h[a] * coarsestStep;
+  }
+  coarsest.kernelRadius = cache.levels[levels - 1].kernelRadius;
+  const vtkIdType nx = coarsest.dims[0], ny = coarsest.dims[1];
+  coarsest.mean.resize(static_cast<size_t>(nx * ny * coarsest.dims[2]));
+  coarsest.variance.resize(coarsest.mean.size());
+  for (int r = 0; r < ranks; ++r)
+  {
+    const int* e = &extents[6 * r];
+    const float* from = all.data() + offsets[r];
+    const vtkIdType count = lengths[r] / 2;
+    vtkIdType i = 0;
+    for (int k = e[4]; k <= e[5]; ++k)
+      for (int j = e[2]; j <= e[3]; ++j)
+        for (int x = e[0]; x <= e[1]; ++x, ++i)
+        {
+          const vtkIdType at = (static_cast<vtkIdType>(k) * ny + j) * nx + x;
+          coarsest.mean[at] = from[i];
+          coarsest.variance[at] = from[count + i];
+        }
+  }
+  cache.levels[levels - 1] = std::move(coarsest);
+  // The shadows' march stops at the whole volume's border, not at this piece's.
+  vao::MomentLevel& base = cache.levels[0];
+  const int baseStep = half ? 2 : 1;
+  for (int a = 0; a < 3; ++a)
+  {
+    vao::Index3::value_type n = whole[2 * a + 1] - whole[2 * a] + 1;
+    if (half)
+      n = (n + 1) / 2;
+    base.wholeBounds[2 * a] = origin[a] + whole[2 * a] * h[a];
+    base.wholeBounds[2 * a + 1] = base.wholeBounds[2 * a] + (n - 1) * h[a] * baseStep;
+  }
+  cache.origin = vtkAmbientOcclusionInput::ExtentOrigin(volume);
+  cache.spacing = { h[0], h[1], h[2] };
+  ++this->PyramidBuilds;
+  return true;
+}
+
+//------------------------------------------------------------------------------
 bool vtkIsosurfaceAmbientOcclusion::SurfaceNormals(vtkPolyData* surface, std::vector<double>& normals)
 {
   const vtkIdType n = surface->GetNumberOfPoints();
@@ -216,7 +417,8 @@ int vtkIsosurfaceAmbientOcclusion::RequestData(
   }
   int whole[6];
   inputVector[1]->GetInformationObject(0)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  if (!std::equal(whole, whole + 6, volume->GetExtent()))
+  const bool distributed = this->IsDistributed();
+  if (!distributed && !std::equal(whole, whole + 6, volume->GetExtent()))
   {
     // Happens when the surface is extracted from the same source output in pieces (MPI):
     // the shared output then holds the surface's piece, not the whole volume.
@@ -224,7 +426,15 @@ int vtkIsosurfaceAmbientOcclusion::RequestData(
                      "reader rather than from the output the surface was extracted from.");
     return 1;
   }
-  if (!this->CheckParameters() || !this->UpdatePyramid(volume, this->GetInputArrayToProcess(0, inputVector)))
+  if (!this->CheckParameters()) // the same answer on every process
+  {
+    return 1;
+  }
+  int piece[6];
+  std::copy(whole, whole + 6, piece);
+  vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
+  if (distributed ? !this->UpdateDistributedPyramid(volume, chosen, whole, piece)
+                  : !this->UpdatePyramid(volume, chosen))
   {
     return 1;
   }
@@ -234,9 +444,17 @@ int vtkIsosurfaceAmbientOcclusion::RequestData(
   {
     return 1; // an empty surface (or an empty piece of one): nothing to shade
   }
-  // Every point must lie in the volume (half a voxel of slack for contours at its border).
+  // Every point must lie in the volume (half a voxel of slack for contours at its border),
+  // or near this process's piece of it: a surface piece extracted with ghost cells
+  // reaches a voxel or two beyond the piece.
   double bounds[6];
-  volume->GetBounds(bounds);
+  const double* origin = volume->GetOrigin();
+  for (int a = 0; a < 6; ++a)
+  {
+    const int slack = distributed ? (a % 2 ? kSurfaceSlack : -kSurfaceSlack) : 0;
+    const int index = std::max(whole[a & ~1], std::min(whole[a | 1], piece[a] + slack));
+    bounds[a] = origin[a / 2] + index * volume->GetSpacing()[a / 2];
+  }
   double surfaceBounds[6];
   surface->GetBounds(surfaceBounds);
   const double* h = volume->GetSpacing();

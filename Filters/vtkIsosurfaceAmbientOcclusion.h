@@ -26,6 +26,7 @@
 #include <vector>
 
 class vtkDataArray;
+class vtkMultiProcessController;
 class vtkImageData;
 
 class VOLUMETRICAOFILTERS_EXPORT vtkIsosurfaceAmbientOcclusion : public vtkPolyDataAlgorithm
@@ -108,6 +109,18 @@ public:
   /// How many times the pyramid was built (the cache's witness).
   int GetNumberOfPyramidBuilds() const { return this->PyramidBuilds; }
 
+  ///@{
+  /// The processes of a distributed run (default: the global controller). With more than
+  /// one process and at least two levels, each process reads its piece of the volume (as
+  /// ParaView splits it) grown by the reach of the finer levels' queries, builds those
+  /// levels locally, and the coarsest level, which the soft shadows march through to the
+  /// volume's border, is assembled from every process's piece and replicated. The surface
+  /// must be the piece extracted from the same decomposition (e.g. Contour of the same
+  /// reader). Every process must execute the filter. nullptr: each reads the whole volume.
+  void SetController(vtkMultiProcessController* controller);
+  vtkMultiProcessController* GetController() const;
+  ///@}
+
 protected:
   vtkIsosurfaceAmbientOcclusion();
   ~vtkIsosurfaceAmbientOcclusion() override;
@@ -137,6 +150,12 @@ private:
 
   bool CheckParameters();
   bool UpdatePyramid(vtkImageData* volume, vtkDataArray* chosen);
+  bool IsDistributed() const;
+  /// This process's piece of the volume and the extent it reads (grown by the reach).
+  void VolumeExtentOf(const int whole[6], const double spacing[3], int piece[6], int ext[6]) const;
+  /// The pyramid of this process's extent, its coarsest level replaced by the whole one.
+  /// Collective: every process calls it, also after an error of its own.
+  bool UpdateDistributedPyramid(vtkImageData* volume, vtkDataArray* chosen, const int whole[6], int piece[6]);
   bool SurfaceNormals(vtkPolyData* surface, std::vector<double>& normals);
 };
 

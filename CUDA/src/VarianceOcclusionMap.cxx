@@ -559,10 +559,12 @@ double levelOcclusion(const MomentLevel& level, const std::array<double, 3>& pos
 
 bool insideBounds(const MomentLevel& level, const std::array<double, 3>& p)
 {
+  const bool window = std::isfinite(level.wholeBounds[0]);
   for (int a = 0; a < 3; ++a)
   {
-    const double lo = level.origin[a];
-    const double hi = level.origin[a] + (level.dims[a] - 1) * level.spacing[a];
+    const double lo = window ? level.wholeBounds[2 * a] : level.origin[a];
+    const double hi =
+      window ? level.wholeBounds[2 * a + 1] : level.origin[a] + (level.dims[a] - 1) * level.spacing[a];
     if (p[a] < lo || p[a] > hi)
     {
       return false;

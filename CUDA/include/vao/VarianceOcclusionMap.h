@@ -10,6 +10,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <new>
 #include <utility>
 #include <vector>
@@ -31,6 +32,8 @@ void freeLevelStorage(void* block) noexcept;
 /// the pyramid builder writes every one, in parallel, so a fresh array is first touched by
 /// the threads that fill it instead of by one serial zero-fill. release() hands the block
 /// to a new owner (a vtkFloatArray, without a copy), who frees it with freeLevelStorage.
+constexpr double kUnsetBound = std::numeric_limits<double>::quiet_NaN();
+
 class LevelArray
 {
 public:
@@ -107,6 +110,10 @@ struct MomentLevel
   std::array<double, 3> origin = { 0, 0, 0 };  // world position of voxel (0, 0, 0)
   std::array<double, 3> spacing = { 1, 1, 1 }; // world units
   double kernelRadius = 0.0;                   // r_l = 2 * largest spacing of this level (world)
+  // World bounds (x0, x1, y0, y1, z0, z1) of the whole volume's level when this level holds
+  // only a window of it (a distributed piece); NaN: the level is whole. The soft-shadow
+  // march of pyramid[0] stops at these bounds, not at the window's.
+  std::array<double, 6> wholeBounds = { kUnsetBound, kUnsetBound, kUnsetBound, kUnsetBound, kUnsetBound, kUnsetBound };
   LevelArray mean;
   LevelArray variance; // E[v^2] - E[v]^2 of the blurred moments, clamped at 0
 };
