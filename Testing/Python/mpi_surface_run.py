@@ -1,37 +1,35 @@
 """pvbatch (serial or under mpirun): contour the CT head's bone and shade it with
 Isosurface Ambient Occlusion (AO and shadows), write a .pvtp (one piece per rank).
 Normals come from the volume gradient (the filter's fallback), which every rank computes
-from the whole volume, so they do not depend on the decomposition.
+from its piece of the volume and the reach around it, so they do not depend on the
+decomposition.
 Usage: pvbatch mpi_surface_run.py PLUGIN INPUT.vti OUT.pvtp"""
+import os
 import sys
 
 from paraview.simple import *  # noqa: F401,F403
 
-plugin, source, target = sys.argv[1:4]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from vao_test_utils import extent_logger  # noqa: E402
+
+plugin, source_path, target = sys.argv[1:4]
 LoadPlugin(plugin, remote=True, ns=globals())
-# Two readers: the contour asks for this rank's piece, the filter for the whole volume;
-# one shared output cannot hold both at once.
-pieces = XMLImageDataReader(FileName=[source])
-whole = XMLImageDataReader(FileName=[source])
+# Two readers: the contour asks for this rank's piece, the filter for that piece grown by
+# the reach of its finer levels; one shared output cannot hold both at once. A
+# pass-through logs the extent the filter's volume input received (<OUT>.volume.<rank>).
+pieces = XMLImageDataReader(FileName=[source_path])
+
+volume = extent_logger(XMLImageDataReader(FileName=[source_path]), target + ".volume")
 bone = Contour(Input=pieces, ContourBy=["POINTS", "MetaImage"], Isosurfaces=[400.0], ComputeNormals=0)
-shaded = IsosurfaceAmbientOcclusion(Input=bone, Volume=whole, ComputeShadows=1, LightDirection=[0.0, -1.0, 1.0])
+shaded = IsosurfaceAmbientOcclusion(Input=bone, Volume=volume, ComputeShadows=1, LightDirection=[0.0, -1.0, 1.0])
 shaded.Scalars = "MetaImage"
 SaveData(target, proxy=shaded, DataMode="Binary")
 
 # The pyramid (Variance Occlusion Map), distributed: each rank computes the level voxels
 # of its piece from its piece grown by the pyramid's reach. A pass-through writes, per
 # rank, every level's extent and arrays (<OUT>.pyramid.<rank>.npz) and the extent the
-# map received (<OUT>.pyramid.<rank>.read).
-read = ProgrammableFilter(Input=XMLImageDataReader(FileName=[source]))
-read.Script = """
-from vtkmodules.vtkParallelCore import vtkMultiProcessController
-controller = vtkMultiProcessController.GetGlobalController()
-rank = controller.GetLocalProcessId() if controller else 0
-data = self.GetInputDataObject(0, 0)
-self.GetOutputDataObject(0).ShallowCopy(data)
-with open(TARGET + ".pyramid.%d.read" % rank, "w") as log:
-    log.write(" ".join(str(e) for e in data.GetExtent()))
-""".replace("TARGET", repr(target))
+# map received (<OUT>.pyramid.read.<rank>).
+read = extent_logger(XMLImageDataReader(FileName=[source_path]), target + ".pyramid.read")
 dump = ProgrammableFilter(Input=VarianceOcclusionMap(Input=read))
 dump.Script = """
 import numpy as np

@@ -38,3 +38,26 @@ def read_image(path):
     if output.GetNumberOfPoints() == 0:
         fail("could not read back " + path)
     return output
+
+
+def extent_logger(upstream, prefix):
+    """(pvpython / pvbatch) A pass-through ProgrammableFilter that writes the extent it
+    received to <prefix>.<rank>: what the filters downstream asked of `upstream`."""
+    from paraview.simple import ProgrammableFilter
+    logger = ProgrammableFilter(Input=upstream)
+    logger.Script = """
+from vtkmodules.vtkParallelCore import vtkMultiProcessController
+controller = vtkMultiProcessController.GetGlobalController()
+rank = controller.GetLocalProcessId() if controller else 0
+data = self.GetInputDataObject(0, 0)
+self.GetOutputDataObject(0).ShallowCopy(data)
+with open(PREFIX + ".%d" % rank, "w") as log:
+    log.write(" ".join(str(e) for e in data.GetExtent()))
+""".replace("PREFIX", repr(prefix))
+    return logger
+
+
+def logged_extent(prefix, rank):
+    """The extent extent_logger wrote for `rank`, as a tuple."""
+    with open("%s.%d" % (prefix, rank)) as log:
+        return tuple(int(v) for v in log.read().split())
