@@ -11,6 +11,7 @@
 // and reads VmHWM from /proc/self/status.
 #include "ProcessMemory.h"
 #include "vtkAmbientOcclusionShading.h"
+#include "vtkIsosurfaceAmbientOcclusion.h"
 #include "vtkOcclusionSweeping.h"
 #include "vtkVarianceOcclusionMap.h"
 #include "vtkVolumetricAmbientOcclusion.h"
@@ -18,11 +19,14 @@
 #include <vtkAlgorithm.h>
 #include <vtkCompositeDataIterator.h>
 #include <vtkDataArray.h>
+#include <vtkDataSet.h>
+#include <vtkFlyingEdges3D.h>
 #include <vtkImageData.h>
 #include <vtkMetaImageReader.h>
 #include <vtkMultiBlockDataSet.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
+#include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 
 #include <cstdio>
@@ -42,13 +46,13 @@ namespace
 using vao_bench::ResetPeak;
 using vao_bench::StatusBytes;
 
-/// Bytes of the arrays of `data` (an image, or the images of a multiblock) that are not
-/// among `known` (the input's arrays, shared by reference).
+/// Bytes of the point arrays of `data` (a data set, or the images of a multiblock) that
+/// are not among `known` (the inputs' arrays, shared by reference).
 long long NewArrayBytes(vtkDataObject* data, const std::set<vtkDataArray*>& known)
 {
   long long bytes = 0;
-  auto addImage = [&](vtkImageData* image) {
-    vtkPointData* pd = image->GetPointData();
+  auto add = [&](vtkDataSet* set) {
+    vtkPointData* pd = set->GetPointData();
     for (int a = 0; a < pd->GetNumberOfArrays(); ++a)
     {
       vtkDataArray* array = pd->GetArray(a);
@@ -58,9 +62,9 @@ long long NewArrayBytes(vtkDataObject* data, const std::set<vtkDataArray*>& know
       }
     }
   };
-  if (auto* image = vtkImageData::SafeDownCast(data))
+  if (auto* set = vtkDataSet::SafeDownCast(data))
   {
-    addImage(image);
+    add(set);
   }
   else if (auto* blocks = vtkMultiBlockDataSet::SafeDownCast(data))
   {
@@ -68,9 +72,9 @@ long long NewArrayBytes(vtkDataObject* data, const std::set<vtkDataArray*>& know
     it.TakeReference(blocks->NewIterator());
     for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
     {
-      if (auto* level = vtkImageData::SafeDownCast(it->GetCurrentDataObject()))
+      if (auto* level = vtkDataSet::SafeDownCast(it->GetCurrentDataObject()))
       {
-        addImage(level);
+        add(level);
       }
     }
   }
@@ -91,6 +95,8 @@ const Case kCases[] = {
   { "Occlusion Sweeping", "AmbientOcclusion, SignedDistance" },
   { "Variance Occlusion Map", "4 levels of Mean, Variance" },
   { "Shading (RGBA)", "ShadedRGBA" },
+  { "Isosurface AO + shadows", "AmbientOcclusion, Shadow (bone)" },
+  { "Isosurface AO, half res.", "AmbientOcclusion, Shadow (bone)" },
 };
 
 /// The filter of case c on `input`, ready to update.
@@ -109,6 +115,23 @@ vtkSmartPointer<vtkAlgorithm> MakeFilter(int c, vtkImageData* input, double radi
     auto map = vtkSmartPointer<vtkVarianceOcclusionMap>::New();
     map->SetInputData(input);
     return map;
+  }
+  if (name.rfind("Isosurface AO", 0) == 0)
+  {
+    // The bone surface (400 HU) is made beforehand, as part of the input.
+    vtkNew<vtkFlyingEdges3D> contour;
+    contour->SetInputData(input);
+    contour->SetValue(0, 400.0);
+    contour->ComputeNormalsOn();
+    contour->Update();
+    auto surface = vtkSmartPointer<vtkPolyData>::New();
+    surface->ShallowCopy(contour->GetOutput());
+    auto shade = vtkSmartPointer<vtkIsosurfaceAmbientOcclusion>::New();
+    shade->SetInputData(0, surface);
+    shade->SetInputData(1, input);
+    shade->SetComputeShadows(true);
+    shade->SetStartAtHalfResolution(name.find("half") != std::string::npos);
+    return shade;
   }
   if (name == "Shading (RGBA)")
   {
@@ -151,10 +174,16 @@ int RunChild(int c, const std::string& path, double radius, int threads)
   }
   const long long inputBytes = scalars->GetNumberOfValues() * scalars->GetDataTypeSize();
   vtkSmartPointer<vtkAlgorithm> filter = MakeFilter(c, input, radius, threads);
-  std::set<vtkDataArray*> known;
-  for (int a = 0; a < input->GetPointData()->GetNumberOfArrays(); ++a)
+  std::set<vtkDataArray*> known; // every input's point arrays
+  for (int port = 0; port < filter->GetNumberOfInputPorts(); ++port)
   {
-    known.insert(input->GetPointData()->GetArray(a));
+    if (auto* set = vtkDataSet::SafeDownCast(filter->GetInputDataObject(port, 0)))
+    {
+      for (int a = 0; a < set->GetPointData()->GetNumberOfArrays(); ++a)
+      {
+        known.insert(set->GetPointData()->GetArray(a));
+      }
+    }
   }
   if (!ResetPeak())
   {
