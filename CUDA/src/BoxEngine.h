@@ -176,6 +176,10 @@ private:
       {
         dst[i] += run[i];
       }
+      if (row + 1 == this->Geo.region.size[1])
+      {
+        break; // no next row: its window's entering row may lie past the rows read
+      }
       const std::int64_t y = y0 + row;
       const std::int64_t entering = y + r + 1;
       const std::int64_t leaving = y - r;

@@ -204,3 +204,28 @@ TEST(BoxStatisticsExecution, HonoursCancellationAndReportsProgress)
 }
 
 } // namespace
+
+TEST(BoxStatistics, BandsOfRowsOnALargeVolumeMatchBruteForce)
+{
+  // With the extrema the region goes in bands of rows; each band's last row once read the
+  // x sums of a row past the band (512x512x40 at R = 10 crashed). Every output checked
+  // on a sample of voxels, the bands' first and last rows included.
+  const vao::Index3 dims = { 512, 512, 40 };
+  const auto v = randomVolume<std::int16_t>(dims, -1000, 1000, 23);
+  const vao::Radius r{ 10, 10, 10 };
+  const vao::Region region{ { 0, 0, 0 }, dims };
+  StatsArrays got(region.voxelCount());
+  const vao::Status status = vao::computeBoxStatistics(viewOf(v, dims), region, r, got.output());
+  ASSERT_TRUE(status.ok) << status.message;
+  for (std::int64_t y : { 0, 31, 32, 33, 255, 479, 480, 511 })
+    for (std::int64_t x : { 0, 7, 300, 511 })
+      for (std::int64_t z : { 0, 19, 39 })
+      {
+        const std::int64_t k = (z * dims[1] + y) * dims[0] + x;
+        const ReferenceStats ref = bruteForceStats(v, dims, r, x, y, z);
+        ASSERT_EQ(got.minimum[k], ref.minimum) << x << "," << y << "," << z;
+        ASSERT_EQ(got.maximum[k], ref.maximum) << x << "," << y << "," << z;
+        ASSERT_TRUE(closeRelative(got.mean[k], ref.mean, 1e-9)) << x << "," << y << "," << z;
+        ASSERT_TRUE(closeRelative(got.variance[k], ref.variance, 1e-9)) << x << "," << y << "," << z;
+      }
+}
