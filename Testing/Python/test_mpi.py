@@ -190,4 +190,32 @@ for ranks in rank_counts:
     # The pieces' pyramids differ from the whole one by float rounding (their moments are
     # taken about another sampled mean): 1e-5 is a few of those roundings.
     check(worst <= 1e-5, "np %d: surface AO and Shadow equal serial (max difference %.3g)" % (ranks, worst))
+# Bad input on one rank only: a NaN voxel in the last slab of a 40^3 sphere. Every rank
+# errors and finishes (no rank waits for the one that stopped).
+from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
+from vtkmodules.util.numpy_support import numpy_to_vtk  # noqa: E402
+z, y, x = np.mgrid[0:40, 0:40, 0:40]
+sphere = (np.sqrt((x - 20.0) ** 2 + (y - 20.0) ** 2 + (z - 20.0) ** 2) < 10).astype("f4")
+sphere[38, 5, 5] = np.nan
+bad = vtkImageData()
+bad.SetDimensions(40, 40, 40)
+values = numpy_to_vtk(sphere.ravel(), deep=1)
+values.SetName("v")
+bad.GetPointData().SetScalars(values)
+bad_path = os.path.join(out_dir, "mpi_nan.vti")
+writer.SetInputData(bad)
+writer.SetFileName(bad_path)
+writer.Write()
+env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "OPAL_"))}
+command = [mpiexec, "--allow-run-as-root", "--oversubscribe", "-np", "2", pvbatch,
+           os.path.join(here, "mpi_bad_input_run.py"), plugin, bad_path, os.path.join(out_dir, "mpi_nan")]
+try:
+    result = subprocess.run(command, capture_output=True, text=True, timeout=120, env=env)
+    output = result.stdout + result.stderr
+except subprocess.TimeoutExpired:
+    output = None
+check(output is not None, "a NaN in one rank's slab: the MPI run finished (no rank waits forever)")
+check("finished" in output and "NaN or infinite values" in output and
+      "another process failed" in output,
+      "the rank with the NaN names it, the other says another process failed")
 print("all MPI checks passed")
