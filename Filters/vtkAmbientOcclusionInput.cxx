@@ -163,6 +163,18 @@ bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData*
   return true;
 }
 
+bool EmptyExtent(const int ext[6])
+{
+  return ext[0] > ext[1] || ext[2] > ext[3] || ext[4] > ext[5];
+}
+
+vtkIdType ExtentPoints(const int ext[6])
+{
+  return EmptyExtent(ext) ? 0
+                          : static_cast<vtkIdType>(ext[1] - ext[0] + 1) * (ext[3] - ext[2] + 1) *
+      (ext[5] - ext[4] + 1);
+}
+
 void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int outExt[6])
 {
   const int* inExt = input->GetExtent();
@@ -171,8 +183,7 @@ void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int ou
     output->ShallowCopy(input);
     return;
   }
-  const vtkIdType points = static_cast<vtkIdType>(outExt[1] - outExt[0] + 1) * (outExt[3] - outExt[2] + 1) *
-    (outExt[5] - outExt[4] + 1);
+  const vtkIdType points = ExtentPoints(outExt);
   output->SetExtent(const_cast<int*>(outExt));
   output->SetOrigin(input->GetOrigin());
   output->SetSpacing(input->GetSpacing());
@@ -297,6 +308,13 @@ void PasteExtent(vtkImageData* piece, const int pieceExt[6], vtkImageData* outpu
 
 } // namespace
 
+double GlobalMax(vtkMultiProcessController* controller, double value)
+{
+  double result = value;
+  controller->AllReduce(&value, &result, 1, vtkCommunicator::MAX_OP);
+  return result;
+}
+
 void GlobalRange(vtkMultiProcessController* controller, double range[2])
 {
   if (!controller || controller->GetNumberOfProcesses() < 2)
@@ -317,12 +335,10 @@ void RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
   controller->AllGather(wanted, wantedExtents.data(), 6);
 
   output->Initialize();
-  int common[6];
-  const bool wantsSomething = IntersectExtents(wanted, wanted, common);
+  const bool wantsSomething = !EmptyExtent(wanted);
   if (wantsSomething)
   {
-    const vtkIdType points = static_cast<vtkIdType>(wanted[1] - wanted[0] + 1) *
-      (wanted[3] - wanted[2] + 1) * (wanted[5] - wanted[4] + 1);
+    const vtkIdType points = ExtentPoints(wanted);
     output->SetExtent(const_cast<int*>(wanted));
     output->SetOrigin(held->GetOrigin());
     output->SetSpacing(held->GetSpacing());
@@ -343,6 +359,7 @@ void RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
     if (from->GetScalars())
       output->GetPointData()->SetActiveScalars(from->GetScalars()->GetName());
     output->GetFieldData()->ShallowCopy(held->GetFieldData());
+    int common[6];
     if (IntersectExtents(held->GetExtent(), wanted, common))
     {
       vtkNew<vtkImageData> own;
@@ -462,7 +479,7 @@ vtkSmartPointer<vtkImageData> LevelPiece(
   image->SetExtent(levelExt);
   image->SetOrigin(origin);
   auto part = vtkSmartPointer<vtkImageData>::New();
-  if (wanted[0] <= wanted[1] && wanted[2] <= wanted[3] && wanted[4] <= wanted[5])
+  if (!EmptyExtent(wanted))
   {
     CopyRequestedExtent(image, part, wanted);
   }

@@ -40,6 +40,12 @@ bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData*
 /// Checks that the whole extent is a 3-D volume (at least 2 voxels on every axis).
 bool CheckWholeExtent(const int whole[6], std::string& error);
 
+/// True when the extent holds no point (some max below its min).
+bool EmptyExtent(const int ext[6]);
+
+/// Points of the extent (0 when empty).
+vtkIdType ExtentPoints(const int ext[6]);
+
 /// Makes `output` the input restricted to `outExt` (a shallow copy when they are equal).
 void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int outExt[6]);
 
@@ -68,6 +74,10 @@ void RequestExactExtent(vtkInformation* inputInformation, const int extent[6]);
 
 /// Asks the input for its whole extent, as one piece (global algorithms).
 void RequestWholeExtent(vtkInformation* inputInformation);
+
+/// The largest `value` over every process of the controller (a failure flag, a change).
+/// Collective.
+double GlobalMax(vtkMultiProcessController* controller, double value);
 
 /// range = [min, max] over every process of the controller (unchanged with one process
 /// or none). Collective.

@@ -4,7 +4,6 @@
 
 #include "vao/VarianceOcclusionMap.h"
 
-#include "vtkCommunicator.h"
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -205,7 +204,7 @@ void vtkIsosurfaceAmbientOcclusion::VolumeExtentOf(
   vtkMultiProcessController* controller = this->Pyramid->controller;
   vtkAmbientOcclusionInput::PieceOfWhole(
     controller->GetLocalProcessId(), controller->GetNumberOfProcesses(), whole, piece);
-  if (piece[0] > piece[1] || piece[2] > piece[3] || piece[4] > piece[5])
+  if (vtkAmbientOcclusionInput::EmptyExtent(piece))
   {
     std::copy(piece, piece + 6, ext);
     return;
@@ -248,7 +247,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
   std::string error;
   int expected[6];
   this->VolumeExtentOf(whole, volume->GetSpacing(), piece, expected);
-  const bool empty = piece[0] > piece[1] || piece[2] > piece[3] || piece[4] > piece[5];
+  const bool empty = vtkAmbientOcclusionInput::EmptyExtent(piece);
   const int levels = this->NumberOfLevels;
   const bool half = this->StartAtHalfResolution != 0;
   const int coarsestStep = (half ? 2 : 1) << (levels - 1);
@@ -284,18 +283,17 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
   vtkIdType total = 0;
   for (int r = 0; r < ranks; ++r)
   {
-    const int* e = &extents[6 * r];
-    lengths[r] = e[1] < e[0] ? 0 : 2 * static_cast<vtkIdType>(e[1] - e[0] + 1) * (e[3] - e[2] + 1) * (e[5] - e[4] + 1);
+    lengths[r] = 2 * vtkAmbientOcclusionInput::ExtentPoints(&extents[6 * r]); // Mean, then Variance
     offsets[r] = total;
     total += lengths[r];
   }
   std::vector<float> all(static_cast<size_t>(std::max<vtkIdType>(total, 1)));
   controller->AllGatherV(mine.data(), all.data(), static_cast<vtkIdType>(mine.size()), lengths.data(), offsets.data());
-  double failed = error.empty() && (empty || !cache.levels.empty()) ? 0.0 : 1.0, anyFailed = 0.0;
-  controller->AllReduce(&failed, &anyFailed, 1, vtkCommunicator::MAX_OP);
-  if (anyFailed > 0.0 || empty)
+  const bool failed = !error.empty() || (!empty && cache.levels.empty());
+  const bool anyFailed = vtkAmbientOcclusionInput::GlobalMax(controller, failed ? 1.0 : 0.0) > 0.0;
+  if (anyFailed || empty)
   {
-    if (anyFailed > 0.0)
+    if (anyFailed)
     {
       vtkErrorMacro(<< (error.empty() ? std::string("The pyramid failed on another process (see its message).") : error));
     }
@@ -309,10 +307,8 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
   const double* origin = volume->GetOrigin();
   for (int a = 0; a < 3; ++a)
   {
-    vao::Index3::value_type n = whole[2 * a + 1] - whole[2 * a] + 1;
-    for (int step = 1; step < coarsestStep; step *= 2)
-      n = (n + 1) / 2; // each halving keeps voxels 0, 2, 4, ...
-    coarsest.dims[a] = n;
+    // Each halving keeps voxels 0, 2, 4, ...: a level of step s keeps ceil(n / s).
+    coarsest.dims[a] = (whole[2 * a + 1] - whole[2 * a] + coarsestStep) / coarsestStep;
     coarsest.origin[a] = origin[a] + whole[2 * a] * h[a];
     coarsest.spacing[a] = h[a] * coarsestStep;
   }
@@ -341,9 +337,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
   const int baseStep = half ? 2 : 1;
   for (int a = 0; a < 3; ++a)
   {
-    vao::Index3::value_type n = whole[2 * a + 1] - whole[2 * a] + 1;
-    if (half)
-      n = (n + 1) / 2;
+    const int n = (whole[2 * a + 1] - whole[2 * a] + baseStep) / baseStep; // ceil(voxels / step)
     base.wholeBounds[2 * a] = origin[a] + whole[2 * a] * h[a];
     base.wholeBounds[2 * a + 1] = base.wholeBounds[2 * a] + (n - 1) * h[a] * baseStep;
   }

@@ -5,7 +5,6 @@
 #include "vao/BlockSweeping.h"
 #include "vao/OcclusionSweeping.h"
 
-#include "vtkCommunicator.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkIntArray.h"
@@ -62,13 +61,7 @@ void SlabInputExtent(const int whole[6], int rank, int ranks, int ext[6])
   ext[2 * axis + 1] = std::min(whole[2 * axis + 1], ext[2 * axis + 1] + 1);
 }
 
-/// Max over the processes (a flag or a change).
-double GlobalMax(vtkMultiProcessController* controller, double value)
-{
-  double result = value;
-  controller->AllReduce(&value, &result, 1, vtkCommunicator::MAX_OP);
-  return result;
-}
+using vtkAmbientOcclusionInput::GlobalMax;
 
 /// Exchanges the face buffers with the slab neighbours (rank - 1 across the lower face,
 /// rank + 1 across the upper). Pairs go in rank order, the lower one sending first, so no

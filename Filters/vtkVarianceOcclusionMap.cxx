@@ -54,7 +54,7 @@ int vtkVarianceOcclusionMap::RequestUpdateExtent(
   int whole[6], piece[6], ext[6];
   inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
   vtkAmbientOcclusionInput::RequestedPiece(outputVector->GetInformationObject(0), whole, piece);
-  if (piece[0] > piece[1] || piece[2] > piece[3] || piece[4] > piece[5])
+  if (vtkAmbientOcclusionInput::EmptyExtent(piece))
   {
     std::copy(piece, piece + 6, ext); // nothing to output: ask for nothing
   }
@@ -79,7 +79,7 @@ int vtkVarianceOcclusionMap::RequestData(
   inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
   vtkAmbientOcclusionInput::RequestedPiece(outInfo, whole, piece);
   const int levels = std::max(0, this->NumberOfLevels);
-  if (piece[0] > piece[1] || piece[2] > piece[3] || piece[4] > piece[5])
+  if (vtkAmbientOcclusionInput::EmptyExtent(piece))
   {
     output->SetNumberOfBlocks(static_cast<unsigned int>(levels)); // an empty piece
     return 1;

@@ -147,7 +147,7 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
   // An extent request is grown here; a piece request (MPI ranks, streaming by pieces) is
   // turned into an extent by the source's executive, which grows it by the ghost levels:
   // ask for as many more as the largest radius, as vtkImageGradient asks for one.
-  if (ext[0] <= ext[1] && ext[2] <= ext[3] && ext[4] <= ext[5])
+  if (!vtkAmbientOcclusionInput::EmptyExtent(ext))
   {
     GrowExtent(ext, radius, whole);
   }
