@@ -1,7 +1,9 @@
 # The streaming test: -DVAO_STREAM=<vao_stream> -DWORK_DIR=<folder>. Generates a 97x83x61
 # phantom, computes Gaussian CDF AO (R = 5) in one piece and in 7, and CDF Reconstruction
-# (extrema too) in 1 and 5; the raw outputs must be identical and the reader must never
-# have held all 61 slices when streaming.
+# (extrema too) in 1 and 5; the raw outputs must be identical, the reader must never
+# have held all 61 slices when streaming, and both files, read back with VTK's MetaImage
+# reader, must give the filter's in-memory result exactly. Bad files and arguments must
+# fail with exit code 2 and a message.
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
 
@@ -30,6 +32,28 @@ foreach(case "gaussian;7" "cdf;5")
   if(different)
     message(FATAL_ERROR "FAILED: ${method} in ${pieces} pieces differs from one piece")
   endif()
-  message("${method}: ${pieces} pieces equal one piece; ${found}")
+  run_stream(check "${WORK_DIR}/phantom.mhd" "${WORK_DIR}/${method}_${pieces}.mhd" --radius 5 --method ${method})
+  if(NOT stream_output MATCHES "max difference 0 over 491111 voxels")
+    message(FATAL_ERROR "FAILED: ${method} in ${pieces} pieces, read back, differs from the in-memory filter")
+  endif()
+  message("${method}: ${pieces} pieces equal one piece and the in-memory filter; ${found}")
 endforeach()
+
+function(expect_refusal text)
+  execute_process(COMMAND "${VAO_STREAM}" ${ARGN} RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT status EQUAL 2 OR NOT "${out}${err}" MATCHES "${text}")
+    message(FATAL_ERROR "FAILED: vao_stream ${ARGN}: exit ${status} (want 2), output: ${out}${err}")
+  endif()
+  message("refused as expected: vao_stream ${ARGN}")
+endfunction()
+file(WRITE "${WORK_DIR}/compressed.mhd"
+  "NDims = 3\nDimSize = 4 4 4\nElementType = MET_SHORT\nCompressedData = True\nElementDataFile = x.raw\n")
+file(WRITE "${WORK_DIR}/local.mhd" "NDims = 3\nDimSize = 4 4 4\nElementType = MET_SHORT\nElementDataFile = LOCAL\n")
+expect_refusal("cannot open" ao "${WORK_DIR}/missing.mhd" "${WORK_DIR}/out.mhd")
+expect_refusal("compressed data cannot be read in pieces" ao "${WORK_DIR}/compressed.mhd" "${WORK_DIR}/out.mhd")
+expect_refusal("separate raw file" ao "${WORK_DIR}/local.mhd" "${WORK_DIR}/out.mhd")
+expect_refusal("usage" ao "${WORK_DIR}/phantom.mhd" "${WORK_DIR}/out.mhd" --pieces 0)
+expect_refusal("usage" ao "${WORK_DIR}/phantom.mhd" "${WORK_DIR}/out.mhd" --radius -1)
+expect_refusal("usage" ao "${WORK_DIR}/phantom.mhd" "${WORK_DIR}/out.mhd" --method box)
+expect_refusal("cannot open" check "${WORK_DIR}/missing.mhd" "${WORK_DIR}/gaussian_7.mhd")
 message("streaming: passed")

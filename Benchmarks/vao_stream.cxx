@@ -7,6 +7,9 @@
 //       the project's head phantom (int16), generated and written slab by slab
 //   vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method gaussian|cdf|chebyshev]
 //       float32 AmbientOcclusion of an uncompressed MetaImage (.mhd + raw data file)
+//   vao_stream check IN.mhd AO.mhd [--radius R] [--method ...]
+//       reads both back with vtkMetaImageReader and compares AO.mhd with the filter run on
+//       the whole input in memory (for volumes that fit)
 //
 // Both print the slabs, the most slices the reader held at once and the peak resident
 // memory (VmHWM). Exit status: 0 done, 1 failed, 2 bad arguments or files.
@@ -17,14 +20,17 @@
 #include <vtkDataArray.h>
 #include <vtkImageData.h>
 #include <vtkImageReader.h>
+#include <vtkMetaImageReader.h>
 #include <vtkInformation.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
+#include <vtkSmartPointer.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkType.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -301,8 +307,81 @@ int Usage()
 {
   std::fprintf(stderr,
     "usage: vao_stream generate OUT.mhd NX NY NZ\n"
-    "       vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method gaussian|cdf|chebyshev]\n");
+    "       vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method gaussian|cdf|chebyshev]\n"
+    "       vao_stream check IN.mhd AO.mhd [--radius R] [--method gaussian|cdf|chebyshev]\n");
   return 2;
+}
+
+/// Reads a whole MetaImage with VTK's own reader (nullptr with a message if it cannot).
+vtkSmartPointer<vtkImageData> ReadWhole(const std::string& path)
+{
+  vtkNew<vtkMetaImageReader> reader;
+  if (!reader->CanReadFile(path.c_str()))
+  {
+    std::fprintf(stderr, "vao_stream: cannot open %s\n", path.c_str());
+    return nullptr;
+  }
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->ShallowCopy(reader->GetOutput());
+  return image;
+}
+
+/// Reads both files back with vtkMetaImageReader (an independent reader: header, type and
+/// orientation), computes the AO of the whole input in memory and compares.
+int Check(const std::string& inPath, const std::string& aoPath, double radius, int method)
+{
+  auto input = ReadWhole(inPath), streamed = ReadWhole(aoPath);
+  if (!input || !streamed)
+    return 2;
+  vtkNew<vtkVolumetricAmbientOcclusion> filter;
+  filter->SetInputData(input);
+  filter->SetMethod(method);
+  filter->SetRadius(radius);
+  filter->Update();
+  vtkDataArray* want = filter->GetOutput()->GetPointData()->GetArray("AmbientOcclusion");
+  vtkDataArray* got = streamed->GetPointData()->GetScalars();
+  if (!want || !got || want->GetNumberOfTuples() != got->GetNumberOfTuples() ||
+    !std::equal(input->GetDimensions(), input->GetDimensions() + 3, streamed->GetDimensions()))
+  {
+    std::fprintf(stderr, "vao_stream: %s does not match %s in size\n", aoPath.c_str(), inPath.c_str());
+    return 1;
+  }
+  double worst = 0.0;
+  for (vtkIdType i = 0; i < want->GetNumberOfTuples(); ++i)
+    worst = std::max(worst, std::abs(want->GetTuple1(i) - got->GetTuple1(i)));
+  std::printf("check: %s against the in-memory filter: max difference %g over %lld voxels\n",
+    aoPath.c_str(), worst, static_cast<long long>(want->GetNumberOfTuples()));
+  return worst == 0.0 ? 0 : 1;
+}
+
+/// --radius and --method (and --pieces where allowed) from argv[first..]; false on a bad one.
+bool ParseOptions(int argc, char* argv[], int first, bool piecesAllowed, int& pieces, double& radius, int& method)
+{
+  for (int i = first; i < argc; ++i)
+  {
+    const std::string a = argv[i];
+    if (a == "--pieces" && piecesAllowed && i + 1 < argc)
+      pieces = std::atoi(argv[++i]);
+    else if (a == "--radius" && i + 1 < argc)
+      radius = std::atof(argv[++i]);
+    else if (a == "--method" && i + 1 < argc)
+    {
+      const std::string m = argv[++i];
+      if (m == "gaussian")
+        method = vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF;
+      else if (m == "cdf")
+        method = vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION;
+      else if (m == "chebyshev")
+        method = vtkVolumetricAmbientOcclusion::CHEBYSHEV;
+      else
+        return false;
+    }
+    else
+      return false;
+  }
+  return pieces >= 1 && radius > 0.0;
 }
 
 } // namespace
@@ -317,34 +396,13 @@ int main(int argc, char* argv[])
       return Usage();
     return Generate(argv[2], dims);
   }
-  if (command != "ao" || argc < 4)
+  if ((command != "ao" && command != "check") || argc < 4)
     return Usage();
   int pieces = 16;
   double radius = 10.0;
   int method = vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF;
-  for (int i = 4; i < argc; ++i)
-  {
-    const std::string a = argv[i];
-    if (a == "--pieces" && i + 1 < argc)
-      pieces = std::atoi(argv[++i]);
-    else if (a == "--radius" && i + 1 < argc)
-      radius = std::atof(argv[++i]);
-    else if (a == "--method" && i + 1 < argc)
-    {
-      const std::string m = argv[++i];
-      if (m == "gaussian")
-        method = vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF;
-      else if (m == "cdf")
-        method = vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION;
-      else if (m == "chebyshev")
-        method = vtkVolumetricAmbientOcclusion::CHEBYSHEV;
-      else
-        return Usage();
-    }
-    else
-      return Usage();
-  }
-  if (pieces < 1 || !(radius > 0.0))
+  if (!ParseOptions(argc, argv, 4, command == "ao", pieces, radius, method))
     return Usage();
-  return AmbientOcclusion(argv[2], argv[3], pieces, radius, method);
+  return command == "ao" ? AmbientOcclusion(argv[2], argv[3], pieces, radius, method)
+                         : Check(argv[2], argv[3], radius, method);
 }
