@@ -18,7 +18,6 @@ LoadPlugin(plugin, remote=True, ns=globals())
 # the reach of its finer levels; one shared output cannot hold both at once. A
 # pass-through logs the extent the filter's volume input received (<OUT>.volume.<rank>).
 pieces = XMLImageDataReader(FileName=[source_path])
-
 volume = extent_logger(XMLImageDataReader(FileName=[source_path]), target + ".volume")
 bone = Contour(Input=pieces, ContourBy=["POINTS", "MetaImage"], Isosurfaces=[400.0], ComputeNormals=0)
 shaded = IsosurfaceAmbientOcclusion(Input=bone, Volume=volume, ComputeShadows=1, LightDirection=[0.0, -1.0, 1.0])
@@ -45,7 +44,6 @@ for l in range(blocks.GetNumberOfBlocks()):
     if level is None or level.GetNumberOfPoints() == 0:
         continue
     arrays["extent%d" % l] = np.array(level.GetExtent())
-    arrays["spacing%d" % l] = np.array(level.GetSpacing())
     for name in ("Mean", "Variance"):
         arrays["%s%d" % (name, l)] = vtk_to_numpy(level.GetPointData().GetArray(name))
 np.savez(TARGET + ".pyramid.%d.npz" % rank, **arrays)
