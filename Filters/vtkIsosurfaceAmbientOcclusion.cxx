@@ -478,7 +478,7 @@ int vtkIsosurfaceAmbientOcclusion::RequestData(
   parameters.query = static_cast<vao::SurfaceQuery>(this->QueryMode);
   parameters.isoValue = this->IsoValue;
   parameters.offsetFactor = this->OffsetFactor;
-  parameters.estimator = static_cast<vao::SurfaceEstimator>(this->Estimator);
+  parameters.estimator = this->Estimator == GAUSSIAN_CDF ? vao::Method::GaussianCdf : vao::Method::Chebyshev;
   parameters.combination = static_cast<vao::LevelCombination>(this->Combine);
   const Cache& cache = *this->Pyramid;
   const vao::Execution execution = vtkAmbientOcclusionInput::ExecutionOf(this);

@@ -385,7 +385,7 @@ TEST(SurfaceAO, SphereInAirIsOpenAndDarkerInsideABox)
   for (std::size_t i = 0; i < open.size(); ++i)
     EXPECT_GE(meanCombined[i], closed[i] - 1e-6f);
   p = {};
-  p.estimator = vao::SurfaceEstimator::GaussianCdf;
+  p.estimator = vao::Method::GaussianCdf;
   p.query = vao::SurfaceQuery::IsoValue;
   p.isoValue = 0.5;
   for (float x : ao(boxed, pyramidOf(boxed), points, normals, p))

@@ -103,19 +103,25 @@ struct BoxStatisticsOutput
   double* maximum = nullptr;
 };
 
-/// Result of a kernel call: ok, or why not (bad arguments, cancelled).
+/// Result of a kernel call: ok, or why not (bad arguments, non-finite input, cancelled).
 struct Status
 {
   bool ok = true;
   bool aborted = false;
   std::string message;
+  // Non-finite input values: how many, and the first one's index in the volume (x
+  // fastest), so that a caller can name its voxel in its own coordinates.
+  std::int64_t nonFiniteCount = 0;
+  std::int64_t firstNonFinite = -1;
 
   static Status success() { return {}; }
   static Status failure(std::string why) { return { false, false, std::move(why) }; }
   static Status cancelled() { return { false, true, "cancelled" }; }
+  static Status nonFinite(std::int64_t count, std::int64_t first);
 };
 
-/// Checks the volume, region and radius; returns the first problem found.
+/// Checks the volume, region and radius; returns the first problem found
+/// (vao/Validation.h has the single checks).
 Status validate(const VolumeView& volume, const Region& region, const Radius& radius);
 
 /// Openness (and optionally the variance) of every voxel of the region.
@@ -128,7 +134,7 @@ Status computeBoxStatistics(const VolumeView& volume, const Region& region, cons
   const BoxStatisticsOutput& output, const Execution& execution = {});
 
 /// Number of voxels that are NaN or infinite (always 0 for integer types); the index of the
-/// first one goes to firstIndex when not null.
+/// first one goes to firstIndex when not null. Runs on every core.
 std::int64_t countNonFinite(const VolumeView& volume, std::int64_t* firstIndex = nullptr);
 
 /// Smallest and largest value of the volume (finite values assumed).

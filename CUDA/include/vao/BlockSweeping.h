@@ -115,7 +115,7 @@ public:
 
 private:
   struct State;
-  std::unique_ptr<State> S;
+  std::unique_ptr<State> Impl;
 };
 
 } // namespace vao

@@ -28,12 +28,13 @@ void freeLevelStorage(void* block) noexcept;
 
 } // namespace detail
 
+/// The value of a bound that is not set (MomentLevel::wholeBounds).
+constexpr double kUnsetBound = std::numeric_limits<double>::quiet_NaN();
+
 /// A level's array of floats in level storage. resize leaves the elements uninitialised:
 /// the pyramid builder writes every one, in parallel, so a fresh array is first touched by
 /// the threads that fill it instead of by one serial zero-fill. release() hands the block
 /// to a new owner (a vtkFloatArray, without a copy), who frees it with freeLevelStorage.
-constexpr double kUnsetBound = std::numeric_limits<double>::quiet_NaN();
-
 class LevelArray
 {
 public:
@@ -144,12 +145,6 @@ enum class SurfaceQuery : int
   IsoValue = 1,        // q = c
 };
 
-enum class SurfaceEstimator : int
-{
-  Chebyshev = 0,
-  GaussianCdf = 1,
-};
-
 enum class LevelCombination : int
 {
   MaximumOcclusion = 0,
@@ -161,7 +156,8 @@ struct SurfaceOcclusionParameters
   SurfaceQuery query = SurfaceQuery::HalfVoxelInside;
   double isoValue = 0.0;
   double offsetFactor = 1.0; // k: samples at p + k r_l n
-  SurfaceEstimator estimator = SurfaceEstimator::Chebyshev;
+  Method estimator = Method::Chebyshev; // Chebyshev or GaussianCdf (the only ones a level's
+                                       // blurred mean and variance can feed)
   LevelCombination combination = LevelCombination::MaximumOcclusion;
   int levels = -1; // levels used, -1: all of the pyramid
 };
@@ -191,17 +187,13 @@ Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* poin
   std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
   float* out, const Execution& execution = {});
 
-/// Trilinear value of the volume at a world position (clamped to its bounds), with
-/// `origin`/`spacing` its geometry: the interpolation of the half-voxel-inside query.
-double sampleVolume(const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const std::array<double, 3>& position);
-
 /// Trilinear sample of a level's mean and variance at a world position (clamped to the
 /// level's bounds).
 void sampleLevel(const MomentLevel& level, const std::array<double, 3>& position, double& mean, double& variance);
 
 /// Trilinear sample of the volume (any scalar type) at a world position, clamped to the
-/// volume: voxel (0, 0, 0) at `origin`, `spacing` per axis.
+/// volume: voxel (0, 0, 0) at `origin`, `spacing` per axis. The interpolation of the
+/// half-voxel-inside query.
 double sampleVolume(const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const std::array<double, 3>& position);
 

@@ -3,15 +3,15 @@
 // Pipeline.h (shared with the host emulation that tests them without a GPU) and
 // Estimators.h (shared with the CPU path).
 #include "vao/Cuda.h"
+#include "vao/Validation.h"
 
-#include "../VolumeAccess.h"
+#include "VolumeAccess.h"
 #include "Pipeline.h"
 
 #include <cuda_runtime.h>
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -29,6 +29,11 @@ using gpu::Index;
 struct CudaFailure : std::runtime_error
 {
   using std::runtime_error::runtime_error;
+};
+
+/// The user aborted between two stages: unwinds like a failure, reported as cancelled.
+struct Cancelled
+{
 };
 
 void check(cudaError_t error, const char* what)
@@ -157,7 +162,7 @@ public:
     if (this->Exec.progress)
       this->Exec.progress(fraction);
     if (this->Exec.abortRequested && this->Exec.abortRequested())
-      throw CudaFailure("cancelled");
+      throw Cancelled{};
   }
 
   /// Waits for the passes and reports their times.
@@ -289,6 +294,8 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   const gpu::EstimatorSetting& estimator, const HostOutputs& host, const Execution& execution, Timing* timing)
 {
   Status status = validate(view, region, radius);
+  if (status.ok)
+    status = checkFiniteValues(view);
   if (!status.ok)
   {
     return status;
@@ -313,7 +320,12 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   catch (const CudaFailure& failure)
   {
     cudaGetLastError(); // clear a non-sticky error so the next call starts clean
-    return std::strcmp(failure.what(), "cancelled") == 0 ? Status::cancelled() : Status::failure(failure.what());
+    return Status::failure(failure.what());
+  }
+  catch (const Cancelled&)
+  {
+    cudaGetLastError();
+    return Status::cancelled();
   }
   catch (const std::bad_alloc&)
   {
@@ -371,9 +383,11 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   {
     return Status::failure("the exact references (Exact Box, Exact Sphere) run on the CPU only");
   }
-  if (p.queryMode == QueryMode::IsoValue && !std::isfinite(p.isoValue))
+  if (p.queryMode == QueryMode::IsoValue)
   {
-    return Status::failure("the iso value must be a finite number");
+    const Status iso = checkFiniteParameter(p.isoValue, "the iso value");
+    if (!iso.ok)
+      return iso;
   }
   HostOutputs host;
   host.openness = output.openness;

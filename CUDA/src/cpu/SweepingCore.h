@@ -1,5 +1,7 @@
-// The stages of occlusion sweeping (OcclusionSweeping.cxx), shared by the whole-volume
-// driver computeOcclusionSweeping and the block driver BlockSweeper (BlockSweeping.cxx).
+// The stages of occlusion sweeping, shared by the whole-volume driver
+// computeOcclusionSweeping (OcclusionSweeping.cxx) and the block driver BlockSweeper
+// (BlockSweeping.cxx). Where each lives: SweepStages.cxx (checks, initial distance, fixed
+// mask, combination), SweepKernel.cxx (the sweeps), SweepGeometryTerm.cxx (G_s(N)).
 //
 // A SweepLayout says where the swept voxels lie in the arrays (D, fixed, V) and in the whole
 // volume. The whole volume: the arrays are the volume, and upwind neighbours outside it are
@@ -94,9 +96,20 @@ struct VisibilityStore
   }
 };
 
-/// Rejects bad volumes (under 2 voxels per axis, non-finite values) and parameters.
+/// Rejects bad spacings and parameters (cheap: no pass over the data).
+Status validateSweepParameters(
+  const std::array<double, 3>& spacing, const SweepParameters& p, const SweepOutput& output);
+
+/// validateSweepParameters, plus the volume: at least 2 voxels per axis, finite values
+/// (one parallel pass).
 Status validateSweep(const VolumeView& volume, const std::array<double, 3>& spacing,
   const SweepParameters& p, const SweepOutput& output);
+
+/// N normalised; a zero or non-finite N (a flat distance field) becomes +z.
+std::array<double, 3> unitNormal(double x, double y, double z);
+
+/// G_s(N) of all eight octants for a unit N (twoSided: G_s(N) + G_s(-N)).
+void allGeometryTerms(const std::array<double, 3>& n, bool twoSided, double g[8]);
 
 /// Initial D of the own voxels, from scalars whose voxel scalarOffset is own voxel
 /// (0, 0, 0): an edge to a scalar neighbour is considered wherever the scalars have one.
@@ -106,7 +119,7 @@ std::int64_t initialiseDistance(const VolumeView& scalars, const Index3& scalarO
   const SweepLayout& layout, const SweepParameters& p, float* distance, int threads);
 
 /// One bit per storage voxel: the fixed voxels, whose D the sweeps never change. Bits,
-/// not bytes: 1/16 of an int16 volume instead of 1/2 (the working-memory bar of issue 7).
+/// not bytes: 1/16 of an int16 volume instead of 1/2 of working memory.
 /// Built from D right after initialiseDistance, where they are exactly the finite values
 /// (the others, ghosts included, are +-infinity).
 class FixedMask

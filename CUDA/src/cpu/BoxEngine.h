@@ -246,10 +246,8 @@ bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
   const auto shift = momentShift(volume);
   const int threads = resolveThreadCount(execution.threads);
   const std::int64_t nz = geometry.region.size[2];
-  LoopControl control(execution, nz);
-  parallelChunks(
-    nz, threads,
-    [&](std::int64_t begin, std::int64_t end, bool caller) {
+  return parallelFor(nz, threads, threads, execution,
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
       MomentPlanes<T> planes(volume, geometry, shift);
       for (std::int64_t k = begin; k < end; ++k)
       {
@@ -265,14 +263,12 @@ bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
         MomentSlice<T> slice{ z, planes.sum(), planes.sumSquares(), static_cast<double>(shift),
           clippedWindowCount(z, geometry.radius.z, geometry.dims[2]) };
         consume(slice);
-        if (!control.advance(1, caller))
+        if (!progress.advance())
         {
           return;
         }
       }
-    },
-    threads);
-  return !control.stopped();
+    });
 }
 
 /// Box minimum and maximum of every region voxel: planes of the slices the region reads,
@@ -305,18 +301,17 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
   planeMax.resize(static_cast<std::size_t>(slices * plane));
   result.offset = (region.begin[2] - geometry.zs.lo) * plane;
   const int threads = resolveThreadCount(execution.threads);
-  LoopControl control(execution, slices + region.size[1]);
-
-  parallelChunks(
-    slices, threads,
-    [&](std::int64_t begin, std::int64_t end, bool caller) {
+  // Progress: the slices of the x/y passes, then the rows of the z pass.
+  const std::int64_t work = slices + region.size[1];
+  const bool planesDone = parallelFor(slices, threads, threads, stageExecution(execution, 0.0, double(slices) / work),
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
       const std::int64_t span = geometry.xs.size();
       const std::int64_t rows = geometry.ys.size();
       std::vector<T> row(static_cast<std::size_t>(span));
       std::vector<T> xMin(static_cast<std::size_t>(rows * nx));
       std::vector<T> xMax(static_cast<std::size_t>(rows * nx));
       ExtremumScratch<T> scratch;
-      for (std::int64_t s = begin; s < end && !control.stopped(); ++s)
+      for (std::int64_t s = begin; s < end && !progress.stopped(); ++s)
       {
         const std::int64_t z = geometry.zs.lo + s;
         for (std::int64_t j = 0; j < rows; ++j)
@@ -334,25 +329,23 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
         const std::int64_t y0 = region.begin[1] - geometry.ys.lo;
         slidingMinMax(xMin.data(), xMax.data(), rows, nx, geometry.radius.y, y0, region.size[1],
           &planeMin[s * plane], &planeMax[s * plane], scratch);
-        control.advance(1, caller);
+        progress.advance();
       }
-    },
-    threads);
-  if (control.stopped())
+    });
+  if (!planesDone)
   {
     return false;
   }
 
-  parallelChunks(
-    region.size[1], threads,
-    [&](std::int64_t begin, std::int64_t end, bool caller) {
+  return parallelFor(region.size[1], threads, threads, stageExecution(execution, double(slices) / work, 1.0),
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
       std::vector<T> lanesMin(static_cast<std::size_t>(slices * nx));
       std::vector<T> lanesMax(static_cast<std::size_t>(slices * nx));
       std::vector<T> outMin(static_cast<std::size_t>(region.size[2] * nx));
       std::vector<T> outMax(static_cast<std::size_t>(region.size[2] * nx));
       ExtremumScratch<T> scratch;
       const std::int64_t z0 = region.begin[2] - geometry.zs.lo;
-      for (std::int64_t y = begin; y < end && !control.stopped(); ++y)
+      for (std::int64_t y = begin; y < end && !progress.stopped(); ++y)
       {
         // z pass: row y of every slice, gathered, is a sequence of lane vectors.
         for (std::int64_t s = 0; s < slices; ++s)
@@ -370,11 +363,9 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
           std::copy(&outMin[k * nx], &outMin[k * nx] + nx, &planeMin[to]);
           std::copy(&outMax[k * nx], &outMax[k * nx] + nx, &planeMax[to]);
         }
-        control.advance(1, caller);
+        progress.advance();
       }
-    },
-    threads);
-  return !control.stopped();
+    });
 }
 
 } // namespace detail

@@ -3,8 +3,8 @@
 #include "BoxEngine.h"
 #include "ExactReference.h"
 
-#include <limits>
-#include <sstream>
+#include "vao/Validation.h"
+
 
 namespace vao
 {
@@ -14,41 +14,6 @@ const char* scalarTypeName(ScalarType type)
   static const char* const names[] = { "int8", "uint8", "int16", "uint16", "int32", "uint32",
     "int64", "uint64", "float32", "float64" };
   return names[static_cast<int>(type)];
-}
-
-Status validate(const VolumeView& volume, const Region& region, const Radius& radius)
-{
-  std::ostringstream why;
-  if (!volume.data || volume.voxelCount() <= 0)
-  {
-    why << "the volume is empty (" << volume.dims[0] << " x " << volume.dims[1] << " x "
-        << volume.dims[2] << " voxels)";
-  }
-  else if (volume.voxelStride < 1)
-  {
-    why << "the voxel stride must be at least 1 (got " << volume.voxelStride << ")";
-  }
-  else if (radius.x < 0 || radius.y < 0 || radius.z < 0)
-  {
-    why << "the radius must not be negative (got " << radius.x << ", " << radius.y << ", "
-        << radius.z << " voxels)";
-  }
-  else
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      if (region.size[a] <= 0 || region.begin[a] < 0 ||
-        region.begin[a] + region.size[a] > volume.dims[a])
-      {
-        why << "the output region [" << region.begin[a] << ", " << region.begin[a] + region.size[a]
-            << ") of axis " << a << " is empty or outside the volume's " << volume.dims[a]
-            << " voxels";
-        break;
-      }
-    }
-  }
-  const std::string message = why.str();
-  return message.empty() ? Status::success() : Status::failure(message);
 }
 
 namespace
@@ -86,13 +51,13 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   const Execution& execution)
 {
   Status status = validate(volume, region, parameters.radius);
+  if (status.ok && parameters.queryMode == QueryMode::IsoValue)
+    status = checkFiniteParameter(parameters.isoValue, "the iso value");
+  if (status.ok)
+    status = checkFiniteValues(volume);
   if (!status.ok)
   {
     return status;
-  }
-  if (parameters.queryMode == QueryMode::IsoValue && !std::isfinite(parameters.isoValue))
-  {
-    return Status::failure("the iso value must be a finite number");
   }
   AmbientOcclusionOutput separable = output;
   if (!isSeparableMethod(parameters.method))
@@ -113,32 +78,6 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
     return separableOpenness<decltype(tag)>(volume, region, parameters, separable,
       isSeparableMethod(parameters.method) ? execution
                                            : detail::stageExecution(execution, 0.9, 1.0));
-  });
-}
-
-std::int64_t countNonFinite(const VolumeView& view, std::int64_t* firstIndex)
-{
-  return detail::dispatchScalarType(view.type, [&](auto tag) -> std::int64_t {
-    using T = decltype(tag);
-    if (std::is_integral<T>::value)
-    {
-      return 0;
-    }
-    const T* data = static_cast<const T*>(view.data);
-    std::int64_t count = 0;
-    const std::int64_t n = view.voxelCount();
-    for (std::int64_t i = 0; i < n; ++i)
-    {
-      if (!std::isfinite(static_cast<double>(data[i * view.voxelStride])))
-      {
-        if (count == 0 && firstIndex)
-        {
-          *firstIndex = i;
-        }
-        ++count;
-      }
-    }
-    return count;
   });
 }
 

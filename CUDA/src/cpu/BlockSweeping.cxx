@@ -130,7 +130,7 @@ struct BlockSweeper::State
 BlockSweeper::BlockSweeper(const VolumeView& scalars, const BlockPlacement& placement,
   const std::array<double, 3>& spacing, const SweepParameters& parameters,
   const Execution& execution)
-  : S(new State(scalars, placement, spacing, parameters, execution))
+  : Impl(new State(scalars, placement, spacing, parameters, execution))
 {
 }
 
@@ -138,7 +138,7 @@ BlockSweeper::~BlockSweeper() = default;
 
 Status BlockSweeper::initialise()
 {
-  State& s = *this->S;
+  State& s = *this->Impl;
   Status status = validatePlacement(s.scalars, s.placement);
   if (status.ok)
   {
@@ -178,12 +178,12 @@ Status BlockSweeper::initialise()
 
 bool BlockSweeper::surfaceFound() const
 {
-  return this->S->surfaceFound;
+  return this->Impl->surfaceFound;
 }
 
 void BlockSweeper::fillWithoutSurface()
 {
-  State& s = *this->S;
+  State& s = *this->Impl;
   if (!s.initialised)
   {
     return;
@@ -195,7 +195,7 @@ void BlockSweeper::fillWithoutSurface()
 
 Status BlockSweeper::runRound(int maxPasses, SweepReport* report)
 {
-  State& s = *this->S;
+  State& s = *this->Impl;
   if (!s.initialised)
   {
     return Status::failure("runRound before a successful initialise()");
@@ -216,7 +216,7 @@ Status BlockSweeper::runRound(int maxPasses, SweepReport* report)
 
 std::int64_t BlockSweeper::faceValueCount(int face) const
 {
-  const State& s = *this->S;
+  const State& s = *this->Impl;
   if (face < 0 || face >= kBlockFaces || !s.placement.hasNeighbour(face))
   {
     return 0;
@@ -228,7 +228,7 @@ std::int64_t BlockSweeper::faceValueCount(int face) const
 
 void BlockSweeper::exportFace(int face, float* buffer) const
 {
-  const State& s = *this->S;
+  const State& s = *this->Impl;
   if (!s.initialised || this->faceValueCount(face) == 0)
   {
     return;
@@ -244,7 +244,7 @@ void BlockSweeper::exportFace(int face, float* buffer) const
 
 double BlockSweeper::importFace(int face, const float* buffer)
 {
-  State& s = *this->S;
+  State& s = *this->Impl;
   if (!s.initialised || this->faceValueCount(face) == 0)
   {
     return 0.0;
@@ -268,12 +268,12 @@ double BlockSweeper::importFace(int face, const float* buffer)
 
 Status BlockSweeper::finish(const SweepOutput& output)
 {
-  State& s = *this->S;
+  State& s = *this->Impl;
   if (!s.initialised)
   {
     return Status::failure("finish before a successful initialise()");
   }
-  const Status status = validateSweep(s.scalars, s.spacing, s.parameters, output);
+  const Status status = validateSweepParameters(s.spacing, s.parameters, output); // the volume was checked by initialise()
   if (!status.ok)
   {
     return status;

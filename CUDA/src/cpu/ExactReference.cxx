@@ -112,24 +112,20 @@ Status computeExactOpenness(const VolumeView& view, const Region& region,
       halfWidths.push_back(rowHalfWidth(r, dy, dz, sphere));
     }
   }
-  const int threads = resolveThreadCount(execution.threads);
-  LoopControl control(execution, region.size[2]);
-  dispatchScalarType(view.type, [&](auto tag) {
+  const bool finished = dispatchScalarType(view.type, [&](auto tag) {
     using T = decltype(tag);
     const TypedVolume<T> volume(view);
     // One slice per chunk: slices cost the same, and progress moves often.
-    parallelChunks(
-      region.size[2], static_cast<int>(region.size[2]),
-      [&](std::int64_t begin, std::int64_t end, bool caller) {
-        for (std::int64_t k = begin; k < end && !control.stopped(); ++k)
+    return parallelFor(region.size[2], static_cast<int>(region.size[2]), execution.threads, execution,
+      [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+        for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
         {
           exactSlice(volume, region, p, halfWidths, region.begin[2] + k, openness);
-          control.advance(1, caller);
+          progress.advance();
         }
-      },
-      threads);
+      });
   });
-  return control.stopped() ? Status::cancelled() : Status::success();
+  return finished ? Status::success() : Status::cancelled();
 }
 
 } // namespace detail

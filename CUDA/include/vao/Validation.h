@@ -1,0 +1,37 @@
+// The checks every entry point of the kernel library makes, written once. Each returns
+// Status::success() or a failure whose message names what was wrong and where; the VTK
+// filters pass the message on (adding their own array and voxel coordinates) and check
+// only what is VTK's (arrays, enums).
+#pragma once
+
+#include "vao/AmbientOcclusion.h"
+
+#include <array>
+
+namespace vao
+{
+
+/// Data present, every axis at least `minimumPerAxis` voxels, stride >= 1.
+/// `method` names what needs them in the message when minimumPerAxis > 1.
+Status checkVolume(const VolumeView& volume, std::int64_t minimumPerAxis = 1, const char* method = nullptr);
+
+/// The region lies in the volume and is not empty.
+Status checkRegion(const VolumeView& volume, const Region& region);
+
+/// No negative half-width.
+Status checkRadius(const Radius& radius);
+
+/// Every spacing finite and > 0 (`what`: "the spacing", "the volume's spacing", ...).
+Status checkSpacing(const std::array<double, 3>& spacing, const char* what = "the spacing");
+
+/// Every coordinate finite.
+Status checkFinitePoint(const std::array<double, 3>& point, const char* what);
+
+/// A parameter that must be a finite number.
+Status checkFiniteParameter(double value, const char* what);
+
+/// No NaN or infinite voxel; otherwise Status::nonFinite (count and first index). One
+/// parallel pass over the data (none for integer types).
+Status checkFiniteValues(const VolumeView& volume);
+
+} // namespace vao

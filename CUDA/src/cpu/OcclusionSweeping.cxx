@@ -1,0 +1,131 @@
+// Occlusion sweeping (Singh, Yuksel & House 2009; the Singh et al. section of METHODS.md):
+// fast sweeping of the signed distance with the octant visibility of Eq. 6 carried along
+// in the same sweeps, then the per-voxel combination into AmbientOcclusion (Eq. 4/5).
+// This file is the whole-volume driver; the stages are in SweepingCore.h.
+//
+// D is a signed float field: the sign is fixed at initialisation by inside(v), and the
+// sweeps only lower |D|.
+#include "vao/OcclusionSweeping.h"
+
+#include "Parallel.h"
+#include "SweepingCore.h"
+
+#include <algorithm>
+#include <new>
+#include <vector>
+
+namespace vao
+{
+namespace
+{
+
+using namespace detail::sweeping;
+
+/// What the request needs: the octants whose V is computed, and whether V is kept per
+/// octant (OctantVisibility, or the geometry term that needs the final N).
+VisibilityStore planVisibility(
+  const Grid& grid, const SweepParameters& p, const SweepOutput& out, int sweepThreads)
+{
+  VisibilityStore vis;
+  int computedCount = 0;
+  for (int s = 0; s < 8; ++s)
+  {
+    vis.computed[s] = out.octantVisibility || (out.ambientOcclusion && p.octantMask[s]);
+    computedCount += vis.computed[s];
+  }
+  vis.kept = out.octantVisibility || (out.ambientOcclusion && p.useGeometryTerm);
+  if (vis.kept)
+  {
+    vis.storage.resize(static_cast<std::size_t>(computedCount * grid.count));
+    float* next = vis.storage.data();
+    for (int s = 0; s < 8; ++s)
+      if (vis.computed[s])
+      {
+        vis.field[s] = next;
+        next += grid.count;
+      }
+  }
+  else if (computedCount > 0)
+  {
+    vis.ringPlanes = std::min<std::int64_t>(grid.nz, sweepThreads + 1);
+    vis.ring.resize(static_cast<std::size_t>(vis.ringPlanes * grid.plane));
+    vis.sum = out.ambientOcclusion;
+  }
+  return vis;
+}
+
+Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& spacing,
+  const SweepParameters& p, const SweepOutput& out, const Execution& execution, SweepReport& report)
+{
+  const SweepLayout layout = SweepLayout::wholeVolume(volume.dims, spacing);
+  const Grid& grid = layout.storage;
+  const int threads = detail::resolveThreadCount(execution.threads);
+  std::vector<float> ownDistance;
+  float* distance = out.signedDistance;
+  if (!distance)
+  {
+    ownDistance.resize(static_cast<std::size_t>(grid.count));
+    distance = ownDistance.data();
+  }
+  const int sweepThreads = static_cast<int>(std::min<std::int64_t>(threads, grid.nz));
+  VisibilityStore vis = planVisibility(grid, p, out, sweepThreads);
+  double maskCount = 0.0;
+  for (bool m : p.octantMask)
+    maskCount += m;
+
+  const std::int64_t fixedCount = initialiseDistance(volume, { 0, 0, 0 }, layout, p, distance, threads);
+  FixedMask fixed;
+  fixed.build(distance, grid.count, threads);
+  report.surfaceFound = fixedCount > 0;
+  report.passes = 0;
+  report.lastChange = 0.0;
+  if (report.surfaceFound)
+  {
+    const Status status = runPasses(layout, p, distance, fixed, vis, sweepThreads,
+      detail::stageExecution(execution, 0.0, 0.95), report);
+    if (!status.ok)
+    {
+      return status;
+    }
+  }
+  else
+  {
+    fillWithoutSurface(layout, distance[0] < 0.0f, distance, vis, maskCount);
+  }
+  const Status status = combine(layout, p, out, distance, vis, maskCount, threads,
+    detail::stageExecution(execution, 0.95, 1.0));
+  if (!status.ok)
+  {
+    return status;
+  }
+  if (execution.progress)
+  {
+    execution.progress(1.0); // the last chunk may have finished on another thread
+  }
+  return Status::success();
+}
+
+} // namespace
+Status computeOcclusionSweeping(const VolumeView& volume, const std::array<double, 3>& spacing,
+  const SweepParameters& parameters, const SweepOutput& output, const Execution& execution,
+  SweepReport* report)
+{
+  const Status status = validateSweep(volume, spacing, parameters, output);
+  if (!status.ok)
+  {
+    return status;
+  }
+  SweepReport local;
+  try
+  {
+    const Status result =
+      occlusionSweeping(volume, spacing, parameters, output, execution, report ? *report : local);
+    return result;
+  }
+  catch (const std::bad_alloc&)
+  {
+    return Status::failure("not enough memory for the sweeping buffers");
+  }
+}
+
+} // namespace vao
