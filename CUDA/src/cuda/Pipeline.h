@@ -62,6 +62,21 @@ struct AxisPass
   VAO_HD Index blocks() const { return (n + 2 * r) / (2 * r + 1); } // van Herk blocks per lane
 };
 
+/// The van Herk block of one thread: its lane and the block [start, end) along the axis.
+struct VanHerkBlock
+{
+  Index lane;
+  Index start;
+  Index end;
+
+  VAO_HD VanHerkBlock(const AxisPass& pass, Index thread)
+    : lane(thread % pass.lanes)
+    , start((thread / pass.lanes) * (2 * pass.r + 1))
+    , end(lower(start + 2 * pass.r + 1, pass.n))
+  {
+  }
+};
+
 /// Outputs one thread of a running-sum pass computes: its initial window costs 2r + 1
 /// additions, spread over at least as many outputs, so the cost per voxel stays O(1).
 VAO_HD Index segmentLength(Index r)
@@ -163,9 +178,8 @@ struct ExtremaSuffixKernel
 
   VAO_HD void operator()(Index thread) const
   {
-    const Index lane = thread % pass.lanes;
-    const Index start = (thread / pass.lanes) * (2 * pass.r + 1);
-    const Index end = lower(start + 2 * pass.r + 1, pass.n);
+    const VanHerkBlock block(pass, thread);
+    const Index lane = block.lane, start = block.start, end = block.end;
     Index at = pass.in.at(lane, end - 1);
     T lo = inMin[at], hi = inMax[at];
     sufMin[at] = lo;
@@ -198,9 +212,8 @@ struct ExtremaOutputKernel
 
   VAO_HD void operator()(Index thread) const
   {
-    const Index lane = thread % pass.lanes;
-    const Index start = (thread / pass.lanes) * (2 * pass.r + 1);
-    const Index end = lower(start + 2 * pass.r + 1, pass.n); // block [start, end)
+    const VanHerkBlock block(pass, thread);
+    const Index lane = block.lane, start = block.start, end = block.end;
     T preMin = inMin[pass.in.at(lane, start)], preMax = inMax[pass.in.at(lane, start)];
     Index prefixEnd = start; // the prefix covers [start, prefixEnd]
     // The outputs whose window end hi = min(n - 1, i + r) lies in [start, end): windows
