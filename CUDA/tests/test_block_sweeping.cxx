@@ -60,49 +60,21 @@ std::vector<float> blockScalars(const std::vector<float>& values, const vao::Blo
   return out;
 }
 
-/// Sweeps the volume split into blocks[0] x blocks[1] x blocks[2] blocks, each with
-/// p.iterations passes per round at most, and assembles the outputs.
-Distributed sweepInBlocks(const std::vector<float>& values, const vao::Index3& dims,
-  const Spacing& h, const Blocks& blocks, const vao::SweepParameters& p, bool withOutputs = true,
-  const Emulation& emulation = {})
-{
-  Distributed result;
-  const int count = blocks[0] * blocks[1] * blocks[2];
-  auto blockIndex = [&](int bx, int by, int bz) { return (bz * blocks[1] + by) * blocks[0] + bx; };
-  std::vector<vao::BlockPlacement> placements(count);
-  std::vector<std::array<int, 6>> neighbours(count);
-  std::vector<std::vector<float>> scalars(count);
-  std::vector<std::unique_ptr<vao::BlockSweeper>> sweepers;
-  for (int bz = 0; bz < blocks[2]; ++bz)
-    for (int by = 0; by < blocks[1]; ++by)
-      for (int bx = 0; bx < blocks[0]; ++bx)
-      {
-        const int b = blockIndex(bx, by, bz);
-        const int position[3] = { bx, by, bz };
-        vao::BlockPlacement& placement = placements[b];
-        placement.whole = dims;
-        for (int a = 0; a < 3; ++a)
-        {
-          placement.begin[a] = cut(dims[a], blocks[a], position[a]);
-          placement.size[a] = cut(dims[a], blocks[a], position[a] + 1) - placement.begin[a];
-        }
-        for (int face = 0; face < vao::kBlockFaces; ++face)
-        {
-          int q[3] = { bx, by, bz };
-          q[face / 2] += (face & 1) ? 1 : -1;
-          neighbours[b][face] = placement.hasNeighbour(face) ? blockIndex(q[0], q[1], q[2]) : -1;
-        }
-        scalars[b] = blockScalars(values, placement);
-        sweepers.push_back(std::make_unique<vao::BlockSweeper>(
-          viewOf(scalars[b], placement.scalarDims()), placement, h, p));
-      }
+using Sweepers = std::vector<std::unique_ptr<vao::BlockSweeper>>;
 
+/// Initialises the blocks and runs rounds of sweeps and face exchanges as the ranks would
+/// (neighbours[b][face]: the block across the face, or -1) until no ghost value changes by
+/// more than the tolerance.
+void runRounds(Sweepers& sweepers, const std::vector<std::array<int, 6>>& neighbours,
+  const vao::SweepParameters& p, const Emulation& emulation, Distributed& result)
+{
+  const int count = static_cast<int>(sweepers.size());
   bool anySurface = false;
   for (auto& s : sweepers)
   {
     result.status = s->initialise();
     if (!result.status.ok)
-      return result;
+      return;
     result.blockSurfaceFound.push_back(s->surfaceFound());
     anySurface = anySurface || s->surfaceFound();
   }
@@ -120,7 +92,7 @@ Distributed sweepInBlocks(const std::vector<float>& values, const vao::Index3& d
       {
         result.status = s->runRound(p.iterations);
         if (!result.status.ok)
-          return result;
+          return;
       }
       result.rounds = round;
       if (!emulation.exchange)
@@ -146,8 +118,13 @@ Distributed sweepInBlocks(const std::vector<float>& values, const vao::Index3& d
     }
   }
 
-  if (!withOutputs)
-    return result;
+}
+
+/// The blocks' outputs assembled into whole-volume arrays.
+void assembleOutputs(Sweepers& sweepers, const std::vector<vao::BlockPlacement>& placements,
+  const vao::Index3& dims, Distributed& result)
+{
+  const int count = static_cast<int>(sweepers.size());
   const std::int64_t n = dims[0] * dims[1] * dims[2];
   result.distance.assign(n, -7.0f);
   result.occlusion.assign(n, -7.0f);
@@ -160,7 +137,7 @@ Distributed sweepInBlocks(const std::vector<float>& values, const vao::Index3& d
     std::vector<float> d(m), a(m), v(8 * m);
     result.status = sweepers[b]->finish({ d.data(), a.data(), v.data() });
     if (!result.status.ok)
-      return result;
+      return;
     std::int64_t k = 0;
     for (std::int64_t z = 0; z < size[2]; ++z)
       for (std::int64_t y = 0; y < size[1]; ++y)
@@ -173,6 +150,48 @@ Distributed sweepInBlocks(const std::vector<float>& values, const vao::Index3& d
           std::copy(v.begin() + 8 * k, v.begin() + 8 * k + 8, result.octants.begin() + 8 * i);
         }
   }
+}
+
+/// Sweeps the volume split into blocks[0] x blocks[1] x blocks[2] blocks, each with
+/// p.iterations passes per round at most, and assembles the outputs.
+Distributed sweepInBlocks(const std::vector<float>& values, const vao::Index3& dims,
+  const Spacing& h, const Blocks& blocks, const vao::SweepParameters& p, bool withOutputs = true,
+  const Emulation& emulation = {})
+{
+  Distributed result;
+  const int count = blocks[0] * blocks[1] * blocks[2];
+  auto blockIndex = [&](int bx, int by, int bz) { return (bz * blocks[1] + by) * blocks[0] + bx; };
+  std::vector<vao::BlockPlacement> placements(count);
+  std::vector<std::array<int, 6>> neighbours(count);
+  std::vector<std::vector<float>> scalars(count);
+  Sweepers sweepers;
+  for (int bz = 0; bz < blocks[2]; ++bz)
+    for (int by = 0; by < blocks[1]; ++by)
+      for (int bx = 0; bx < blocks[0]; ++bx)
+      {
+        const int b = blockIndex(bx, by, bz);
+        const int position[3] = { bx, by, bz };
+        vao::BlockPlacement& placement = placements[b];
+        placement.whole = dims;
+        for (int a = 0; a < 3; ++a)
+        {
+          placement.begin[a] = cut(dims[a], blocks[a], position[a]);
+          placement.size[a] = cut(dims[a], blocks[a], position[a] + 1) - placement.begin[a];
+        }
+        for (int face = 0; face < vao::kBlockFaces; ++face)
+        {
+          int q[3] = { bx, by, bz };
+          q[face / 2] += (face & 1) ? 1 : -1;
+          neighbours[b][face] = placement.hasNeighbour(face) ? blockIndex(q[0], q[1], q[2]) : -1;
+        }
+        scalars[b] = blockScalars(values, placement);
+        sweepers.push_back(std::make_unique<vao::BlockSweeper>(
+          viewOf(scalars[b], placement.scalarDims()), placement, h, p));
+      }
+
+  runRounds(sweepers, neighbours, p, emulation, result);
+  if (result.status.ok && withOutputs)
+    assembleOutputs(sweepers, placements, dims, result);
   return result;
 }
 
