@@ -1,7 +1,7 @@
 // Peak resident memory of each filter on one volume (default: the 512x512x209 CT head
 // phantom at R = 10), as a table: the input's and the outputs' sizes, the peak, and the
 // extra memory (peak - resident before the filter - the new output arrays) against the
-// input's size. The bar of issue 7: extra <= 25% of the input.
+// input's size (the separable filters aim at extra <= 25% of the input).
 //
 //   vao_memory [CT.mha] [--radius R] [--threads N] [--exact]
 //

@@ -1,5 +1,5 @@
 // Occlusion sweeping on one block of a distributed volume: the stages of
-// OcclusionSweeping.cxx over a ghosted SweepLayout, and the face exchange of D and V_s.
+// SweepingCore.h over a ghosted SweepLayout, and the face exchange of D and V_s.
 #include "vao/BlockSweeping.h"
 
 #include "Parallel.h"

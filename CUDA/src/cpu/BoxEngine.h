@@ -432,7 +432,7 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
 
 /// Rows of region per band when the extrema are needed: a band's extrema planes hold
 /// 2 x (slices read) x rows x width values, so bands of 1/16 of the volume's rows keep
-/// them at 1/8 of the input's size (issue 7's bar: working memory <= 25% of the input),
+/// them at 1/8 of the input's size (working memory stays under 25% of the input),
 /// at the price of re-reading R rows above and below each band in the x passes; bands
 /// of at least 2R + 1 rows keep that price under 2x.
 inline std::int64_t extremaBandRows(const BoxGeometry& geometry)
