@@ -95,6 +95,29 @@ double sampledMean(const TypedVolume<T>& volume)
   return count > 0 ? sum / count : 0.0;
 }
 
+/// How a volume's box moments are accumulated: the value subtracted before squaring, and
+/// the variance the sums' rounding can give a flat box (Estimators.h, sumRoundingVariance).
+struct MomentScale
+{
+  double shift = 0.0;
+  double roundingVariance = 0.0;
+};
+
+/// No shift and no rounding for exact integer sums (so the sums, and everything after
+/// them, do not depend on which piece of the volume a run holds); for double sums a
+/// sampled mean, and the rounding of values in [lowest, highest] about it.
+template <class T>
+MomentScale momentScale(const TypedVolume<T>& volume, double lowest, double highest)
+{
+  if (MomentTraits<T>::exactInteger)
+  {
+    return {};
+  }
+  const double shift = sampledMean(volume);
+  const double deviation = std::max(std::abs(highest - shift), std::abs(lowest - shift));
+  return { shift, sumRoundingVariance(deviation) };
+}
+
 /// The clipped span [lo, hi) of input indices that the region [begin, begin + size)
 /// reads along one axis of n voxels with half-width r.
 struct AxisSpan

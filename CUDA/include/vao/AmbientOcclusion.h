@@ -33,6 +33,12 @@ enum class ScalarType : int
 
 const char* scalarTypeName(ScalarType type);
 
+/// True for the integer types (which hold no NaN or infinity).
+inline bool scalarTypeIsIntegral(ScalarType type)
+{
+  return type != ScalarType::Float32 && type != ScalarType::Float64;
+}
+
 using Index3 = std::array<std::int64_t, 3>;
 
 struct VolumeView
@@ -137,7 +143,7 @@ Status computeBoxStatistics(const VolumeView& volume, const Region& region, cons
 /// first one goes to firstIndex when not null. Runs on every core.
 std::int64_t countNonFinite(const VolumeView& volume, std::int64_t* firstIndex = nullptr);
 
-/// Smallest and largest value of the volume (finite values assumed).
+/// Smallest and largest finite value of the volume (one parallel pass).
 std::array<double, 2> valueRange(const VolumeView& volume);
 
 } // namespace vao

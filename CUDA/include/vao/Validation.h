@@ -30,6 +30,30 @@ Status checkFinitePoint(const std::array<double, 3>& point, const char* what);
 /// A parameter that must be a finite number.
 Status checkFiniteParameter(double value, const char* what);
 
+/// What one parallel pass over the values finds: the non-finite ones, and the range of
+/// the finite ones (0, 0 when there is none).
+struct ValueScan
+{
+  std::int64_t nonFiniteCount = 0;
+  std::int64_t firstNonFinite = -1;
+  double minimum = 0.0;
+  double maximum = 0.0;
+};
+
+/// One pass over the values, on every core.
+ValueScan scanValues(const VolumeView& volume);
+
+/// Whether the box statistics of this type need a scan: floating-point types (NaN,
+/// infinity) and the integers wider than 16 bits (their double sums round, by the range).
+inline bool needsValueScan(ScalarType type)
+{
+  return type != ScalarType::Int8 && type != ScalarType::UInt8 && type != ScalarType::Int16 &&
+    type != ScalarType::UInt16;
+}
+
+/// Status::nonFinite (count and first index) when the scan found any, else success.
+Status finiteStatus(const ValueScan& scan);
+
 /// No NaN or infinite voxel; otherwise Status::nonFinite (count and first index). One
 /// parallel pass over the data (none for integer types).
 Status checkFiniteValues(const VolumeView& volume);

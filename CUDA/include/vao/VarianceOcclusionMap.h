@@ -117,6 +117,10 @@ struct MomentLevel
   std::array<double, 6> wholeBounds = { kUnsetBound, kUnsetBound, kUnsetBound, kUnsetBound, kUnsetBound, kUnsetBound };
   LevelArray mean;
   LevelArray variance; // E[v^2] - E[v]^2 of the blurred moments, clamped at 0
+  // The variance rounding alone can leave in a flat region (sumRoundingVariance of the
+  // volume's largest deviation from the moments' shift): the estimators treat a sample
+  // at or below it as flat.
+  double roundingVariance = 0.0;
 };
 
 struct PyramidParameters

@@ -22,13 +22,14 @@ namespace
 template <class T>
 Status separableOpenness(const VolumeView& view, const Region& region,
   const AmbientOcclusionParameters& p, const AmbientOcclusionOutput& output,
-  const Execution& execution)
+  const ValueScan& scan, const Execution& execution)
 {
   const detail::TypedVolume<T> volume(view);
   const detail::BoxGeometry geometry(view.dims, region, p.radius);
   const bool withExtrema = output.openness && p.method == Method::CdfReconstruction;
   const bool voxelQuery = p.queryMode == QueryMode::VoxelValue;
-  const bool ok = detail::forEachNeighbourhood(volume, geometry, withExtrema, execution,
+  const detail::MomentScale scale = detail::momentScale(volume, scan.minimum, scan.maximum);
+  const bool ok = detail::forEachNeighbourhood(volume, geometry, scale, withExtrema, execution,
     [&](const detail::VoxelNeighbourhood& voxel) {
       if (output.variance)
       {
@@ -53,8 +54,11 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   Status status = validate(volume, region, parameters.radius);
   if (status.ok && parameters.queryMode == QueryMode::IsoValue)
     status = checkFiniteParameter(parameters.isoValue, "the iso value");
+  // One pass for the non-finite values and the range the double sums' rounding depends
+  // on; none for the types of up to 16 bits (no NaN, exact sums).
+  const ValueScan scan = status.ok && needsValueScan(volume.type) ? scanValues(volume) : ValueScan{};
   if (status.ok)
-    status = checkFiniteValues(volume);
+    status = finiteStatus(scan);
   if (!status.ok)
   {
     return status;
@@ -75,30 +79,9 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
     separable.openness = nullptr; // the variance still comes from the moments
   }
   return detail::dispatchScalarType(volume.type, [&](auto tag) {
-    return separableOpenness<decltype(tag)>(volume, region, parameters, separable,
+    return separableOpenness<decltype(tag)>(volume, region, parameters, separable, scan,
       isSeparableMethod(parameters.method) ? execution
                                            : detail::stageExecution(execution, 0.9, 1.0));
-  });
-}
-
-std::array<double, 2> valueRange(const VolumeView& view)
-{
-  return detail::dispatchScalarType(view.type, [&](auto tag) -> std::array<double, 2> {
-    using T = decltype(tag);
-    const T* data = static_cast<const T*>(view.data);
-    const std::int64_t n = view.voxelCount();
-    if (n <= 0)
-    {
-      return { 0.0, 0.0 };
-    }
-    T lo = data[0], hi = data[0];
-    for (std::int64_t i = 1; i < n; ++i)
-    {
-      const T v = data[i * view.voxelStride];
-      lo = v < lo ? v : lo;
-      hi = hi < v ? v : hi;
-    }
-    return { static_cast<double>(lo), static_cast<double>(hi) };
   });
 }
 

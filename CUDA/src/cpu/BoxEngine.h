@@ -211,19 +211,6 @@ private:
   std::vector<Acc> Run1, Run2;
 };
 
-/// The value subtracted before squaring: none for exact integer sums (so the sums, and
-/// everything after them, do not depend on which piece of the volume a run holds), a
-/// sampled mean for double sums.
-template <class T>
-typename MomentTraits<T>::Accumulator momentShift(const TypedVolume<T>& volume)
-{
-  if (MomentTraits<T>::exactInteger)
-  {
-    return 0;
-  }
-  return static_cast<typename MomentTraits<T>::Accumulator>(sampledMean(volume));
-}
-
 /// Per-slice view handed to the consumer of the moments: everything needed to turn the
 /// sums of slice z into statistics.
 template <class T>
@@ -235,15 +222,16 @@ struct MomentSlice
   const Acc* sumSquares;  //
   double shift;           // add to sum / count to get the mean
   std::int64_t countZ;    // clipped window size along z
+  double roundingVariance; // what rounding can fake on a flat box (MomentScale)
 };
 
 /// Streams the moment planes of every region slice to consume(slice) on worker threads;
 /// each thread takes a contiguous chunk of slices. Returns false when cancelled.
 template <class T, class Consume>
-bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
+bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry, const MomentScale& scale,
   const Execution& execution, Consume&& consume)
 {
-  const auto shift = momentShift(volume);
+  const auto shift = static_cast<typename MomentTraits<T>::Accumulator>(scale.shift);
   const int threads = resolveThreadCount(execution.threads);
   const std::int64_t nz = geometry.region.size[2];
   return parallelFor(nz, threads, threads, execution,
@@ -261,7 +249,7 @@ bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
           planes.advanceFrom(z - 1);
         }
         MomentSlice<T> slice{ z, planes.sum(), planes.sumSquares(), static_cast<double>(shift),
-          clippedWindowCount(z, geometry.radius.z, geometry.dims[2]) };
+          clippedWindowCount(z, geometry.radius.z, geometry.dims[2]), scale.roundingVariance };
         consume(slice);
         if (!progress.advance())
         {
@@ -389,7 +377,7 @@ struct VoxelNeighbourhood
 /// indices are those of the whole region.
 template <class T, class Visit>
 bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Region& whole,
-  bool withExtrema, const Execution& execution, Visit&& visit)
+  const MomentScale& scale, bool withExtrema, const Execution& execution, Visit&& visit)
 {
   const Region& region = band.region;
   BoxExtrema<T> extrema;
@@ -403,11 +391,11 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
   const std::int64_t nx = region.size[0], ny = region.size[1];
   const std::int64_t wholePlane = whole.size[0] * whole.size[1];
   const std::int64_t firstRow = region.begin[1] - whole.begin[1];
-  return streamMoments(volume, band, stageExecution(execution, split, 1.0),
+  return streamMoments(volume, band, scale, stageExecution(execution, split, 1.0),
     [&](const MomentSlice<T>& slice) {
       const std::int64_t bandBase = (slice.z - region.begin[2]) * nx * ny;
       const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
-      VoxelNeighbourhood voxel{ 0, 0.0, 0, { 0.0, 0.0, 0.0, 0.0 } };
+      VoxelNeighbourhood voxel{ 0, 0.0, 0, { 0.0, 0.0, 0.0, 0.0, slice.roundingVariance } };
       for (std::int64_t j = 0; j < ny; ++j)
       {
         const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
@@ -446,7 +434,7 @@ inline std::int64_t extremaBandRows(const BoxGeometry& geometry)
 /// each band's extrema first, then its moments. Returns false when cancelled.
 template <class T, class Visit>
 bool forEachNeighbourhood(const TypedVolume<T>& volume, const BoxGeometry& geometry,
-  bool withExtrema, const Execution& execution, Visit&& visit)
+  const MomentScale& scale, bool withExtrema, const Execution& execution, Visit&& visit)
 {
   const Region& region = geometry.region;
   const std::int64_t ny = region.size[1];
@@ -458,7 +446,7 @@ bool forEachNeighbourhood(const TypedVolume<T>& volume, const BoxGeometry& geome
     band.begin[1] = region.begin[1] + b * bandRows;
     band.size[1] = std::min(bandRows, ny - b * bandRows);
     const Execution stage = stageExecution(execution, double(b) / bands, double(b + 1) / bands);
-    if (!visitBand(volume, BoxGeometry(geometry.dims, band, geometry.radius), region, withExtrema, stage, visit))
+    if (!visitBand(volume, BoxGeometry(geometry.dims, band, geometry.radius), region, scale, withExtrema, stage, visit))
     {
       return false;
     }

@@ -17,7 +17,9 @@ Status computeBoxStatistics(const VolumeView& view, const Region& region, const 
   const bool withExtrema = output.minimum || output.maximum;
   return detail::dispatchScalarType(view.type, [&](auto tag) -> Status {
     const detail::TypedVolume<decltype(tag)> volume(view);
-    const bool ok = detail::forEachNeighbourhood(volume, geometry, withExtrema, execution,
+    // Only the shift matters here: the statistics are written as they are.
+    const detail::MomentScale scale{ detail::momentScale(volume, 0.0, 0.0).shift, 0.0 };
+    const bool ok = detail::forEachNeighbourhood(volume, geometry, scale, withExtrema, execution,
       [&](const detail::VoxelNeighbourhood& voxel) {
         const std::int64_t k = voxel.index;
         if (output.count)

@@ -283,8 +283,6 @@ Status checkPyramidRequest(const VolumeView& volume, const std::array<double, 3>
     why << "the number of pyramid levels must be in [1, 16], got " << parameters.levels;
     status = Status::failure(why.str());
   }
-  if (status.ok)
-    status = checkFiniteValues(volume);
   return status;
 }
 
@@ -294,7 +292,10 @@ Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>&
   const std::array<double, 3>& spacing, const PyramidParameters& parameters,
   std::vector<MomentLevel>& pyramid, const Execution& execution)
 {
-  const Status status = checkPyramidRequest(volume, origin, spacing, parameters);
+  Status status = checkPyramidRequest(volume, origin, spacing, parameters);
+  const ValueScan scan = status.ok ? scanValues(volume) : ValueScan{};
+  if (status.ok)
+    status = finiteStatus(scan);
   if (!status.ok)
   {
     pyramid.clear();
@@ -304,6 +305,8 @@ Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>&
   const double shift = detail::dispatchScalarType(volume.type, [&](auto tag) {
     return detail::sampledMean(detail::TypedVolume<decltype(tag)>(volume));
   });
+  const double roundingVariance =
+    sumRoundingVariance(std::max(std::abs(scan.maximum - shift), std::abs(scan.minimum - shift)));
   const int levels = parameters.levels;
   // Reuse the storage of a previous build (same sizes: no allocation, no page faults).
   std::vector<MomentLevel> result = std::move(pyramid);
@@ -343,6 +346,7 @@ Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>&
     // r_l: the 5-tap half-width (2 voxels) of the level's own grid, largest axis; it
     // doubles with every level.
     level.kernelRadius = 2.0 * std::max(level.spacing[0], std::max(level.spacing[1], level.spacing[2]));
+    level.roundingVariance = roundingVariance;
   }
   pyramid = std::move(result);
   return Status::success();

@@ -172,7 +172,7 @@ double levelOcclusion(const MomentLevel& level, const std::array<double, 3>& pos
 {
   double mean = 0.0, variance = 0.0;
   sampleLevel(level, position, mean, variance);
-  const NeighbourhoodStats stats{ mean, variance, mean, mean };
+  const NeighbourhoodStats stats{ mean, variance, mean, mean, level.roundingVariance };
   const double open = estimator == Method::GaussianCdf
     ? opennessGaussianCdf(query, stats, ErfMode::Exact)
     : opennessChebyshev(query, stats);

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <sstream>
 
@@ -119,46 +120,82 @@ Status validate(const VolumeView& volume, const Region& region, const Radius& ra
   return status;
 }
 
-std::int64_t countNonFinite(const VolumeView& view, std::int64_t* firstIndex)
+ValueScan scanValues(const VolumeView& view)
 {
-  return detail::dispatchScalarType(view.type, [&](auto tag) -> std::int64_t {
+  return detail::dispatchScalarType(view.type, [&](auto tag) -> ValueScan {
     using T = decltype(tag);
-    if (std::is_integral<T>::value || view.voxelCount() <= 0)
+    const std::int64_t n = view.voxelCount();
+    if (n <= 0 || !view.data)
     {
-      return 0;
+      return {};
     }
     const T* data = static_cast<const T*>(view.data);
-    const std::int64_t n = view.voxelCount();
     std::mutex merge;
-    std::int64_t count = 0;
-    std::int64_t first = n;
+    ValueScan total;
+    total.firstNonFinite = n;
+    bool anyFinite = false;
     const int threads = detail::resolveThreadCount(0);
     detail::parallelFor(n, 4 * threads, threads, [&](std::int64_t begin, std::int64_t end) {
-      std::int64_t localCount = 0, localFirst = n;
+      std::int64_t count = 0, first = n;
+      // The range of the finite values: +-infinity start values, so no branch on the
+      // first one (the loop vectorises).
+      T lo = std::numeric_limits<T>::has_infinity ? std::numeric_limits<T>::infinity() : std::numeric_limits<T>::max();
+      T hi = std::numeric_limits<T>::has_infinity ? -std::numeric_limits<T>::infinity() : std::numeric_limits<T>::lowest();
       for (std::int64_t i = begin; i < end; ++i)
       {
-        // Written without a branch on the value so that the loop vectorises.
-        const bool bad = !std::isfinite(data[i * view.voxelStride]);
-        localCount += bad;
-        localFirst = bad && localFirst == n ? i : localFirst;
+        const T v = data[i * view.voxelStride];
+        const bool bad = !std::isfinite(static_cast<double>(v));
+        count += bad;
+        first = bad && first == n ? i : first;
+        lo = bad || !(v < lo) ? lo : v;
+        hi = bad || !(hi < v) ? hi : v;
       }
       std::lock_guard<std::mutex> lock(merge);
-      count += localCount;
-      first = std::min(first, localFirst);
+      total.nonFiniteCount += count;
+      total.firstNonFinite = std::min(total.firstNonFinite, first);
+      if (count < end - begin)
+      {
+        total.minimum = anyFinite ? std::min(total.minimum, static_cast<double>(lo)) : static_cast<double>(lo);
+        total.maximum = anyFinite ? std::max(total.maximum, static_cast<double>(hi)) : static_cast<double>(hi);
+        anyFinite = true;
+      }
     });
-    if (count > 0 && firstIndex)
+    if (total.nonFiniteCount == 0)
     {
-      *firstIndex = first;
+      total.firstNonFinite = -1;
     }
-    return count;
+    return total;
   });
+}
+
+Status finiteStatus(const ValueScan& scan)
+{
+  return scan.nonFiniteCount > 0 ? Status::nonFinite(scan.nonFiniteCount, scan.firstNonFinite) : Status::success();
+}
+
+std::int64_t countNonFinite(const VolumeView& view, std::int64_t* firstIndex)
+{
+  if (scalarTypeIsIntegral(view.type))
+  {
+    return 0;
+  }
+  const ValueScan scan = scanValues(view);
+  if (scan.nonFiniteCount > 0 && firstIndex)
+  {
+    *firstIndex = scan.firstNonFinite;
+  }
+  return scan.nonFiniteCount;
 }
 
 Status checkFiniteValues(const VolumeView& volume)
 {
-  std::int64_t first = -1;
-  const std::int64_t count = countNonFinite(volume, &first);
-  return count > 0 ? Status::nonFinite(count, first) : Status::success();
+  return scalarTypeIsIntegral(volume.type) ? Status::success() : finiteStatus(scanValues(volume));
+}
+
+std::array<double, 2> valueRange(const VolumeView& volume)
+{
+  const ValueScan scan = scanValues(volume);
+  return { scan.minimum, scan.maximum };
 }
 
 } // namespace vao

@@ -251,13 +251,15 @@ struct HostOutputs
 
 template <class T>
 void run(const VolumeView& view, const Region& region, const Radius& radius, bool withExtrema,
-  const gpu::EstimatorSetting& estimator, const HostOutputs& host, const Execution& execution, Timing* timing)
+  gpu::EstimatorSetting estimator, const ValueScan& scan, const HostOutputs& host, const Execution& execution,
+  Timing* timing)
 {
   using Acc = typename detail::MomentTraits<T>::Accumulator;
   const detail::TypedVolume<T> volume(view);
   const gpu::RegionGeometry g = gpu::geometryFor(view.dims, region, radius);
-  const Acc shift =
-    detail::MomentTraits<T>::exactInteger ? Acc(0) : static_cast<Acc>(detail::sampledMean(volume));
+  const detail::MomentScale scale = detail::momentScale(volume, scan.minimum, scan.maximum);
+  const Acc shift = static_cast<Acc>(scale.shift);
+  estimator.roundingVariance = scale.roundingVariance;
   CudaExecutor ex(timing, execution);
   DeviceBuffer<T> input(g.block());
   upload(volume, region, g, input.get());
@@ -294,8 +296,9 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   const gpu::EstimatorSetting& estimator, const HostOutputs& host, const Execution& execution, Timing* timing)
 {
   Status status = validate(view, region, radius);
+  const ValueScan scan = status.ok && needsValueScan(view.type) ? scanValues(view) : ValueScan{};
   if (status.ok)
-    status = checkFiniteValues(view);
+    status = finiteStatus(scan);
   if (!status.ok)
   {
     return status;
@@ -313,7 +316,7 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   try
   {
     detail::dispatchScalarType(view.type, [&](auto tag) {
-      run<decltype(tag)>(view, region, radius, withExtrema, estimator, host, execution, timing);
+      run<decltype(tag)>(view, region, radius, withExtrema, estimator, scan, host, execution, timing);
     });
     check(cudaDeviceSynchronize(), "synchronize");
   }

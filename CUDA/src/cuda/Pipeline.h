@@ -303,6 +303,7 @@ struct EstimatorSetting
   QueryMode query;
   double isoValue;
   ErfMode erfMode;
+  double roundingVariance = 0.0; // of the moment sums (MomentScale)
 };
 
 /// The z pass fused with the estimator: one thread per (x, y) column of the region and
@@ -362,7 +363,7 @@ struct FinalKernel
 
   VAO_HD void write(Index index, Index z, Index x, Index y, long long count, Acc s1, Acc s2) const
   {
-    NeighbourhoodStats s{ 0.0, 0.0, 0.0, 0.0 };
+    NeighbourhoodStats s{ 0.0, 0.0, 0.0, 0.0, estimator.roundingVariance };
     meanVarianceFromSums(s1, s2, count, static_cast<double>(shift), s.mean, s.variance);
     if (extremaMin)
     {
