@@ -21,10 +21,11 @@ VAO_HD double varianceModulation(double variance, double varianceMax)
   return varianceMax > 0.0 ? clamp01(variance / varianceMax) : 1.0;
 }
 
-/// A value in [0, 1] as an 8-bit channel.
+/// A value in [0, 1] as an 8-bit channel; NaN gives 0 (casting NaN to an integer is
+/// undefined behaviour).
 VAO_HD unsigned char toByte(double unit)
 {
-  return static_cast<unsigned char>(clamp01(unit) * 255.0 + 0.5);
+  return unit > 0.0 ? static_cast<unsigned char>(clamp01(unit) * 255.0 + 0.5) : static_cast<unsigned char>(0);
 }
 
 } // namespace vao

@@ -54,6 +54,12 @@ inline bool needsValueScan(ScalarType type)
 /// Status::nonFinite (count and first index) when the scan found any, else success.
 Status finiteStatus(const ValueScan& scan);
 
+/// The largest magnitude whose moments (sums of squares over any box) stay finite in double.
+constexpr double kLargestMomentMagnitude = 1e140;
+
+/// A failure when the scanned values exceed kLargestMomentMagnitude in magnitude.
+Status checkMomentMagnitude(const ValueScan& scan);
+
 /// No NaN or infinite voxel; otherwise Status::nonFinite (count and first index). One
 /// parallel pass over the data (none for integer types).
 Status checkFiniteValues(const VolumeView& volume);

@@ -59,6 +59,8 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   const ValueScan scan = status.ok && needsValueScan(volume.type) ? scanValues(volume) : ValueScan{};
   if (status.ok)
     status = finiteStatus(scan);
+  if (status.ok)
+    status = checkMomentMagnitude(scan);
   if (!status.ok)
   {
     return status;

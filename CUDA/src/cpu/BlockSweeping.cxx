@@ -25,7 +25,7 @@ constexpr int kFaceValues = 5; // D and four V_s per face voxel
 SweepLayout blockLayout(const BlockPlacement& b, const std::array<double, 3>& spacing)
 {
   const Index3 storage = { b.size[0] + 2, b.size[1] + 2, b.size[2] + 2 };
-  return { Grid(storage, spacing), { 1, 1, 1 }, b.size, b.begin, b.whole, true };
+  return { Grid(storage, inSweepUnits(spacing)), { 1, 1, 1 }, b.size, b.begin, b.whole, true };
 }
 
 Status validatePlacement(const VolumeView& scalars, const BlockPlacement& b)
@@ -204,14 +204,17 @@ Status BlockSweeper::runRound(int maxPasses, SweepReport* report)
   {
     return Status::failure("a round needs at least one pass of the 8 sweeps");
   }
+  const double unit = sweepUnit(s.spacing);
   SweepParameters p = s.parameters;
   p.iterations = maxPasses;
+  p.tolerance /= unit;
   SweepReport local;
   SweepReport& r = report ? *report : local;
   r.surfaceFound = s.surfaceFound;
   const int sweepThreads = static_cast<int>(std::min<std::int64_t>(s.threads, s.layout.size[2]));
-  return runPasses(
-    s.layout, p, s.distance.data(), s.fixed, s.vis, sweepThreads, s.execution, r);
+  const Status status = runPasses(s.layout, p, s.distance.data(), s.fixed, s.vis, sweepThreads, s.execution, r);
+  r.lastChange *= unit;
+  return status;
 }
 
 std::int64_t BlockSweeper::faceValueCount(int face) const
@@ -251,10 +254,11 @@ double BlockSweeper::importFace(int face, const float* buffer)
   }
   // The sweeps that read this ghost layer move away from it, into the block.
   const std::array<int, 4> octants = State::octantsMoving(face / 2, (face & 1) ? -1 : 1);
+  const double unit = sweepUnit(s.spacing); // D is exchanged in sweep units
   double largest = 0.0;
   s.forFaceVoxels(face, true, [&](std::int64_t i, std::int64_t k) {
     const float* in = buffer + kFaceValues * k;
-    largest = std::max(largest, changeOf(s.distance[i], in[0]));
+    largest = std::max(largest, changeOf(s.distance[i], in[0]) * unit);
     s.distance[i] = in[0];
     for (int o = 0; o < 4; ++o)
     {
@@ -280,12 +284,15 @@ Status BlockSweeper::finish(const SweepOutput& output)
   }
   if (output.signedDistance)
   {
+    const float unit = static_cast<float>(sweepUnit(s.spacing));
     const Index3& n = s.layout.size;
     for (std::int64_t z = 0; z < n[2]; ++z)
       for (std::int64_t y = 0; y < n[1]; ++y)
       {
         const float* row = s.distance.data() + s.layout.index(0, y, z);
-        std::copy(row, row + n[0], output.signedDistance + (z * n[1] + y) * n[0]);
+        float* to = output.signedDistance + (z * n[1] + y) * n[0];
+        for (std::int64_t x = 0; x < n[0]; ++x)
+          to[x] = row[x] * unit; // sweep units to world units (exact: a power of two)
       }
   }
   return combine(

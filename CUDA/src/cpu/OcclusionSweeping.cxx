@@ -54,10 +54,23 @@ VisibilityStore planVisibility(
   return vis;
 }
 
-Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& spacing,
-  const SweepParameters& p, const SweepOutput& out, const Execution& execution, SweepReport& report)
+/// D of the whole volume from sweep units to world units, in place.
+void distanceToWorld(float* distance, std::int64_t count, double unit, int threads)
 {
-  const SweepLayout layout = SweepLayout::wholeVolume(volume.dims, spacing);
+  const float scale = static_cast<float>(unit);
+  detail::parallelFor(count, 4 * threads, threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i)
+      distance[i] *= scale;
+  });
+}
+
+Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& spacing,
+  const SweepParameters& parameters, const SweepOutput& out, const Execution& execution, SweepReport& report)
+{
+  const double unit = sweepUnit(spacing);
+  SweepParameters p = parameters;
+  p.tolerance /= unit;
+  const SweepLayout layout = SweepLayout::wholeVolume(volume.dims, inSweepUnits(spacing));
   const Grid& grid = layout.storage;
   const int threads = detail::resolveThreadCount(execution.threads);
   std::vector<float> ownDistance;
@@ -83,6 +96,7 @@ Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& 
   {
     const Status status = runPasses(layout, p, distance, fixed, vis, sweepThreads,
       detail::stageExecution(execution, 0.0, 0.95), report);
+    report.lastChange *= unit;
     if (!status.ok)
     {
       return status;
@@ -97,6 +111,10 @@ Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& 
   if (!status.ok)
   {
     return status;
+  }
+  if (out.signedDistance && unit != 1.0)
+  {
+    distanceToWorld(out.signedDistance, grid.count, unit, threads);
   }
   if (execution.progress)
   {

@@ -296,6 +296,8 @@ Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>&
   const ValueScan scan = status.ok ? scanValues(volume) : ValueScan{};
   if (status.ok)
     status = finiteStatus(scan);
+  if (status.ok)
+    status = checkMomentMagnitude(scan);
   if (!status.ok)
   {
     pyramid.clear();

@@ -26,6 +26,19 @@ namespace
 constexpr double kPi = 3.14159265358979323846;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
+/// (c - v) / (w - v), the fraction of the edge from v to w where it crosses c, also for
+/// values near the largest doubles, whose differences overflow: then of the halves
+/// (exact), which cannot.
+double crossingFraction(double c, double v, double w)
+{
+  const double across = w - v;
+  if (std::isfinite(across))
+  {
+    return (c - v) / across;
+  }
+  return (0.5 * c - 0.5 * v) / (0.5 * w - 0.5 * v);
+}
+
 /// The number of octants lit.
 int litOctants(const SweepParameters& p)
 {
@@ -33,6 +46,17 @@ int litOctants(const SweepParameters& p)
 }
 
 } // namespace
+
+double sweepUnit(const std::array<double, 3>& spacing)
+{
+  return std::ldexp(1.0, std::ilogb(std::min({ spacing[0], spacing[1], spacing[2] })));
+}
+
+std::array<double, 3> inSweepUnits(const std::array<double, 3>& spacing)
+{
+  const double unit = sweepUnit(spacing);
+  return { spacing[0] / unit, spacing[1] / unit, spacing[2] / unit };
+}
 
 Status validateSweepParameters(
   const std::array<double, 3>& spacing, const SweepParameters& p, const SweepOutput& output)
@@ -43,7 +67,14 @@ Status validateSweepParameters(
   if (!status.ok)
     return status;
   std::ostringstream why;
-  if (p.iterations < 1)
+  const auto [smallest, largest] = std::minmax({ spacing[0], spacing[1], spacing[2] });
+  if (smallest < kSmallestSpacing || largest > kLargestSpacing)
+  {
+    why << "occlusion sweeping needs spacings between " << kSmallestSpacing << " and " << kLargestSpacing
+        << " (its distances are float; got " << spacing[0] << ", " << spacing[1] << ", " << spacing[2]
+        << "): rescale the volume (e.g. with Change Spacing)";
+  }
+  else if (p.iterations < 1)
   {
     why << "at least one pass of the 8 sweeps is needed (iterations = " << p.iterations << ")";
   }
@@ -119,7 +150,7 @@ std::int64_t initialiseDistanceOf(const VolumeView& view, const Index3& scalarOf
                 const double w =
                   static_cast<double>(volume.data[(i + side * steps[a]) * volume.stride]);
                 if (inside(w) != in)
-                  nearest = std::min(nearest, (c - v) / (w - v) * h[a]);
+                  nearest = std::min(nearest, crossingFraction(c, v, w) * h[a]);
               }
             const bool isFixed = nearest < std::numeric_limits<double>::infinity();
             const float magnitude = isFixed ? static_cast<float>(nearest) : kInfinity;

@@ -96,6 +96,20 @@ struct VisibilityStore
   }
 };
 
+/// The unit the sweeps measure distances in: the power of two at or below the smallest
+/// spacing. Scaling by a power of two is exact, so the sweeps give the bits they would
+/// give in world units, but 1/h^2 and its products stay inside float's range whatever
+/// the spacing (at 1e-10, (1/h^2)^2 overflowed and distances were off by voxels).
+/// D, the tolerance and the reported changes are converted at the entry points.
+double sweepUnit(const std::array<double, 3>& spacing);
+
+/// The spacing in sweep units.
+std::array<double, 3> inSweepUnits(const std::array<double, 3>& spacing);
+
+/// The spacings the sweeps accept: their float distances stay normal and finite.
+constexpr double kSmallestSpacing = 1e-30;
+constexpr double kLargestSpacing = 1e30;
+
 /// Rejects bad spacings and parameters (cheap: no pass over the data).
 Status validateSweepParameters(
   const std::array<double, 3>& spacing, const SweepParameters& p, const SweepOutput& output);

@@ -173,6 +173,19 @@ Status finiteStatus(const ValueScan& scan)
   return scan.nonFiniteCount > 0 ? Status::nonFinite(scan.nonFiniteCount, scan.firstNonFinite) : Status::success();
 }
 
+Status checkMomentMagnitude(const ValueScan& scan)
+{
+  const double largest = std::max(std::abs(scan.minimum), std::abs(scan.maximum));
+  if (largest <= kLargestMomentMagnitude)
+  {
+    return Status::success();
+  }
+  std::ostringstream why;
+  why << "the values reach " << largest << " in magnitude; above " << kLargestMomentMagnitude
+      << " their squared sums overflow double precision: rescale the data (e.g. with the Calculator) first";
+  return Status::failure(why.str());
+}
+
 std::int64_t countNonFinite(const VolumeView& view, std::int64_t* firstIndex)
 {
   if (scalarTypeIsIntegral(view.type))

@@ -299,6 +299,8 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   const ValueScan scan = status.ok && needsValueScan(view.type) ? scanValues(view) : ValueScan{};
   if (status.ok)
     status = finiteStatus(scan);
+  if (status.ok)
+    status = checkMomentMagnitude(scan);
   if (!status.ok)
   {
     return status;

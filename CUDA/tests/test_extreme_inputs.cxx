@@ -1,0 +1,150 @@
+// Values and spacings at the edges of floating point: a correct result or a clear error,
+// never garbage. The references are the same scenes at ordinary scales.
+#include "SweepTestSupport.h"
+#include "TestVolumes.h"
+#include "vao/AmbientOcclusion.h"
+#include "vao/Shading.h"
+#include "vao/VarianceOcclusionMap.h"
+
+#include <gtest/gtest.h>
+
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace
+{
+
+using namespace vaotest;
+
+vao::SweepParameters sweepWithOctants()
+{
+  vao::SweepParameters p = withIterations(2);
+  p.isoValue = 0.0;
+  return p;
+}
+
+/// D and A of the sweeps of `scene` values at spacing h (isotropic).
+void sweepAt(const std::vector<double>& values, const vao::Index3& dims, double h, std::vector<float>& d,
+  std::vector<float>& a, vao::Status& status)
+{
+  const std::size_t n = values.size();
+  d.assign(n, 0.0f);
+  a.assign(n, 0.0f);
+  status = vao::computeOcclusionSweeping(viewOf(values, dims), { h, h, h }, sweepWithOctants(), { d.data(), a.data() });
+}
+
+std::vector<double> ballValues(const vao::Index3& dims, double inside, double outside)
+{
+  std::vector<double> v;
+  for (std::int64_t z = 0; z < dims[2]; ++z)
+    for (std::int64_t y = 0; y < dims[1]; ++y)
+      for (std::int64_t x = 0; x < dims[0]; ++x)
+      {
+        const double r = std::sqrt((x - 9.3) * (x - 9.3) + (y - 8.1) * (y - 8.1) + (z - 10.4) * (z - 10.4));
+        v.push_back(r < 5.5 ? inside : outside);
+      }
+  return v;
+}
+
+TEST(ExtremeInputs, SweepingDistancesScaleWithAnySpacingInItsRange)
+{
+  const vao::Index3 dims = { 19, 17, 21 };
+  const std::vector<double> values = ballValues(dims, 1.0, -1.0);
+  std::vector<float> d1, a1;
+  vao::Status status;
+  sweepAt(values, dims, 1.0, d1, a1, status);
+  ASSERT_TRUE(status.ok) << status.message;
+  for (double h : { 1e-10, 3e-7, 1e-30, 1e30, 0.75, 2.0 })
+  {
+    std::vector<float> d, a;
+    sweepAt(values, dims, h, d, a, status);
+    ASSERT_TRUE(status.ok) << "spacing " << h << ": " << status.message;
+    double worst = 0.0, worstOcclusion = 0.0;
+    for (std::size_t i = 0; i < d.size(); ++i)
+    {
+      ASSERT_TRUE(std::isfinite(d[i])) << "spacing " << h << ", voxel " << i;
+      worst = std::max(worst, std::abs(d[i] / h - d1[i]));
+      worstOcclusion = std::max(worstOcclusion, std::abs(static_cast<double>(a[i]) - a1[i]));
+    }
+    // D is float: a few ulps of the largest distance (~20 voxels) after the rescaling.
+    EXPECT_LT(worst, 1e-4) << "spacing " << h << ": distances in voxels differ from spacing 1";
+    EXPECT_LT(worstOcclusion, 1e-5) << "spacing " << h;
+  }
+}
+
+TEST(ExtremeInputs, SweepingRejectsSpacingsOutsideItsRangeWithAReason)
+{
+  const vao::Index3 dims = { 8, 8, 8 };
+  const std::vector<double> values = ballValues(dims, 1.0, -1.0);
+  std::vector<float> d, a;
+  vao::Status status;
+  for (double h : { 1e-31, 1e31 })
+  {
+    sweepAt(values, dims, h, d, a, status);
+    EXPECT_FALSE(status.ok) << "spacing " << h;
+    EXPECT_NE(status.message.find("spacings between"), std::string::npos) << status.message;
+  }
+}
+
+TEST(ExtremeInputs, SweepingFindsTheSurfaceBetweenTheLargestDoubles)
+{
+  // Inside +DBL_MAX, outside -DBL_MAX, iso 0: every crossing is half-way, as for +-1.
+  const vao::Index3 dims = { 19, 17, 21 };
+  std::vector<float> dHuge, aHuge, dUnit, aUnit;
+  vao::Status status;
+  sweepAt(ballValues(dims, DBL_MAX, -DBL_MAX), dims, 1.0, dHuge, aHuge, status);
+  ASSERT_TRUE(status.ok) << status.message;
+  sweepAt(ballValues(dims, 1.0, -1.0), dims, 1.0, dUnit, aUnit, status);
+  ASSERT_TRUE(status.ok) << status.message;
+  for (std::size_t i = 0; i < dHuge.size(); ++i)
+  {
+    ASSERT_EQ(dHuge[i], dUnit[i]) << "voxel " << i;
+    ASSERT_EQ(aHuge[i], aUnit[i]) << "voxel " << i;
+  }
+}
+
+TEST(ExtremeInputs, MomentMethodsRefuseValuesWhoseSquaresOverflow)
+{
+  const vao::Index3 dims = { 10, 10, 10 };
+  std::vector<double> values = ballValues(dims, 1e200, 0.0);
+  const vao::VolumeView view = viewOf(values, dims);
+  std::vector<float> open(values.size());
+  vao::AmbientOcclusionParameters p;
+  p.radius = { 2, 2, 2 };
+  for (vao::Method m : { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
+  {
+    p.method = m;
+    const vao::Status s = vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
+    EXPECT_FALSE(s.ok);
+    EXPECT_NE(s.message.find("rescale"), std::string::npos) << s.message;
+  }
+  std::vector<vao::MomentLevel> pyramid;
+  const vao::Status s = vao::buildMomentPyramid(view, { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid);
+  EXPECT_FALSE(s.ok);
+  EXPECT_NE(s.message.find("rescale"), std::string::npos) << s.message;
+  EXPECT_TRUE(pyramid.empty());
+
+  // At the limit the estimators still see the scene as at unit scale.
+  values = ballValues(dims, 1e140, 0.0);
+  std::vector<double> unit = ballValues(dims, 1.0, 0.0);
+  std::vector<float> openUnit(values.size());
+  p.method = vao::Method::GaussianCdf;
+  ASSERT_TRUE(vao::computeAmbientOcclusion(viewOf(values, dims), vao::Region::whole(view), p, { open.data(), nullptr }).ok);
+  ASSERT_TRUE(
+    vao::computeAmbientOcclusion(viewOf(unit, dims), vao::Region::whole(view), p, { openUnit.data(), nullptr }).ok);
+  for (std::size_t i = 0; i < open.size(); ++i)
+    ASSERT_NEAR(open[i], openUnit[i], 1e-6) << "voxel " << i;
+}
+
+TEST(ExtremeInputs, ByteOfNanIsZeroNotUndefined)
+{
+  EXPECT_EQ(vao::toByte(std::numeric_limits<double>::quiet_NaN()), 0);
+  EXPECT_EQ(vao::toByte(-std::numeric_limits<double>::infinity()), 0);
+  EXPECT_EQ(vao::toByte(std::numeric_limits<double>::infinity()), 255);
+  EXPECT_EQ(vao::toByte(0.5), 128);
+}
+
+} // namespace
