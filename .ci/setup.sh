@@ -7,6 +7,8 @@
 #   bash .ci/setup.sh test                        the whole test suite (ctest)
 #   bash .ci/setup.sh benchmark                   the benchmark table (README "Benchmark")
 #   bash .ci/setup.sh build                       set-up only
+#   bash .ci/setup.sh sanitize [--filters]        the tests under ASan + UBSan and TSan
+#   bash .ci/setup.sh fuzz [seconds]              libFuzzer on the kernel library (600 s)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 job="${1:-demo}"
@@ -20,6 +22,8 @@ packages=(cmake g++ ninja-build paraview-dev paraview python3-paraview qtbase5-d
   libavcodec-dev libavformat-dev libswscale-dev libtheora-dev libdouble-conversion-dev
   liblz4-dev libexpat1-dev libeigen3-dev libboost-dev libfreetype-dev mpi-default-dev
   python3-mpi4py libgtest-dev xvfb xauth python3-numpy python3-scipy)
+# libFuzzer comes with clang (GCC's sanitizers come with g++).
+[ "$job" = fuzz ] && packages+=(clang-16 libclang-rt-16-dev)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -32,6 +36,11 @@ if ((${#missing[@]})); then
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
+
+case "$job" in
+  sanitize) exec bash .ci/sanitize.sh "$@" ;;
+  fuzz) exec bash .ci/fuzz.sh "$@" ;;
+esac
 
 echo "== configuring and building (build/)"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release

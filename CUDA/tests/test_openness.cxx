@@ -1,6 +1,7 @@
 // computeAmbientOcclusion end to end on random volumes: the exact references against an
-// independent brute force, the separable estimators against the formulas applied to
-// brute-force statistics, the properties of METHODS.md, and decomposition invariance.
+// independent brute force, the separable estimators against METHODS.md's formulas written
+// again in ReferenceFormulas.h, applied to brute-force statistics, the properties of METHODS.md, and decomposition invariance.
+#include "ReferenceFormulas.h"
 #include "TestVolumes.h"
 
 #include <gtest/gtest.h>
@@ -54,11 +55,11 @@ void expectMatchesBruteForce(const std::vector<T>& v, const vao::Index3& dims, v
       {
         const double q = query == vao::QueryMode::IsoValue ? iso : double(v[k]);
         const auto ref = bruteForceStats(v, dims, r, x, y, z);
-        const vao::NeighbourhoodStats s{ ref.mean, ref.variance, ref.minimum, ref.maximum };
+        const reference::Statistics s{ ref.mean, ref.variance, ref.minimum, ref.maximum };
         const double expected[] = { bruteForceOpenness(v, dims, r, x, y, z, q, false),
           bruteForceOpenness(v, dims, r, x, y, z, q, true),
-          vao::opennessCdfReconstruction(q, s), vao::opennessGaussianCdf(q, s, vao::ErfMode::Exact),
-          vao::opennessGaussianCdf(q, s, vao::ErfMode::Winitzki), vao::opennessChebyshev(q, s) };
+          reference::cdfReconstruction(q, s), reference::gaussianCdf(q, s, false),
+          reference::gaussianCdf(q, s, true), reference::chebyshev(q, s) };
         const float got[] = { exactBox[k], exactSphere[k], cdf[k], gauss[k], winitzki[k], cheb[k] };
         for (int m = 0; m < 6; ++m)
         {

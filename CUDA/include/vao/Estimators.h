@@ -101,7 +101,8 @@ VAO_HD double clamp01(double x)
   return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
 }
 
-/// Winitzki's closed-form approximation of erf (max abs error ~1.2e-4).
+/// Winitzki's closed-form approximation of erf with a = 8(pi - 3) / (3 pi (4 - pi)) ~ 0.140:
+/// max abs error 3.3e-4 (measured on [-6, 6]; the 1.2e-4 often quoted is for a = 0.147).
 VAO_HD double erfWinitzki(double x)
 {
   constexpr double pi = 3.14159265358979323846;

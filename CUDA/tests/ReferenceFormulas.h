@@ -1,0 +1,74 @@
+// The estimators of METHODS.md written out again for the tests, from the text, not from
+// Estimators.h: a reference that called the library's own formulas would share its bugs.
+#pragma once
+
+#include <cmath>
+
+namespace vaotest
+{
+namespace reference
+{
+
+struct Statistics
+{
+  double mean, variance, minimum, maximum;
+};
+
+/// METHODS.md: flat when s2 <= eps max(1, mu^2) (eps = 1e-14) or vmax == vmin; then
+/// O = (q >= mu).
+inline bool flat(const Statistics& s)
+{
+  return s.maximum == s.minimum || s.variance <= 1e-14 * std::fmax(1.0, s.mean * s.mean);
+}
+
+inline double flatAnswer(double q, const Statistics& s)
+{
+  return q >= s.mean ? 1.0 : 0.0;
+}
+
+/// Ruiz et al. 3.2: t = (q - vmin) / (vmax - vmin) in [0, 1], beta = (mu - vmin) / (vmax - mu),
+/// O = t^beta, 1 when t >= 1.
+inline double cdfReconstruction(double q, const Statistics& s)
+{
+  if (s.maximum == s.minimum)
+    return q >= s.minimum ? 1.0 : 0.0;
+  const double t = std::fmin(1.0, std::fmax(0.0, (q - s.minimum) / (s.maximum - s.minimum)));
+  if (t >= 1.0)
+    return 1.0;
+  const double mu = std::fmin(s.maximum, std::fmax(s.minimum, s.mean));
+  if (mu >= s.maximum)
+    return 0.0; // beta infinite
+  return std::pow(t, (mu - s.minimum) / (s.maximum - mu));
+}
+
+/// Winitzki: erf(x) ~ sign(x) sqrt(1 - exp(-x^2 (4/pi + a x^2) / (1 + a x^2))),
+/// a = 8(pi - 3) / (3 pi (4 - pi)).
+inline double winitzki(double x)
+{
+  const double pi = std::acos(-1.0);
+  const double a = 8.0 * (pi - 3.0) / (3.0 * pi * (4.0 - pi));
+  const double value = std::sqrt(std::fmax(0.0, 1.0 - std::exp(-x * x * (4.0 / pi + a * x * x) / (1.0 + a * x * x))));
+  return x < 0 ? -value : value;
+}
+
+/// Ruiz et al. 3.3: O = (1 + erf((q - mu) / sqrt(2 s2))) / 2.
+inline double gaussianCdf(double q, const Statistics& s, bool useWinitzki)
+{
+  if (flat(s))
+    return flatAnswer(q, s);
+  const double x = (q - s.mean) / std::sqrt(2.0 * s.variance);
+  return 0.5 * (1.0 + (useWinitzki ? winitzki(x) : std::erf(x)));
+}
+
+/// Cantelli: p_max = 1 if q <= mu, else s2 / (s2 + (q - mu)^2); O = 1 - p_max.
+inline double chebyshev(double q, const Statistics& s)
+{
+  if (flat(s))
+    return flatAnswer(q, s);
+  if (q <= s.mean)
+    return 0.0;
+  return 1.0 - s.variance / (s.variance + (q - s.mean) * (q - s.mean));
+}
+
+} // namespace reference
+} // namespace vaotest
