@@ -86,13 +86,15 @@ constexpr double kFlatSpread = 1e-7;
 /// The exact answer on a flat neighbourhood, which every estimator returns there:
 /// O = (q >= mu). The computed mu carries the rounding of streamed sums (the CPU's and the
 /// GPU's differ by a few ulps), so a query equal to the common value may land a hair below
-/// it. A query within the flat spread of mu (or within the standard deviation rounding
-/// can fake) is one of the neighbourhood's values: q >= mu.
+/// it. A query within the flat spread of mu, or within the rounding of a mean of double
+/// sums (kSumRoundingUlps ulps of the data's largest deviation, which roundingVariance
+/// squares), is one of the neighbourhood's values: q >= mu. An iso value closer than
+/// that to a flat region's value cannot be told from it.
 VAO_HD double flatOpenness(double query, double mean, double roundingVariance = 0.0)
 {
   const double scale = mean > 1.0 ? mean : (mean < -1.0 ? -mean : 1.0);
   const double relative = kFlatSpread * scale;
-  const double rounding = sqrt(roundingVariance);
+  const double rounding = sqrt(roundingVariance * kSumRoundingUlps * 2.220446049250313e-16);
   return query >= mean - (rounding > relative ? rounding : relative) ? 1.0 : 0.0;
 }
 
