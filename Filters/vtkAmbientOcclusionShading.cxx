@@ -1,6 +1,6 @@
 #include "vtkAmbientOcclusionShading.h"
 
-#include "vtkAmbientOcclusionInput.h"
+#include "vtkAmbientOcclusionCollectives.h"
 
 #include "vao/Shading.h"
 
@@ -23,6 +23,7 @@
 #include <sstream>
 
 vtkStandardNewMacro(vtkAmbientOcclusionShading);
+vtkCxxSetSmartPointerMacro(vtkAmbientOcclusionShading, Controller, vtkMultiProcessController);
 
 namespace
 {
@@ -73,15 +74,6 @@ vtkMultiProcessController* vtkAmbientOcclusionShading::GetController() const
   return this->Controller;
 }
 
-void vtkAmbientOcclusionShading::SetController(vtkMultiProcessController* controller)
-{
-  if (this->Controller != controller)
-  {
-    this->Controller = controller;
-    this->Modified();
-  }
-}
-
 void vtkAmbientOcclusionShading::SetColorTransferFunction(vtkScalarsToColors* colors)
 {
   this->Colors = colors;
@@ -102,22 +94,10 @@ vtkMTimeType vtkAmbientOcclusionShading::GetMTime()
 }
 
 //------------------------------------------------------------------------------
-int vtkAmbientOcclusionShading::RequestData(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+std::string vtkAmbientOcclusionShading::CheckInput(vtkPointData* pd, vtkDataArray* scalars, bool volume) const
 {
-  vtkDataSet* input = vtkDataSet::GetData(inputVector[0]);
-  vtkDataSet* output = vtkDataSet::GetData(outputVector);
-  if (!input || !output)
-  {
-    return 1;
-  }
-  output->ShallowCopy(input);
   std::ostringstream why;
-  vtkPointData* pd = input->GetPointData();
   vtkDataArray* ao = pd->GetArray(this->AmbientOcclusionArrayName.c_str());
-  vtkDataArray* scalars =
-    this->ScalarsArrayName.empty() ? pd->GetScalars() : pd->GetArray(this->ScalarsArrayName.c_str());
-  const bool volume = vtkImageData::SafeDownCast(input) != nullptr;
   if (!std::isfinite(this->AmbientIntensity) || this->AmbientIntensity < 0.0)
     why << "AmbientIntensity must be a finite, non-negative number (got " << this->AmbientIntensity << ").";
   else if (!std::isfinite(this->Gamma) || !(this->Gamma > 0.0))
@@ -135,33 +115,35 @@ int vtkAmbientOcclusionShading::RequestData(
   else if (volume && this->ModulateOpacity && !pd->GetArray("Variance"))
     why << "ModulateOpacity needs the point array 'Variance' (Volumetric Ambient Occlusion with Compute "
            "Variance on).";
-  // The automatic range is the data's range over every process (each holds a piece):
-  // reduced before any error return, since every process must take part.
-  double range[2] = { this->ScalarRange[0], this->ScalarRange[1] };
+  return why.str();
+}
+
+//------------------------------------------------------------------------------
+void vtkAmbientOcclusionShading::ColourRange(vtkDataArray* scalars, double range[2])
+{
+  range[0] = this->ScalarRange[0];
+  range[1] = this->ScalarRange[1];
   if (range[0] > range[1])
   {
+    // The data's range over every process (each holds a piece).
     range[0] = std::numeric_limits<double>::infinity();
     range[1] = -range[0];
     if (scalars && scalars->GetNumberOfTuples() > 0)
     {
       scalars->GetRange(range, 0);
     }
-    vtkAmbientOcclusionInput::GlobalRange(this->Controller, range);
+    vtkAmbientOcclusionCollectives::GlobalRange(this->Controller, range);
   }
-  if (!why.str().empty())
-  {
-    vtkErrorMacro(<< why.str());
-    output->Initialize();
-    return 1;
-  }
-  vtkSmartPointer<vtkScalarsToColors> colors = this->Colors ? this->Colors : PresetColors(this->ColorPreset, range);
-  const vtkIdType n = input->GetNumberOfPoints();
-  vtkNew<vtkUnsignedCharArray> shaded;
-  shaded->SetNumberOfComponents(volume ? 4 : 3);
-  shaded->SetNumberOfTuples(n);
-  shaded->SetName(volume ? "ShadedRGBA" : "ShadedRGB");
+}
+
+//------------------------------------------------------------------------------
+bool vtkAmbientOcclusionShading::ShadePoints(
+  vtkPointData* pd, vtkDataArray* scalars, bool volume, const double range[2], vtkUnsignedCharArray* shaded)
+{
+  vtkDataArray* ao = pd->GetArray(this->AmbientOcclusionArrayName.c_str());
   vtkDataArray* shadow = volume ? nullptr : pd->GetArray("Shadow");
   vtkDataArray* variance = volume && this->ModulateOpacity ? pd->GetArray("Variance") : nullptr;
+  vtkSmartPointer<vtkScalarsToColors> colors = this->Colors ? this->Colors : PresetColors(this->ColorPreset, range);
   double ramp[2] = { this->OpacityRamp[0], this->OpacityRamp[1] };
   if (ramp[0] > ramp[1])
   {
@@ -171,6 +153,7 @@ int vtkAmbientOcclusionShading::RequestData(
   vtkSmartPointer<vtkPiecewiseFunction> opacity = this->Opacity ? this->Opacity : RampOpacity(ramp);
   const double varianceMax =
     this->VarianceMax > 0.0 ? this->VarianceMax : std::pow((range[1] - range[0]) / 20.0, 2.0);
+  const vtkIdType n = shaded->GetNumberOfTuples();
   unsigned char* out = shaded->GetPointer(0);
   for (vtkIdType i = 0; i < n; ++i)
   {
@@ -179,8 +162,7 @@ int vtkAmbientOcclusionShading::RequestData(
       this->UpdateProgress(static_cast<double>(i) / n);
       if (this->GetAbortExecute())
       {
-        output->Initialize();
-        return 1;
+        return false;
       }
     }
     double rgb[3] = { 1.0, 1.0, 1.0 };
@@ -200,6 +182,43 @@ int vtkAmbientOcclusionShading::RequestData(
       *out++ = vao::toByte(opacity->GetValue(v) * m);
     }
   }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+int vtkAmbientOcclusionShading::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkDataSet* input = vtkDataSet::GetData(inputVector[0]);
+  vtkDataSet* output = vtkDataSet::GetData(outputVector);
+  if (!input || !output)
+  {
+    return 1;
+  }
+  output->ShallowCopy(input);
+  vtkPointData* pd = input->GetPointData();
+  vtkDataArray* scalars =
+    this->ScalarsArrayName.empty() ? pd->GetScalars() : pd->GetArray(this->ScalarsArrayName.c_str());
+  const bool volume = vtkImageData::SafeDownCast(input) != nullptr;
+  const std::string error = this->CheckInput(pd, scalars, volume);
+  // The range is reduced before any error return: every process must take part.
+  double range[2];
+  this->ColourRange(scalars, range);
+  if (!error.empty())
+  {
+    vtkErrorMacro(<< error);
+    output->Initialize();
+    return 1;
+  }
+  vtkNew<vtkUnsignedCharArray> shaded;
+  shaded->SetNumberOfComponents(volume ? 4 : 3);
+  shaded->SetNumberOfTuples(input->GetNumberOfPoints());
+  shaded->SetName(volume ? "ShadedRGBA" : "ShadedRGB");
+  if (!this->ShadePoints(pd, scalars, volume, range, shaded))
+  {
+    output->Initialize();
+    return 1;
+  }
   output->GetPointData()->AddArray(shaded);
   output->GetPointData()->SetActiveScalars(shaded->GetName());
   return 1;
@@ -215,4 +234,5 @@ void vtkAmbientOcclusionShading::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ModulateOpacity: " << this->ModulateOpacity << ", VarianceMax: " << this->VarianceMax << "\n";
   os << indent << "ColorPreset: " << this->ColorPreset << ", ScalarRange: " << this->ScalarRange[0] << " "
      << this->ScalarRange[1] << ", OpacityRamp: " << this->OpacityRamp[0] << " " << this->OpacityRamp[1] << "\n";
+  os << indent << "Controller: " << this->Controller.Get() << "\n";
 }

@@ -27,9 +27,12 @@
 
 #include <string>
 
+class vtkDataArray;
 class vtkMultiProcessController;
 class vtkPiecewiseFunction;
+class vtkPointData;
 class vtkScalarsToColors;
+class vtkUnsignedCharArray;
 
 class VOLUMETRICAOFILTERS_EXPORT vtkAmbientOcclusionShading : public vtkPassInputTypeAlgorithm
 {
@@ -121,6 +124,14 @@ protected:
 private:
   vtkAmbientOcclusionShading(const vtkAmbientOcclusionShading&) = delete;
   void operator=(const vtkAmbientOcclusionShading&) = delete;
+
+  /// Why the parameters or the input's arrays cannot be shaded; empty when they can.
+  std::string CheckInput(vtkPointData* pd, vtkDataArray* scalars, bool volume) const;
+  /// ScalarRange, or when it is empty the scalars' range over every process. Collective.
+  void ColourRange(vtkDataArray* scalars, double range[2]);
+  /// Fills `shaded` (3 components a point, 4 on a volume); false when the user aborted.
+  bool ShadePoints(
+    vtkPointData* pd, vtkDataArray* scalars, bool volume, const double range[2], vtkUnsignedCharArray* shaded);
 };
 
 #endif

@@ -21,6 +21,7 @@
 
 #include "VolumetricAOFiltersModule.h" // for export macro
 #include "vtkPolyDataAlgorithm.h"
+#include "vtkSmartPointer.h" // for the controller
 
 #include <memory>
 #include <vector>
@@ -28,6 +29,11 @@
 class vtkDataArray;
 class vtkMultiProcessController;
 class vtkImageData;
+namespace vao
+{
+struct PyramidParameters;
+struct SurfaceOcclusionParameters;
+}
 
 class VOLUMETRICAOFILTERS_EXPORT vtkIsosurfaceAmbientOcclusion : public vtkPolyDataAlgorithm
 {
@@ -106,6 +112,14 @@ public:
   vtkGetMacro(Component, int);
   ///@}
 
+  ///@{
+  /// Threads of the pyramid's build and of the sampling on this process; 0 (default): the
+  /// cores available to the process, divided among the MPI ranks on its node. Negative
+  /// values are an error.
+  vtkSetMacro(NumberOfThreads, int);
+  vtkGetMacro(NumberOfThreads, int);
+  ///@}
+
   /// How many times the pyramid was built (the cache's witness).
   int GetNumberOfPyramidBuilds() const { return this->PyramidBuilds; }
 
@@ -139,7 +153,9 @@ protected:
   vtkTypeBool ComputeShadows = false;
   double LightDirection[3] = { 0.0, 0.0, 1.0 };
   int Component = -1;
+  int NumberOfThreads = 0;
   int PyramidBuilds = 0;
+  vtkSmartPointer<vtkMultiProcessController> Controller;
 
 private:
   vtkIsosurfaceAmbientOcclusion(const vtkIsosurfaceAmbientOcclusion&) = delete;
@@ -149,6 +165,9 @@ private:
   std::unique_ptr<Cache> Pyramid;
 
   bool CheckParameters();
+  /// The kernel's parameters of the sampling, and of the pyramid (CheckParameters passed).
+  vao::SurfaceOcclusionParameters Parameters() const;
+  vao::PyramidParameters PyramidRequest() const;
   bool UpdatePyramid(vtkImageData* volume, vtkDataArray* chosen);
   bool IsDistributed() const;
   /// This process's piece of the volume and the extent it reads (grown by the reach).
@@ -156,7 +175,13 @@ private:
   /// The pyramid of this process's extent, its coarsest level replaced by the whole one.
   /// Collective: every process calls it, also after an error of its own.
   bool UpdateDistributedPyramid(vtkImageData* volume, vtkDataArray* chosen, const int whole[6], int piece[6]);
-  bool SurfaceNormals(vtkPolyData* surface, std::vector<double>& normals);
+  /// Replaces the coarsest level of this process's pyramid (built from `inputExt`) by the
+  /// whole volume's, assembled from every process's piece. Collective.
+  void ShareCoarsestLevel(vtkImageData* volume, const int whole[6], const int inputExt[6], const int piece[6]);
+  /// The surface lies in the volume (or near this process's piece of it when distributed).
+  bool CheckSurfaceInVolume(vtkPolyData* surface, vtkImageData* volume, const int whole[6], const int piece[6]);
+  /// Samples the pyramid at the surface's points into output's AO (and Shadow) arrays.
+  bool Shade(vtkPolyData* surface, vtkPolyData* output);
 };
 
 #endif

@@ -1,6 +1,8 @@
 #include "vtkOcclusionSweeping.h"
 
-#include "vtkAmbientOcclusionInput.h"
+#include "vtkAmbientOcclusionArrayInput.h"
+#include "vtkAmbientOcclusionCollectives.h"
+#include "vtkAmbientOcclusionExtents.h"
 
 #include "vao/BlockSweeping.h"
 #include "vao/OcclusionSweeping.h"
@@ -25,7 +27,13 @@
 #include <vector>
 
 vtkStandardNewMacro(vtkOcclusionSweeping);
-vtkCxxSetObjectMacro(vtkOcclusionSweeping, Controller, vtkMultiProcessController);
+vtkCxxSetSmartPointerMacro(vtkOcclusionSweeping, Controller, vtkMultiProcessController);
+
+using vtkAmbientOcclusionArrayInput::ExecutionOf;
+using vtkAmbientOcclusionArrayInput::KernelError;
+using vtkAmbientOcclusionArrayInput::PrepareScalars;
+using vtkAmbientOcclusionArrayInput::ScalarVolume;
+using vtkAmbientOcclusionCollectives::GlobalMax;
 
 namespace
 {
@@ -61,7 +69,13 @@ void SlabInputExtent(const int whole[6], int rank, int ranks, int ext[6])
   ext[2 * axis + 1] = std::min(whole[2 * axis + 1], ext[2 * axis + 1] + 1);
 }
 
-using vtkAmbientOcclusionInput::GlobalMax;
+/// The rounds stop when no ghost value moves by this much; so does each round's sweeping
+/// of its slab (one pass per round would need as many rounds as passes): the
+/// ConvergenceTolerance, or when it is 0 a thousandth of the smallest spacing.
+double ExchangeTolerance(double convergenceTolerance, const double spacing[3])
+{
+  return convergenceTolerance > 0.0 ? convergenceTolerance : 1e-3 * std::min({ spacing[0], spacing[1], spacing[2] });
+}
 
 /// Exchanges the face buffers with the slab neighbours (rank - 1 across the lower face,
 /// rank + 1 across the upper). Pairs go in rank order, the lower one sending first, so no
@@ -117,18 +131,26 @@ vao::SweepOutput AddOutputArrays(vtkImageData* image, bool withOctants)
 
 } // namespace
 
+struct vtkOcclusionSweeping::Slab
+{
+  int extent[6]; // the voxels this process sweeps (its input has a ghost layer more)
+  ScalarVolume scalars; // read by the block sweeper until it finishes
+  std::unique_ptr<vao::BlockSweeper> block;
+};
+
 //------------------------------------------------------------------------------
 vtkOcclusionSweeping::vtkOcclusionSweeping()
+  : Controller(vtkMultiProcessController::GetGlobalController())
 {
   this->SetInputArrayToProcess(
     0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
-  this->SetController(vtkMultiProcessController::GetGlobalController());
 }
 
-//------------------------------------------------------------------------------
-vtkOcclusionSweeping::~vtkOcclusionSweeping()
+vtkOcclusionSweeping::~vtkOcclusionSweeping() = default;
+
+vtkMultiProcessController* vtkOcclusionSweeping::GetController() const
 {
-  this->SetController(nullptr);
+  return this->Controller;
 }
 
 //------------------------------------------------------------------------------
@@ -181,51 +203,55 @@ int vtkOcclusionSweeping::RequestUpdateExtent(
     int ext[6];
     SlabInputExtent(whole, this->Controller->GetLocalProcessId(),
       this->Controller->GetNumberOfProcesses(), ext);
-    vtkAmbientOcclusionInput::RequestExactExtent(inInfo, ext);
+    vtkAmbientOcclusionExtents::RequestExactExtent(inInfo, ext);
   }
   else
   {
-    vtkAmbientOcclusionInput::RequestWholeExtent(inInfo);
+    vtkAmbientOcclusionExtents::RequestWholeExtent(inInfo);
   }
   return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkOcclusionSweeping::WarnNoSurface(const std::string& arrayName)
+{
+  vtkWarningMacro(<< "IsoValue " << this->IsoValue << " does not cross array '" << arrayName
+                  << "': there is no surface; every voxel is "
+                  << "entirely inside or outside (AmbientOcclusion 0 or 1).");
 }
 
 //------------------------------------------------------------------------------
 int vtkOcclusionSweeping::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  vtkImageData* input = vtkImageData::GetData(inInfo);
-  vtkImageData* output = vtkImageData::GetData(outInfo);
+  vtkImageData* input = vtkImageData::GetData(inputVector[0]);
+  vtkImageData* output = vtkImageData::GetData(outputVector);
   output->Initialize();
   if (!input)
   {
     return 1;
   }
   int whole[6], outExt[6];
-  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), outExt);
-  std::string error;
-  if (!vtkAmbientOcclusionInput::CheckWholeExtent(whole, error))
+  std::string error = vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+  if (!error.empty() ||
+    !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, whole, outExt, error))
   {
     vtkErrorMacro(<< error);
     return 1;
   }
+  vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
   if (this->IsDistributed(whole))
   {
-    return this->RequestDistributedData(input, output, whole, outExt, inputVector);
+    return this->RequestDistributedData(input, output, whole, outExt, chosen);
   }
   this->LastRounds = 0;
-  const int* inExt = input->GetExtent();
-  if (!std::equal(whole, whole + 6, inExt))
+  if (!std::equal(whole, whole + 6, input->GetExtent()))
   {
     vtkErrorMacro(<< "Occlusion sweeping needs the whole volume; the upstream source delivered only part of it.");
     return 1;
   }
-  vtkAmbientOcclusionInput::ScalarVolume scalars;
-  if (!vtkAmbientOcclusionInput::PrepareScalars(
-        this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error))
+  ScalarVolume scalars;
+  if (!PrepareScalars(this, chosen, input, this->Component, scalars, error))
   {
     vtkErrorMacro(<< error);
     return 1;
@@ -238,44 +264,36 @@ int vtkOcclusionSweeping::RequestData(
   const double* spacing = input->GetSpacing();
   vao::SweepReport report;
   const vao::Status status = vao::computeOcclusionSweeping(scalars.view, { spacing[0], spacing[1], spacing[2] },
-    this->Parameters(), arrays, vtkAmbientOcclusionInput::ExecutionOf(this), &report);
+    this->Parameters(), arrays, ExecutionOf(this, this->NumberOfThreads), &report);
   if (!status.ok)
   {
-    if (!status.aborted)
+    error = KernelError(status, scalars, "Occlusion sweeping failed");
+    if (!error.empty())
     {
-      vtkErrorMacro(<< "Occlusion sweeping failed: " << status.message << ".");
+      vtkErrorMacro(<< error);
     }
     return 1;
   }
   if (!report.surfaceFound)
   {
-    vtkWarningMacro(<< "IsoValue " << this->IsoValue << " does not cross array '" << scalars.name
-                    << "': there is no surface; every voxel is "
-                    << "entirely inside or outside (AmbientOcclusion 0 or 1).");
+    this->WarnNoSurface(scalars.name);
   }
   this->LastPasses = report.passes;
   this->LastChange = report.lastChange;
 
-  vtkAmbientOcclusionInput::CopyRequestedExtent(whole3d, output, outExt);
+  vtkAmbientOcclusionExtents::CopyRequestedExtent(whole3d, output, outExt);
   return 1;
 }
 
 //------------------------------------------------------------------------------
-int vtkOcclusionSweeping::RequestDistributedData(vtkImageData* input, vtkImageData* output,
-  const int whole[6], const int outExt[6], vtkInformationVector** inputVector)
+std::string vtkOcclusionSweeping::StartSlab(vtkImageData* input, vtkDataArray* chosen, const int whole[6], Slab& slab)
 {
-  vtkMultiProcessController* controller = this->Controller;
-  const int rank = controller->GetLocalProcessId(), ranks = controller->GetNumberOfProcesses();
-  const int axis = SlabAxis(whole);
-  int slab[6], expected[6];
-  SlabExtent(whole, rank, ranks, slab);
+  const int rank = this->Controller->GetLocalProcessId(), ranks = this->Controller->GetNumberOfProcesses();
+  int expected[6];
+  SlabExtent(whole, rank, ranks, slab.extent);
   SlabInputExtent(whole, rank, ranks, expected);
-
-  // Every process checks its slab, then all agree: one that stopped alone would leave
-  // the others waiting at the first exchange.
-  std::string error;
-  vtkAmbientOcclusionInput::ScalarVolume scalars;
   const int* inExt = input->GetExtent();
+  std::string error;
   if (!std::equal(expected, expected + 6, inExt))
   {
     std::ostringstream why;
@@ -283,38 +301,68 @@ int vtkOcclusionSweeping::RequestDistributedData(vtkImageData* input, vtkImageDa
         << expected[1] << ", " << expected[2] << ".." << expected[3] << ", " << expected[4] << ".."
         << expected[5] << "); the upstream source delivered (" << inExt[0] << ".." << inExt[1] << ", "
         << inExt[2] << ".." << inExt[3] << ", " << inExt[4] << ".." << inExt[5] << ").";
-    error = why.str();
+    return why.str();
   }
-  else
+  if (!PrepareScalars(this, chosen, input, this->Component, slab.scalars, error))
   {
-    vtkAmbientOcclusionInput::PrepareScalars(
-      this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error);
+    return error;
   }
-  vao::SweepParameters parameters = this->Parameters();
   const double* spacing = input->GetSpacing();
-  // The rounds stop when no ghost value moves by the tolerance; so does each round's
-  // sweeping of its slab (one pass per round would need as many rounds as passes).
-  const double smallest = std::min({ spacing[0], spacing[1], spacing[2] });
-  parameters.tolerance = this->ConvergenceTolerance > 0.0 ? this->ConvergenceTolerance : 1e-3 * smallest;
-  const int passesPerRound = std::max(this->NumberOfIterations, 64);
+  vao::SweepParameters parameters = this->Parameters();
+  parameters.tolerance = ExchangeTolerance(this->ConvergenceTolerance, spacing);
   vao::BlockPlacement placement;
   for (int a = 0; a < 3; ++a)
   {
     placement.whole[a] = whole[2 * a + 1] - whole[2 * a] + 1;
-    placement.begin[a] = slab[2 * a] - whole[2 * a];
-    placement.size[a] = slab[2 * a + 1] - slab[2 * a] + 1;
+    placement.begin[a] = slab.extent[2 * a] - whole[2 * a];
+    placement.size[a] = slab.extent[2 * a + 1] - slab.extent[2 * a] + 1;
   }
-  std::unique_ptr<vao::BlockSweeper> block;
-  if (error.empty())
+  slab.block.reset(new vao::BlockSweeper(slab.scalars.view, placement, { spacing[0], spacing[1], spacing[2] },
+    parameters, ExecutionOf(this, this->NumberOfThreads)));
+  return KernelError(slab.block->initialise(), slab.scalars, "Occlusion sweeping failed");
+}
+
+//------------------------------------------------------------------------------
+int vtkOcclusionSweeping::SweepRounds(vao::BlockSweeper& block, int axis, double tolerance)
+{
+  // Sweep the slab with the ghosts as they are, exchange the faces, until the ghosts
+  // settle everywhere (or the process aborts, everywhere).
+  vtkMultiProcessController* controller = this->Controller;
+  const int ranks = controller->GetNumberOfProcesses();
+  const int passesPerRound = std::max(this->NumberOfIterations, 64);
+  const int maxRounds = 4 * ranks + 32;
+  int rounds = 0;
+  double change = 0.0;
+  do
   {
-    block.reset(new vao::BlockSweeper(scalars.view, placement, { spacing[0], spacing[1], spacing[2] },
-      parameters, vtkAmbientOcclusionInput::ExecutionOf(this)));
-    const vao::Status status = block->initialise();
-    if (!status.ok)
+    vao::SweepReport report;
+    const vao::Status status = block.runRound(passesPerRound, &report);
+    if (GlobalMax(controller, status.ok ? 0.0 : 1.0) > 0.0)
     {
-      error = "Occlusion sweeping failed: " + status.message + ".";
+      return -1; // aborted (an abort is not an error)
     }
+    change = GlobalMax(controller, ExchangeFaces(controller, block, axis));
+    this->LastPasses = report.passes;
+    this->LastChange = change;
+    this->UpdateProgress(std::min(0.9, 0.9 * (rounds + 1) / (ranks + 2.0)));
+  } while (++rounds < maxRounds && change > tolerance);
+  if (change > tolerance)
+  {
+    vtkWarningMacro(<< "Occlusion sweeping: the slabs still changed by " << change << " after " << rounds
+                    << " rounds of exchanges.");
   }
+  return rounds;
+}
+
+//------------------------------------------------------------------------------
+int vtkOcclusionSweeping::RequestDistributedData(
+  vtkImageData* input, vtkImageData* output, const int whole[6], const int outExt[6], vtkDataArray* chosen)
+{
+  // Every process checks its slab, then all agree: one that stopped alone would leave
+  // the others waiting at the first exchange.
+  vtkMultiProcessController* controller = this->Controller;
+  Slab slab;
+  const std::string error = this->StartSlab(input, chosen, whole, slab);
   if (GlobalMax(controller, error.empty() ? 0.0 : 1.0) > 0.0)
   {
     vtkErrorMacro(<< (error.empty() ? std::string("Occlusion sweeping stopped: another process "
@@ -322,51 +370,33 @@ int vtkOcclusionSweeping::RequestDistributedData(vtkImageData* input, vtkImageDa
                                     : error));
     return 1;
   }
-
-  // Rounds: sweep the slab with the ghosts as they are, exchange the faces, until the
-  // ghosts settle everywhere (or the process aborts, everywhere).
   int rounds = 0;
-  if (GlobalMax(controller, block->surfaceFound() ? 1.0 : 0.0) == 0.0)
+  vao::BlockSweeper& block = *slab.block;
+  if (GlobalMax(controller, block.surfaceFound() ? 1.0 : 0.0) == 0.0)
   {
-    block->fillWithoutSurface();
-    vtkWarningMacro(<< "IsoValue " << this->IsoValue << " does not cross array '" << scalars.name
-                    << "': there is no surface; every voxel is entirely inside or outside.");
+    block.fillWithoutSurface();
+    this->WarnNoSurface(slab.scalars.name);
   }
   else
   {
-    const int maxRounds = 4 * ranks + 32;
-    double change = 0.0;
-    do
+    const double tolerance = ExchangeTolerance(this->ConvergenceTolerance, input->GetSpacing());
+    rounds = this->SweepRounds(block, SlabAxis(whole), tolerance);
+    if (rounds < 0)
     {
-      vao::SweepReport report;
-      const vao::Status status = block->runRound(passesPerRound, &report);
-      const double stop = GlobalMax(controller, status.ok ? 0.0 : 1.0);
-      if (stop > 0.0)
-      {
-        return 1; // aborted (an abort is not an error)
-      }
-      change = GlobalMax(controller, ExchangeFaces(controller, *block, axis));
-      this->LastPasses = report.passes;
-      this->LastChange = change;
-      this->UpdateProgress(std::min(0.9, 0.9 * (rounds + 1) / (ranks + 2.0)));
-    } while (++rounds < maxRounds && change > parameters.tolerance);
-    if (change > parameters.tolerance)
-    {
-      vtkWarningMacro(<< "Occlusion sweeping: the slabs still changed by " << change << " after "
-                      << rounds << " rounds of exchanges.");
+      return 1;
     }
   }
   this->LastRounds = rounds;
 
   // The slab's results with the input's arrays, then to whatever extent was requested.
   vtkNew<vtkImageData> held;
-  vtkAmbientOcclusionInput::CopyRequestedExtent(input, held, slab);
-  block->finish(AddOutputArrays(held, this->OutputOctantVisibility != 0));
+  vtkAmbientOcclusionExtents::CopyRequestedExtent(input, held, slab.extent);
+  block.finish(AddOutputArrays(held, this->OutputOctantVisibility != 0));
   vtkNew<vtkIntArray> roundsArray;
   roundsArray->SetName("SweepingExchangeRounds");
   roundsArray->InsertNextValue(rounds);
   held->GetFieldData()->AddArray(roundsArray);
-  vtkAmbientOcclusionInput::RedistributeExtents(controller, held, outExt, output);
+  vtkAmbientOcclusionCollectives::RedistributeExtents(controller, held, outExt, output);
   this->UpdateProgress(1.0);
   return 1;
 }
@@ -387,5 +417,6 @@ void vtkOcclusionSweeping::PrintSelf(ostream& os, vtkIndent indent)
   }
   os << "\n" << indent << "Gamma: " << this->Gamma << ", Opacity: " << this->Opacity << "\n";
   os << indent << "OutputOctantVisibility: " << this->OutputOctantVisibility << "\n";
-  os << indent << "Component: " << this->Component << "\n";
+  os << indent << "Component: " << this->Component << ", NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "Controller: " << this->Controller.Get() << "\n";
 }

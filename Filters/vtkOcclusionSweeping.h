@@ -26,10 +26,15 @@
 
 #include "VolumetricAOFiltersModule.h" // for export macro
 #include "vtkImageAlgorithm.h"
+#include "vtkSmartPointer.h" // for the controller
 
+#include <string>
+
+class vtkDataArray;
 class vtkMultiProcessController;
 namespace vao
 {
+class BlockSweeper;
 struct SweepParameters;
 }
 
@@ -101,6 +106,13 @@ public:
   vtkGetMacro(Component, int);
   ///@}
 
+  ///@{
+  /// Threads of the sweeps on this process; 0 (default): the cores available to the
+  /// process, divided among the MPI ranks on its node. Negative values are an error.
+  vtkSetMacro(NumberOfThreads, int);
+  vtkGetMacro(NumberOfThreads, int);
+  ///@}
+
   /// Passes run and the last pass's largest change, from the last execution.
   int GetLastNumberOfPasses() const { return this->LastPasses; }
   double GetLastChange() const { return this->LastChange; }
@@ -115,8 +127,8 @@ public:
   /// slabs that hold it. The result is the converged sweeping, equal to a serial run
   /// that converges (NumberOfIterations large, ConvergenceTolerance > 0). Every process
   /// must execute the filter. nullptr: each process sweeps the whole volume.
-  virtual void SetController(vtkMultiProcessController*);
-  vtkGetObjectMacro(Controller, vtkMultiProcessController);
+  void SetController(vtkMultiProcessController* controller);
+  vtkMultiProcessController* GetController() const;
   ///@}
 
   /// Rounds of face exchanges of the last distributed execution (0 when serial); also in
@@ -141,17 +153,26 @@ protected:
   double Opacity = 1.0;
   vtkTypeBool OutputOctantVisibility = false;
   int Component = -1;
+  int NumberOfThreads = 0;
   int LastPasses = 0;
   double LastChange = 0.0;
   int LastRounds = 0;
-  vtkMultiProcessController* Controller = nullptr;
+  vtkSmartPointer<vtkMultiProcessController> Controller;
 
 private:
   vao::SweepParameters Parameters() const;
   bool IsDistributed(const int whole[6]) const;
+  void WarnNoSurface(const std::string& arrayName);
   /// The distributed execution (Controller with several processes).
-  int RequestDistributedData(vtkImageData* input, vtkImageData* output, const int whole[6],
-    const int outExt[6], vtkInformationVector** inputVector);
+  int RequestDistributedData(
+    vtkImageData* input, vtkImageData* output, const int whole[6], const int outExt[6], vtkDataArray* chosen);
+  /// This process's slab: its scalars and its block sweeper.
+  struct Slab;
+  /// Starts the block sweeper of this process's slab; the reason when it cannot.
+  std::string StartSlab(vtkImageData* input, vtkDataArray* chosen, const int whole[6], Slab& slab);
+  /// Rounds of sweeps and face exchanges until the ghosts settle on every process; -1
+  /// when the run was aborted.
+  int SweepRounds(vao::BlockSweeper& block, int axis, double tolerance);
 
   vtkOcclusionSweeping(const vtkOcclusionSweeping&) = delete;
   void operator=(const vtkOcclusionSweeping&) = delete;

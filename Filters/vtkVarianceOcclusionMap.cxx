@@ -1,6 +1,8 @@
 #include "vtkVarianceOcclusionMap.h"
 
-#include "vtkAmbientOcclusionInput.h"
+#include "vtkAmbientOcclusionArrayInput.h"
+#include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionPyramidImages.h"
 
 #include "vao/VarianceOcclusionMap.h"
 
@@ -18,6 +20,8 @@
 #include <string>
 
 vtkStandardNewMacro(vtkVarianceOcclusionMap);
+
+namespace Extents = vtkAmbientOcclusionExtents;
 
 //------------------------------------------------------------------------------
 vtkVarianceOcclusionMap::vtkVarianceOcclusionMap()
@@ -38,23 +42,23 @@ void vtkVarianceOcclusionMap::InputExtentOf(const int whole[6], const int piece[
 {
   const bool half = this->StartAtHalfResolution != 0;
   const int levels = std::max(1, std::min(this->NumberOfLevels, 16));
-  const int reach = vtkAmbientOcclusionInput::PyramidReach(levels, half);
+  const int reach = Extents::PyramidReach(levels, half);
   const int reaches[3] = { reach, reach, reach };
-  vtkAmbientOcclusionInput::GrowForPyramid(
-    whole, piece, reaches, vtkAmbientOcclusionInput::PyramidAlignment(levels, half), ext);
+  Extents::GrowForPyramid(
+    whole, piece, reaches, Extents::PyramidAlignment(levels, half), ext);
 }
 
 //------------------------------------------------------------------------------
 int vtkVarianceOcclusionMap::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  // Each level voxel depends on the input within PyramidMargin of it: a piece needs its
+  // Each level voxel depends on the input within PyramidReach of it: a piece needs its
   // extent grown by that (aligned on the coarsest level's voxels), not the whole volume.
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
   int whole[6], piece[6], ext[6];
   inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  vtkAmbientOcclusionInput::RequestedPiece(outputVector->GetInformationObject(0), whole, piece);
-  if (vtkAmbientOcclusionInput::EmptyExtent(piece))
+  Extents::RequestedPiece(outputVector->GetInformationObject(0), whole, piece);
+  if (Extents::EmptyExtent(piece))
   {
     std::copy(piece, piece + 6, ext); // nothing to output: ask for nothing
   }
@@ -62,8 +66,17 @@ int vtkVarianceOcclusionMap::RequestUpdateExtent(
   {
     this->InputExtentOf(whole, piece, ext);
   }
-  vtkAmbientOcclusionInput::RequestExactExtent(inInfo, ext);
+  Extents::RequestExactExtent(inInfo, ext);
   return 1;
+}
+
+//------------------------------------------------------------------------------
+vao::PyramidParameters vtkVarianceOcclusionMap::Parameters() const
+{
+  vao::PyramidParameters parameters;
+  parameters.levels = this->NumberOfLevels;
+  parameters.startAtHalfResolution = this->StartAtHalfResolution != 0;
+  return parameters;
 }
 
 //------------------------------------------------------------------------------
@@ -73,13 +86,19 @@ int vtkVarianceOcclusionMap::RequestData(
   vtkImageData* input = vtkImageData::GetData(inputVector[0]);
   vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector);
   output->Initialize();
+  std::string error = vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+  if (!error.empty())
+  {
+    vtkErrorMacro(<< error);
+    return 1;
+  }
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
   int whole[6], piece[6], expected[6];
   inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  vtkAmbientOcclusionInput::RequestedPiece(outInfo, whole, piece);
+  Extents::RequestedPiece(outInfo, whole, piece);
   const int levels = std::max(0, this->NumberOfLevels);
-  if (vtkAmbientOcclusionInput::EmptyExtent(piece))
+  if (Extents::EmptyExtent(piece))
   {
     output->SetNumberOfBlocks(static_cast<unsigned int>(levels)); // an empty piece
     return 1;
@@ -92,14 +111,13 @@ int vtkVarianceOcclusionMap::RequestData(
                   << expected[5] << "; the upstream source delivered another one.");
     return 1;
   }
-  std::string error;
   std::vector<vao::MomentLevel> pyramid;
-  vtkAmbientOcclusionInput::ScalarVolume scalars;
-  if (!input || !vtkAmbientOcclusionInput::CheckWholeExtent(whole, error) ||
-    !vtkAmbientOcclusionInput::PrepareScalars(
+  vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
+  if (!input || !Extents::CheckWholeExtent(whole, error) ||
+    !vtkAmbientOcclusionArrayInput::PrepareScalars(
       this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error) ||
-    !vtkAmbientOcclusionInput::BuildPyramid(
-      this, scalars, input, this->NumberOfLevels, this->StartAtHalfResolution != 0, pyramid, error))
+    !vtkAmbientOcclusionPyramidImages::BuildPyramid(scalars, input, this->Parameters(),
+      vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads), pyramid, error))
   {
     if (!error.empty())
     {
@@ -113,7 +131,7 @@ int vtkVarianceOcclusionMap::RequestData(
   int step = this->StartAtHalfResolution ? 2 : 1;
   for (size_t l = 0; l < pyramid.size(); ++l, step *= 2)
   {
-    auto part = vtkAmbientOcclusionInput::LevelPiece(pyramid[l], whole, expected, piece, step);
+    auto part = vtkAmbientOcclusionPyramidImages::LevelPiece(pyramid[l], whole, expected, piece, step);
     output->SetBlock(static_cast<unsigned int>(l), part);
     output->GetMetaData(static_cast<unsigned int>(l))
       ->Set(vtkCompositeDataSet::NAME(), ("Level " + std::to_string(l)).c_str());
@@ -127,5 +145,5 @@ void vtkVarianceOcclusionMap::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "NumberOfLevels: " << this->NumberOfLevels << "\n";
   os << indent << "StartAtHalfResolution: " << this->StartAtHalfResolution << "\n";
-  os << indent << "Component: " << this->Component << "\n";
+  os << indent << "Component: " << this->Component << ", NumberOfThreads: " << this->NumberOfThreads << "\n";
 }

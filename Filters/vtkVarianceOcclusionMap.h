@@ -17,6 +17,11 @@
 #include "VolumetricAOFiltersModule.h" // for export macro
 #include "vtkMultiBlockDataSetAlgorithm.h"
 
+namespace vao
+{
+struct PyramidParameters;
+}
+
 class VOLUMETRICAOFILTERS_EXPORT vtkVarianceOcclusionMap : public vtkMultiBlockDataSetAlgorithm
 {
 public:
@@ -44,6 +49,13 @@ public:
   vtkGetMacro(Component, int);
   ///@}
 
+  ///@{
+  /// Threads of the pyramid's build on this process; 0 (default): the cores available to
+  /// the process, divided among the MPI ranks on its node. Negative values are an error.
+  vtkSetMacro(NumberOfThreads, int);
+  vtkGetMacro(NumberOfThreads, int);
+  ///@}
+
 protected:
   vtkVarianceOcclusionMap();
   ~vtkVarianceOcclusionMap() override = default;
@@ -55,8 +67,11 @@ protected:
   int NumberOfLevels = 4;
   vtkTypeBool StartAtHalfResolution = false;
   int Component = -1;
+  int NumberOfThreads = 0;
 
 private:
+  /// The kernel's pyramid parameters.
+  vao::PyramidParameters Parameters() const;
   /// The input extent a piece needs: the piece grown by the pyramid's reach, its lower
   /// end aligned on the coarsest level's voxels.
   void InputExtentOf(const int whole[6], const int piece[6], int ext[6]) const;

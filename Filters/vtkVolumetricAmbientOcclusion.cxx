@@ -1,9 +1,11 @@
 #include "vtkVolumetricAmbientOcclusion.h"
 
-#include "vtkAmbientOcclusionInput.h"
+#include "vtkAmbientOcclusionArrayInput.h"
+#include "vtkAmbientOcclusionExtents.h"
 
 #include "vao/AmbientOcclusion.h"
 #include "vao/Cuda.h"
+#include "vao/Validation.h"
 
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
@@ -31,14 +33,40 @@ namespace
 const char* const MethodNames[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box",
   "Exact Sphere" };
 
-/// Grows ext by r on each axis, clipped to whole.
-void GrowExtent(int ext[6], const int r[3], const int whole[6])
+vao::Method KernelMethod(int method)
 {
-  for (int a = 0; a < 3; ++a)
+  switch (method)
   {
-    ext[2 * a] = std::max(ext[2 * a] - r[a], whole[2 * a]);
-    ext[2 * a + 1] = std::min(ext[2 * a + 1] + r[a], whole[2 * a + 1]);
+    case vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION:
+      return vao::Method::CdfReconstruction;
+    case vtkVolumetricAmbientOcclusion::CHEBYSHEV:
+      return vao::Method::Chebyshev;
+    case vtkVolumetricAmbientOcclusion::EXACT_BOX:
+      return vao::Method::ExactBox;
+    case vtkVolumetricAmbientOcclusion::EXACT_SPHERE:
+      return vao::Method::ExactSphere;
+    case vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF:
+    default: // CheckParameters rejects any other value
+      return vao::Method::GaussianCdf;
   }
+}
+
+vao::QueryMode KernelQueryMode(int mode)
+{
+  return mode == vtkVolumetricAmbientOcclusion::ISO_VALUE ? vao::QueryMode::IsoValue : vao::QueryMode::VoxelValue;
+}
+
+vao::ErfMode KernelErfMode(int erf)
+{
+  return erf == vtkVolumetricAmbientOcclusion::ERF_WINITZKI ? vao::ErfMode::Winitzki : vao::ErfMode::Exact;
+}
+
+vtkSmartPointer<vtkFloatArray> NewFloatArray(const char* name, vtkIdType values)
+{
+  auto array = vtkSmartPointer<vtkFloatArray>::New();
+  array->SetName(name);
+  array->SetNumberOfTuples(values);
+  return array;
 }
 
 } // namespace
@@ -69,53 +97,48 @@ void vtkVolumetricAmbientOcclusion::ComputeVoxelRadius(const double spacing[3], 
 //------------------------------------------------------------------------------
 bool vtkVolumetricAmbientOcclusion::CheckParameters()
 {
+  // The VTK side: enums, names, the radius before it becomes voxels. The kernel's own
+  // checks (finiteness) keep its wording, with the property's name.
+  std::ostringstream why;
+  const vao::Status iso = this->QueryMode == ISO_VALUE ? vao::checkFiniteParameter(this->IsoValue, "IsoValue")
+                                                       : vao::Status::success();
   if (!std::isfinite(this->Radius) || this->Radius < 0.0)
+    why << "Radius must be a finite, non-negative number (got " << this->Radius << ").";
+  else if (this->Method < CDF_RECONSTRUCTION || this->Method > EXACT_SPHERE)
+    why << "Unknown Method " << this->Method
+        << " (0 CDF Reconstruction, 1 Gaussian CDF, 2 Chebyshev, 3 Exact Box, 4 Exact Sphere).";
+  else if (this->RadiusUnits != VOXELS && this->RadiusUnits != WORLD)
+    why << "Unknown RadiusUnits " << this->RadiusUnits << " (0 Voxels, 1 World).";
+  else if (this->QueryMode != VOXEL_VALUE && this->QueryMode != ISO_VALUE)
+    why << "Unknown QueryMode " << this->QueryMode << " (0 Voxel Value, 1 Iso Value).";
+  else if (!iso.ok)
+    why << iso.message << ".";
+  else if (this->ErfApproximation != ERF_EXACT && this->ErfApproximation != ERF_WINITZKI)
+    why << "Unknown ErfApproximation " << this->ErfApproximation << " (0 Exact, 1 Winitzki).";
+  else if (this->Backend < BACKEND_AUTO || this->Backend > BACKEND_CUDA)
+    why << "Unknown Backend " << this->Backend << " (0 Auto, 1 CPU, 2 CUDA).";
+  else if (this->NumberOfThreads < 0)
+    why << vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+  else if (this->OutputArrayName.empty())
+    why << "OutputArrayName must not be empty.";
+  if (why.tellp() == 0)
   {
-    vtkErrorMacro(<< "Radius must be a finite, non-negative number (got " << this->Radius << ").");
-    return false;
+    return true;
   }
-  if (this->Method < CDF_RECONSTRUCTION || this->Method > EXACT_SPHERE)
-  {
-    vtkErrorMacro(<< "Unknown Method " << this->Method
-                  << " (0 CDF Reconstruction, 1 Gaussian CDF, 2 Chebyshev, 3 Exact Box, 4 Exact Sphere).");
-    return false;
-  }
-  if (this->RadiusUnits != VOXELS && this->RadiusUnits != WORLD)
-  {
-    vtkErrorMacro(<< "Unknown RadiusUnits " << this->RadiusUnits << " (0 Voxels, 1 World).");
-    return false;
-  }
-  if (this->QueryMode != VOXEL_VALUE && this->QueryMode != ISO_VALUE)
-  {
-    vtkErrorMacro(<< "Unknown QueryMode " << this->QueryMode << " (0 Voxel Value, 1 Iso Value).");
-    return false;
-  }
-  if (this->QueryMode == ISO_VALUE && !std::isfinite(this->IsoValue))
-  {
-    vtkErrorMacro(<< "IsoValue must be a finite number (got " << this->IsoValue << ").");
-    return false;
-  }
-  if (this->ErfApproximation != ERF_EXACT && this->ErfApproximation != ERF_WINITZKI)
-  {
-    vtkErrorMacro(<< "Unknown ErfApproximation " << this->ErfApproximation << " (0 Exact, 1 Winitzki).");
-    return false;
-  }
-  if (this->Backend < BACKEND_AUTO || this->Backend > BACKEND_CUDA)
-  {
-    vtkErrorMacro(<< "Unknown Backend " << this->Backend << " (0 Auto, 1 CPU, 2 CUDA).");
-    return false;
-  }
-  if (this->NumberOfThreads < 0)
-  {
-    vtkErrorMacro(<< "NumberOfThreads must be 0 (all cores) or positive (got " << this->NumberOfThreads << ").");
-    return false;
-  }
-  if (this->OutputArrayName.empty())
-  {
-    vtkErrorMacro(<< "OutputArrayName must not be empty.");
-    return false;
-  }
-  return true;
+  vtkErrorMacro(<< why.str());
+  return false;
+}
+
+//------------------------------------------------------------------------------
+vao::AmbientOcclusionParameters vtkVolumetricAmbientOcclusion::Parameters(const int radius[3]) const
+{
+  vao::AmbientOcclusionParameters parameters;
+  parameters.method = KernelMethod(this->Method);
+  parameters.radius = { radius[0], radius[1], radius[2] };
+  parameters.queryMode = KernelQueryMode(this->QueryMode);
+  parameters.isoValue = this->IsoValue;
+  parameters.erfMode = KernelErfMode(this->ErfApproximation);
+  return parameters;
 }
 
 //------------------------------------------------------------------------------
@@ -147,9 +170,9 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
   // An extent request is grown here; a piece request (MPI ranks, streaming by pieces) is
   // turned into an extent by the source's executive, which grows it by the ghost levels:
   // ask for as many more as the largest radius, as vtkImageGradient asks for one.
-  if (!vtkAmbientOcclusionInput::EmptyExtent(ext))
+  if (!vtkAmbientOcclusionExtents::EmptyExtent(ext))
   {
-    GrowExtent(ext, radius, whole);
+    vtkAmbientOcclusionExtents::GrowExtent(ext, radius, whole);
   }
   inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), ext, 6);
   const int ghostLevels =
@@ -160,55 +183,33 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
 }
 
 //------------------------------------------------------------------------------
-int vtkVolumetricAmbientOcclusion::RequestData(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+bool vtkVolumetricAmbientOcclusion::CheckInputCovers(vtkImageData* input, const int outExt[6])
 {
-  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  vtkImageData* input = vtkImageData::GetData(inInfo);
-  vtkImageData* output = vtkImageData::GetData(outInfo);
-  output->Initialize();
-  this->LastBackend.clear();
-  if (!input || !this->CheckParameters())
-  {
-    return 1;
-  }
-
-  int whole[6], outExt[6];
-  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), outExt);
-  std::string error;
-  if (!vtkAmbientOcclusionInput::CheckWholeExtent(whole, error))
-  {
-    vtkErrorMacro(<< error);
-    return 1;
-  }
-  const int wholeDims[3] = { whole[1] - whole[0] + 1, whole[3] - whole[2] + 1, whole[5] - whole[4] + 1 };
   const int* inExt = input->GetExtent();
-  if (input->GetNumberOfPoints() == 0)
-  {
-    return 1; // an empty piece of a distributed data set (e.g. MetaImage on rank > 0)
-  }
   for (int a = 0; a < 3; ++a)
   {
-    if (outExt[2 * a] < inExt[2 * a] || outExt[2 * a + 1] > inExt[2 * a + 1] ||
-      outExt[2 * a] > outExt[2 * a + 1])
+    if (outExt[2 * a] < inExt[2 * a] || outExt[2 * a + 1] > inExt[2 * a + 1] || outExt[2 * a] > outExt[2 * a + 1])
     {
       vtkErrorMacro(<< "The input extent (" << inExt[0] << ".." << inExt[1] << ", " << inExt[2] << ".."
                     << inExt[3] << ", " << inExt[4] << ".." << inExt[5]
                     << ") does not cover the requested extent: the upstream source ignored the request.");
-      return 1;
+      return false;
     }
   }
+  return true;
+}
 
-  int radius[3];
+//------------------------------------------------------------------------------
+bool vtkVolumetricAmbientOcclusion::CheckVoxelRadius(vtkImageData* input, const int whole[6], int radius[3])
+{
+  const int wholeDims[3] = { whole[1] - whole[0] + 1, whole[3] - whole[2] + 1, whole[5] - whole[4] + 1 };
   this->ComputeVoxelRadius(input->GetSpacing(), radius);
   if (radius[0] == 0 && radius[1] == 0 && radius[2] == 0)
   {
     vtkErrorMacro(<< "Radius " << this->Radius << (this->RadiusUnits == WORLD ? " (world units)" : "")
                   << " rounds to 0 voxels on every axis: the neighbourhood would be the voxel alone "
                      "and the ambient occlusion 1 everywhere. Use at least one voxel.");
-    return 1;
+    return false;
   }
   if (radius[0] >= wholeDims[0] - 1 && radius[1] >= wholeDims[1] - 1 && radius[2] >= wholeDims[2] - 1)
   {
@@ -216,72 +217,68 @@ int vtkVolumetricAmbientOcclusion::RequestData(
                   << radius[2] << " voxels) covers the whole " << wholeDims[0] << " x " << wholeDims[1]
                   << " x " << wholeDims[2] << " volume from every voxel: every neighbourhood "
                   << "would be the whole volume. Use a smaller radius.");
+    return false;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumetricAmbientOcclusion::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkImageData* input = vtkImageData::GetData(inputVector[0]);
+  vtkImageData* output = vtkImageData::GetData(outputVector);
+  output->Initialize();
+  this->LastBackend.clear();
+  if (!input || !this->CheckParameters())
+  {
     return 1;
   }
-
-  vtkAmbientOcclusionInput::ScalarVolume scalars;
-  if (!vtkAmbientOcclusionInput::PrepareScalars(
+  int whole[6], outExt[6], radius[3];
+  std::string error;
+  if (!vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, whole, outExt, error))
+  {
+    vtkErrorMacro(<< error);
+    return 1;
+  }
+  if (input->GetNumberOfPoints() == 0)
+  {
+    return 1; // an empty piece of a distributed data set (e.g. MetaImage on rank > 0)
+  }
+  if (!this->CheckInputCovers(input, outExt) || !this->CheckVoxelRadius(input, whole, radius))
+  {
+    return 1;
+  }
+  vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
+  if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
         this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error))
   {
     vtkErrorMacro(<< error);
     return 1;
   }
-  const vao::VolumeView& volume = scalars.view;
 
   vao::Region region;
   for (int a = 0; a < 3; ++a)
   {
-    region.begin[a] = outExt[2 * a] - inExt[2 * a];
+    region.begin[a] = outExt[2 * a] - input->GetExtent()[2 * a];
     region.size[a] = outExt[2 * a + 1] - outExt[2 * a] + 1;
   }
-  vao::AmbientOcclusionParameters parameters;
-  parameters.method = static_cast<vao::Method>(this->Method);
-  parameters.radius = { radius[0], radius[1], radius[2] };
-  parameters.queryMode = static_cast<vao::QueryMode>(this->QueryMode);
-  parameters.isoValue = this->IsoValue;
-  parameters.erfMode = static_cast<vao::ErfMode>(this->ErfApproximation);
-
-  vtkNew<vtkFloatArray> openness;
-  openness->SetName(this->OutputArrayName.c_str());
-  openness->SetNumberOfTuples(region.voxelCount());
-  vtkSmartPointer<vtkFloatArray> variance;
-  if (this->ComputeVariance)
-  {
-    variance = vtkSmartPointer<vtkFloatArray>::New();
-    variance->SetName("Variance");
-    variance->SetNumberOfTuples(region.voxelCount());
-  }
-  vao::Execution execution = vtkAmbientOcclusionInput::ExecutionOf(this);
-  execution.threads = this->NumberOfThreads;
-  const vao::AmbientOcclusionOutput arrays{ openness->GetPointer(0),
-    variance ? variance->GetPointer(0) : nullptr };
-  vao::Status status;
-  bool onDevice = this->ChooseCuda(vao::isSeparableMethod(parameters.method), region.voxelCount());
-  if (onDevice)
-  {
-    status = vao::cuda::computeAmbientOcclusion(volume, region, parameters, arrays, execution);
-    if (!status.ok && !status.aborted)
-    {
-      vtkWarningMacro(<< "The CUDA backend failed (" << status.message << "); computing on the CPU.");
-      onDevice = false;
-    }
-  }
-  if (!onDevice)
-  {
-    status = vao::computeAmbientOcclusion(volume, region, parameters, arrays, execution);
-  }
-  this->LastBackend = onDevice ? "CUDA" : "CPU";
+  auto openness = NewFloatArray(this->OutputArrayName.c_str(), region.voxelCount());
+  auto variance = this->ComputeVariance ? NewFloatArray("Variance", region.voxelCount()) : nullptr;
+  const vao::Status status = this->Compute(scalars.view, region, this->Parameters(radius),
+    { openness->GetPointer(0), variance ? variance->GetPointer(0) : nullptr });
   if (!status.ok)
   {
-    if (!status.aborted)
+    error = vtkAmbientOcclusionArrayInput::KernelError(status, scalars, "Ambient occlusion failed");
+    if (!error.empty())
     {
-      vtkErrorMacro(<< "Ambient occlusion failed: " << status.message << ".");
+      vtkErrorMacro(<< error);
     }
     return 1;
   }
 
   // The output is exactly the requested extent: the input's arrays cropped to it.
-  vtkAmbientOcclusionInput::CopyRequestedExtent(input, output, outExt);
+  vtkAmbientOcclusionExtents::CopyRequestedExtent(input, output, outExt);
   output->GetPointData()->AddArray(openness);
   if (variance)
   {
@@ -292,6 +289,32 @@ int vtkVolumetricAmbientOcclusion::RequestData(
   backend->InsertNextValue(this->LastBackend);
   output->GetFieldData()->AddArray(backend);
   return 1;
+}
+
+//------------------------------------------------------------------------------
+vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume, const vao::Region& region,
+  const vao::AmbientOcclusionParameters& parameters, const vao::AmbientOcclusionOutput& arrays)
+{
+  const vao::Execution execution = vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads);
+  vao::Status status;
+  bool onDevice = this->ChooseCuda(vao::isSeparableMethod(parameters.method), region.voxelCount());
+  if (onDevice)
+  {
+    status = vao::cuda::computeAmbientOcclusion(volume, region, parameters, arrays, execution);
+    // Bad input fails on the CPU too, with the same message: only a device failure
+    // falls back.
+    if (!status.ok && !status.aborted && status.nonFiniteCount == 0)
+    {
+      vtkWarningMacro(<< "The CUDA backend failed (" << status.message << "); computing on the CPU.");
+      onDevice = false;
+    }
+  }
+  if (!onDevice)
+  {
+    status = vao::computeAmbientOcclusion(volume, region, parameters, arrays, execution);
+  }
+  this->LastBackend = onDevice ? "CUDA" : "CPU";
+  return status;
 }
 
 //------------------------------------------------------------------------------

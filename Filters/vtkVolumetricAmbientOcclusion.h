@@ -32,6 +32,16 @@
 
 #include <string>
 
+class vtkImageData;
+namespace vao
+{
+struct AmbientOcclusionOutput;
+struct AmbientOcclusionParameters;
+struct Region;
+struct Status;
+struct VolumeView;
+}
+
 class VOLUMETRICAOFILTERS_EXPORT vtkVolumetricAmbientOcclusion : public vtkImageAlgorithm
 {
 public:
@@ -125,7 +135,8 @@ public:
   ///@}
 
   ///@{
-  /// Threads for the CPU backend; 0 (default) uses every hardware thread.
+  /// Threads of the CPU backend on this process; 0 (default): the cores available to the
+  /// process, divided among the MPI ranks on its node. Negative values are an error.
   vtkSetMacro(NumberOfThreads, int);
   vtkGetMacro(NumberOfThreads, int);
   ///@}
@@ -165,7 +176,17 @@ private:
   void operator=(const vtkVolumetricAmbientOcclusion&) = delete;
 
   bool CheckParameters();
+  /// The kernel's parameters for a radius in voxels (CheckParameters passed).
+  vao::AmbientOcclusionParameters Parameters(const int radius[3]) const;
+  /// The input covers the requested extent `outExt`.
+  bool CheckInputCovers(vtkImageData* input, const int outExt[6]);
+  /// The radius in voxels for the input's spacing; false when it is 0 on every axis or
+  /// covers the whole extent on every axis.
+  bool CheckVoxelRadius(vtkImageData* input, const int whole[6], int radius[3]);
   bool ChooseCuda(bool separableMethod, long long voxels);
+  /// Runs the kernel on the chosen backend; a device failure falls back to the CPU.
+  vao::Status Compute(const vao::VolumeView& volume, const vao::Region& region,
+    const vao::AmbientOcclusionParameters& parameters, const vao::AmbientOcclusionOutput& arrays);
 };
 
 #endif

@@ -60,6 +60,41 @@ vtkSmartPointer<vtkPolyData> Contour(vtkImageData* volume, double iso)
   return contour->GetOutput();
 }
 
+/// A float copy of the volume with a NaN at voxel (i, j, k).
+vtkSmartPointer<vtkImageData> WithNaN(vtkImageData* volume, int i, int j, int k)
+{
+  auto copy = vtkSmartPointer<vtkImageData>::New();
+  copy->DeepCopy(volume);
+  vtkNew<vtkFloatArray> values;
+  values->DeepCopy(volume->GetPointData()->GetScalars());
+  values->SetName("Density");
+  int ijk[3] = { i, j, k };
+  values->SetValue(copy->ComputePointId(ijk), std::nanf(""));
+  copy->GetPointData()->SetScalars(values);
+  return copy;
+}
+
+TEST(VarianceOcclusionMapFilter, RejectsBadInputWithAClearError)
+{
+  const auto run = [](vtkImageData* volume, int threads) {
+    vtkNew<vtkVarianceOcclusionMap> map;
+    vtkNew<MessageCatcher> catcher;
+    catcher->Watch(map);
+    map->SetInputData(volume);
+    map->SetNumberOfThreads(threads);
+    map->Update();
+    EXPECT_EQ(map->GetOutput()->GetNumberOfBlocks(), 0u);
+    return catcher->AllErrors();
+  };
+  auto volume = Slab(12, 4, 6);
+  EXPECT_NE(run(volume, -1).find("NumberOfThreads"), std::string::npos);
+  vtkNew<vtkImageData> shifted;
+  shifted->DeepCopy(WithNaN(volume, 2, 9, 4));
+  shifted->SetExtent(10, 21, -3, 8, 0, 11);
+  const std::string error = run(shifted, 0);
+  EXPECT_NE(error.find("has 1 NaN or infinite values (the first at voxel 12, 6, 4)"), std::string::npos) << error;
+}
+
 TEST(VarianceOcclusionMapFilter, OutputsOneImagePerLevelWithItsGeometry)
 {
   vtkNew<vtkImageData> volume;
@@ -271,6 +306,8 @@ TEST(IsosurfaceAmbientOcclusionFilter, RejectsBadInputWithAClearError)
   }, "LightDirection");
   ExpectRejected(surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetNumberOfLevels(0); }, "NumberOfLevels");
   ExpectRejected(surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetOffsetFactor(-1); }, "OffsetFactor");
+  ExpectRejected(surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetNumberOfThreads(-1); }, "NumberOfThreads");
+  ExpectRejected(surface, WithNaN(volume, 7, 5, 3), none, "NaN or infinite values (the first at voxel 7, 5, 3)");
   vtkNew<vtkImageData> twoD;
   twoD->DeepCopy(Slab(24, 8, 12));
   twoD->SetDimensions(24, 576, 1);

@@ -154,6 +154,7 @@ TEST(OcclusionSweepingFilter, RejectsBadInputWithAClearError)
   values->SetValue(40, std::nanf(""));
   nan->GetPointData()->SetScalars(values);
   ExpectRejected(nan, none, "NaN");
+  ExpectRejected(nan, none, "NaN or infinite values (the first at voxel 4, 4, 0)");
   ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(std::nan("")); }, "iso");
   ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfIterations(0); }, "iteration");
   ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetGamma(0); }, "gamma");
@@ -163,6 +164,7 @@ TEST(OcclusionSweepingFilter, RejectsBadInputWithAClearError)
     int none8[8] = { 0, 0, 0, 0, 0, 0, 0, 0 };
     f->SetOctantMask(none8);
   }, "octant");
+  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfThreads(-1); }, "NumberOfThreads");
 }
 
 } // namespace

@@ -100,7 +100,8 @@ Delete(default_run)
 # by it (the pipeline a user builds).
 sweep = OcclusionSweeping(Input=ct, IsoValue=-300.0, OutputOctantVisibility=1, UseGeometryTerm=0)
 for name in ["Scalars", "IsoValue", "InsideIsAbove", "NumberOfIterations", "ConvergenceTolerance",
-             "UseGeometryTerm", "OctantMask", "Gamma", "Opacity", "OutputOctantVisibility", "Component"]:
+             "UseGeometryTerm", "OctantMask", "Gamma", "Opacity", "OutputOctantVisibility", "Component",
+             "NumberOfThreads"]:
     prop = sweep.GetProperty(name)
     check(prop is not None and len(prop.SMProperty.GetDocumentation().GetDescription().strip()) > 20,
           "OcclusionSweeping property %s exists and is documented" % name)
@@ -126,6 +127,9 @@ Delete(sweep)
 # pipeline on the CT head's bone, with shadows.
 vom = VarianceOcclusionMap(Input=ct)
 vom.Scalars = ["POINTS", "MetaImage"]
+check(vom.NumberOfThreads == 0 and
+      len(vom.GetProperty("NumberOfThreads").SMProperty.GetDocumentation().GetDescription().strip()) > 20,
+      "VarianceOcclusionMap property NumberOfThreads exists, defaults to 0 and is documented")
 levels = servermanager.Fetch(vom)
 check(levels.GetNumberOfBlocks() == 4, "VarianceOcclusionMap: 4 levels")
 level1 = levels.GetBlock(1)
@@ -137,7 +141,7 @@ Delete(vom)
 bone = Contour(Input=ct, ContourBy=["POINTS", "MetaImage"], Isosurfaces=[400.0], ComputeNormals=1)
 shaded = IsosurfaceAmbientOcclusion(Input=bone, Volume=ct, ComputeShadows=1, LightDirection=[0.0, -1.0, 1.0])
 for name in ["Scalars", "QueryMode", "IsoValue", "NumberOfLevels", "OffsetFactor", "Combine", "Estimator",
-             "ComputeShadows", "LightDirection"]:
+             "ComputeShadows", "LightDirection", "NumberOfThreads"]:
     prop = shaded.GetProperty(name)
     check(prop is not None and len(prop.SMProperty.GetDocumentation().GetDescription().strip()) > 20,
           "IsosurfaceAmbientOcclusion property %s exists and is documented" % name)

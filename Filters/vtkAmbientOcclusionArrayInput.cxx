@@ -1,0 +1,233 @@
+#include "vtkAmbientOcclusionArrayInput.h"
+
+#include "vao/VarianceOcclusionMap.h"
+
+#include "vtkAlgorithm.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace vtkAmbientOcclusionArrayInput
+{
+namespace
+{
+
+bool ToKernelType(int vtkType, vao::ScalarType& type)
+{
+  const bool longIs64 = sizeof(long) == 8;
+  switch (vtkType)
+  {
+    case VTK_CHAR:
+    case VTK_SIGNED_CHAR:
+      type = vao::ScalarType::Int8;
+      return true;
+    case VTK_UNSIGNED_CHAR:
+      type = vao::ScalarType::UInt8;
+      return true;
+    case VTK_SHORT:
+      type = vao::ScalarType::Int16;
+      return true;
+    case VTK_UNSIGNED_SHORT:
+      type = vao::ScalarType::UInt16;
+      return true;
+    case VTK_INT:
+      type = vao::ScalarType::Int32;
+      return true;
+    case VTK_UNSIGNED_INT:
+      type = vao::ScalarType::UInt32;
+      return true;
+    case VTK_LONG:
+      type = longIs64 ? vao::ScalarType::Int64 : vao::ScalarType::Int32;
+      return true;
+    case VTK_LONG_LONG:
+    case VTK_ID_TYPE:
+      type = vao::ScalarType::Int64;
+      return true;
+    case VTK_UNSIGNED_LONG:
+      type = longIs64 ? vao::ScalarType::UInt64 : vao::ScalarType::UInt32;
+      return true;
+    case VTK_UNSIGNED_LONG_LONG:
+      type = vao::ScalarType::UInt64;
+      return true;
+    case VTK_FLOAT:
+      type = vao::ScalarType::Float32;
+      return true;
+    case VTK_DOUBLE:
+      type = vao::ScalarType::Float64;
+      return true;
+    default:
+      return false;
+  }
+}
+
+vtkDataArray* ChosenArray(vtkAlgorithm* algorithm, vtkDataArray* scalars, vtkImageData* input)
+{
+  const char* name = algorithm->GetInputArrayInformation(0)->Get(vtkDataObject::FIELD_NAME());
+  if (!scalars && (!name || !*name))
+  {
+    // No array chosen (pvpython before the input was updated): the active point scalars.
+    scalars = input->GetPointData()->GetScalars();
+  }
+  return scalars;
+}
+
+/// Points the view at component `picked` of the scalars, in place when their layout
+/// allows, else through a copy unpacked to double.
+void ViewComponent(vtkDataArray* scalars, int picked, ScalarVolume& volume)
+{
+  vao::VolumeView& view = volume.view;
+  if (scalars->HasStandardMemoryLayout())
+  {
+    view.data = scalars->GetVoidPointer(picked);
+    view.voxelStride = scalars->GetNumberOfComponents();
+    return;
+  }
+  volume.unpacked.resize(static_cast<size_t>(scalars->GetNumberOfTuples()));
+  for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i)
+  {
+    volume.unpacked[i] = scalars->GetComponent(i, picked);
+  }
+  view.data = volume.unpacked.data();
+  view.type = vao::ScalarType::Float64;
+  view.voxelStride = 1;
+}
+
+} // namespace
+
+bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input, int component,
+  ScalarVolume& volume, std::string& error)
+{
+  vtkDataArray* scalars = ChosenArray(algorithm, chosen, input);
+  if (!scalars)
+  {
+    error = "No numeric point array to process: choose a point-data array of the image "
+            "(the Scalars property; string and cell arrays are not accepted).";
+    return false;
+  }
+  volume.name = scalars->GetName() ? scalars->GetName() : "";
+  if (input->GetPointData()->GetAbstractArray(scalars->GetName()) != scalars)
+  {
+    error = "Array '" + volume.name + "' is not a point-data array; the filter works on points (voxels).";
+    return false;
+  }
+  const int components = scalars->GetNumberOfComponents();
+  const int picked = component < 0 && components == 1 ? 0 : component;
+  if (picked < 0 || picked >= components)
+  {
+    std::ostringstream why;
+    why << "Array '" << volume.name << "' has " << components << " components; set Component to one of 0.."
+        << components - 1 << " (got " << component << ").";
+    error = why.str();
+    return false;
+  }
+  if (!ToKernelType(scalars->GetDataType(), volume.view.type))
+  {
+    error = "Array '" + volume.name + "' has unsupported type " + scalars->GetDataTypeAsString() + ".";
+    return false;
+  }
+  const int* dims = input->GetDimensions();
+  const int* extent = input->GetExtent();
+  volume.view.dims = { dims[0], dims[1], dims[2] };
+  volume.firstVoxel = { extent[0], extent[2], extent[4] };
+  ViewComponent(scalars, picked, volume);
+  return true;
+}
+
+bool SurfaceNormals(vtkPolyData* surface, const ScalarVolume& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, std::vector<double>& normals, std::string& error)
+{
+  const vtkIdType n = surface->GetNumberOfPoints();
+  normals.resize(static_cast<size_t>(3 * n));
+  vtkDataArray* given = surface->GetPointData()->GetNormals();
+  if (!given)
+  {
+    given = surface->GetPointData()->GetArray("Normals");
+  }
+  if (given && given->GetNumberOfComponents() == 3)
+  {
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      given->GetTuple(i, &normals[3 * i]);
+    }
+    return true;
+  }
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    double p[3], g[3];
+    surface->GetPoint(i, p);
+    for (int a = 0; a < 3; ++a)
+    {
+      std::array<double, 3> forward = { p[0], p[1], p[2] }, backward = forward;
+      forward[a] += spacing[a];
+      backward[a] -= spacing[a];
+      g[a] = (vao::sampleVolume(volume.view, origin, spacing, forward) -
+               vao::sampleVolume(volume.view, origin, spacing, backward)) /
+        (2.0 * spacing[a]);
+    }
+    const double length = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    if (!(length > 0.0))
+    {
+      std::ostringstream why;
+      why << "The surface has no point normals and the volume's gradient is zero at point " << i
+          << ": add normals (e.g. Contour with Compute Normals, or Generate Surface Normals).";
+      error = why.str();
+      return false;
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      normals[3 * i + a] = -g[a] / length;
+    }
+  }
+  return true;
+}
+
+vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads)
+{
+  vao::Execution execution;
+  execution.threads = threads;
+  execution.progress = [algorithm](double p) { algorithm->UpdateProgress(p); };
+  execution.abortRequested = [algorithm] { return algorithm->GetAbortExecute() != 0; };
+  return execution;
+}
+
+std::string NumberOfThreadsError(int threads)
+{
+  if (threads >= 0)
+  {
+    return {};
+  }
+  std::ostringstream why;
+  why << "NumberOfThreads must be 0 (the cores available, divided among the MPI ranks of the node) or "
+         "positive (got "
+      << threads << ").";
+  return why.str();
+}
+
+std::string KernelError(const vao::Status& status, const ScalarVolume& scalars, const std::string& failed)
+{
+  if (status.ok || status.aborted)
+  {
+    return {};
+  }
+  if (status.nonFiniteCount <= 0)
+  {
+    return failed + ": " + status.message + ".";
+  }
+  const vao::Index3& dims = scalars.view.dims;
+  const std::int64_t first = status.firstNonFinite;
+  const std::int64_t plane = dims[0] * dims[1];
+  std::ostringstream why;
+  why << "Array '" << scalars.name << "' has " << status.nonFiniteCount
+      << " NaN or infinite values (the first at voxel " << first % dims[0] + scalars.firstVoxel[0] << ", "
+      << (first / dims[0]) % dims[1] + scalars.firstVoxel[1] << ", " << first / plane + scalars.firstVoxel[2]
+      << "). A non-finite value has no place in a cumulative distribution or an isosurface: replace "
+         "them (e.g. with the Calculator or Threshold filters) first.";
+  return why.str();
+}
+
+} // namespace vtkAmbientOcclusionArrayInput

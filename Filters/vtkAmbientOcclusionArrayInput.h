@@ -1,0 +1,63 @@
+// Private helpers of the module's filters: the input arrays as the kernels read them (a
+// volume's scalars, a surface's normals), the kernels' execution hooks, and the
+// user-facing message of a failed kernel call. Not part of the module's public interface.
+#ifndef vtkAmbientOcclusionArrayInput_h
+#define vtkAmbientOcclusionArrayInput_h
+
+#include "vao/AmbientOcclusion.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+class vtkAlgorithm;
+class vtkDataArray;
+class vtkImageData;
+class vtkPolyData;
+
+namespace vtkAmbientOcclusionArrayInput
+{
+
+/// The input scalars as the kernels read them: in place when the array has the standard
+/// layout (one component through the stride), unpacked to double otherwise.
+struct ScalarVolume
+{
+  vao::VolumeView view;
+  std::string name;
+  std::vector<double> unpacked;
+  /// Structured coordinates of the view's first voxel (the lower corner of the input's
+  /// extent): a voxel index of the kernels becomes a voxel the user can find.
+  std::array<int, 3> firstVoxel = { 0, 0, 0 };
+};
+
+/// Takes the array the algorithm chose to process (`chosen`, from GetInputArrayToProcess;
+/// the active point scalars when no array was named at all), checks it (numeric, point
+/// data, a valid component) and fills volume. On failure returns false and says why in
+/// `error`. NaN and infinite values are not looked for here: the kernels find them in
+/// their first pass over the data, and KernelError names them.
+bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input, int component,
+  ScalarVolume& volume, std::string& error);
+
+/// The unit normals of the surface's points as the surface kernels read them (3 doubles
+/// a point): its point normals, or without them the gradient of `volume` (voxel 0 at
+/// `origin`) at each point, pointing towards lower values. On failure (no normals and a
+/// zero gradient) returns false and says why in `error`.
+bool SurfaceNormals(vtkPolyData* surface, const ScalarVolume& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, std::vector<double>& normals, std::string& error);
+
+/// The kernels' execution hooks for an algorithm: its progress, its abort flag, and
+/// `threads` (the filter's NumberOfThreads; 0: the kernels' default).
+vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads);
+
+/// The error for a NumberOfThreads below 0; empty for a valid one.
+std::string NumberOfThreadsError(int threads);
+
+/// The one message of a failed kernel call on `scalars`, for the user: for non-finite
+/// input, the array, how many such values it has and the first one's voxel in the input's
+/// coordinates; otherwise "<failed>: <the kernel's reason>.". Empty when the call
+/// succeeded or the user aborted it.
+std::string KernelError(const vao::Status& status, const ScalarVolume& scalars, const std::string& failed);
+
+} // namespace vtkAmbientOcclusionArrayInput
+
+#endif
