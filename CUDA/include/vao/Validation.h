@@ -64,4 +64,9 @@ Status checkMomentMagnitude(const ValueScan& scan);
 /// parallel pass over the data (none for integer types).
 Status checkFiniteValues(const VolumeView& volume);
 
+/// The checks of a call on box moments (Volumetric AO on the CPU or the GPU): validate(),
+/// then, where the type needs it, one scan for non-finite values and for magnitudes whose
+/// squares overflow. `scan` receives the scan (empty for the types of up to 16 bits).
+Status validateMomentRequest(const VolumeView& volume, const Region& region, const Radius& radius, ValueScan& scan);
+
 } // namespace vao

@@ -51,16 +51,12 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
   const Execution& execution)
 {
-  Status status = validate(volume, region, parameters.radius);
-  if (status.ok && parameters.queryMode == QueryMode::IsoValue)
-    status = checkFiniteParameter(parameters.isoValue, "the iso value");
-  // One pass for the non-finite values and the range the double sums' rounding depends
-  // on; none for the types of up to 16 bits (no NaN, exact sums).
-  const ValueScan scan = status.ok && needsValueScan(volume.type) ? scanValues(volume) : ValueScan{};
+  Status status = parameters.queryMode == QueryMode::IsoValue
+    ? checkFiniteParameter(parameters.isoValue, "the iso value")
+    : Status::success();
+  ValueScan scan;
   if (status.ok)
-    status = finiteStatus(scan);
-  if (status.ok)
-    status = checkMomentMagnitude(scan);
+    status = validateMomentRequest(volume, region, parameters.radius, scan);
   if (!status.ok)
   {
     return status;

@@ -186,6 +186,19 @@ Status checkMomentMagnitude(const ValueScan& scan)
   return Status::failure(why.str());
 }
 
+Status validateMomentRequest(const VolumeView& volume, const Region& region, const Radius& radius, ValueScan& scan)
+{
+  Status status = validate(volume, region, radius);
+  // One pass for the non-finite values and the range the double sums' rounding depends
+  // on; none for the types of up to 16 bits (no NaN, exact sums).
+  scan = status.ok && needsValueScan(volume.type) ? scanValues(volume) : ValueScan{};
+  if (status.ok)
+    status = finiteStatus(scan);
+  if (status.ok)
+    status = checkMomentMagnitude(scan);
+  return status;
+}
+
 std::int64_t countNonFinite(const VolumeView& view, std::int64_t* firstIndex)
 {
   if (scalarTypeIsIntegral(view.type))

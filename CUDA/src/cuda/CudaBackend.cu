@@ -295,12 +295,8 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
 Status runChecked(const VolumeView& view, const Region& region, const Radius& radius, bool withExtrema,
   const gpu::EstimatorSetting& estimator, const HostOutputs& host, const Execution& execution, Timing* timing)
 {
-  Status status = validate(view, region, radius);
-  const ValueScan scan = status.ok && needsValueScan(view.type) ? scanValues(view) : ValueScan{};
-  if (status.ok)
-    status = finiteStatus(scan);
-  if (status.ok)
-    status = checkMomentMagnitude(scan);
+  ValueScan scan;
+  const Status status = validateMomentRequest(view, region, radius, scan);
   if (!status.ok)
   {
     return status;

@@ -163,15 +163,25 @@ struct MomentKernel
   }
 };
 
-/// Van Herk step 1: suffix minimum and maximum of every block of w = 2r + 1 voxels,
-/// one thread per (lane, block).
-template <class T>
-struct ExtremaSuffixKernel
+/// The two van Herk steps along one axis, one thread per (lane, block of w = 2r + 1
+/// voxels). Suffix (step 1): suffix minimum and maximum of every block into suf*. Output
+/// (step 2): the outputs whose window ends in the block, from the block's running prefix
+/// and the suffix at the window's start, into out*.
+enum class VanHerkStep
+{
+  Suffix,
+  Output,
+};
+
+template <class T, VanHerkStep Step>
+struct VanHerkKernel
 {
   const T* inMin;
   const T* inMax;
-  T* sufMin;
+  T* sufMin; // written by the suffix step, read by the output step
   T* sufMax;
+  T* outMin; // the output step's only
+  T* outMax;
   AxisPass pass;
 
   VAO_HD Index threads() const { return pass.lanes * pass.blocks(); }
@@ -179,7 +189,14 @@ struct ExtremaSuffixKernel
   VAO_HD void operator()(Index thread) const
   {
     const VanHerkBlock block(pass, thread);
-    const Index lane = block.lane, start = block.start, end = block.end;
+    if (Step == VanHerkStep::Suffix)
+      this->suffix(block.lane, block.start, block.end);
+    else
+      this->output(block.lane, block.start, block.end);
+  }
+
+  VAO_HD void suffix(Index lane, Index start, Index end) const
+  {
     Index at = pass.in.at(lane, end - 1);
     T lo = inMin[at], hi = inMax[at];
     sufMin[at] = lo;
@@ -193,27 +210,9 @@ struct ExtremaSuffixKernel
       sufMax[at] = hi;
     }
   }
-};
 
-/// Van Herk step 2: one thread per (lane, block B) takes the outputs whose window ends in
-/// B, runs B's prefix up to each window end and combines it with the suffix at its start.
-template <class T>
-struct ExtremaOutputKernel
-{
-  const T* inMin;
-  const T* inMax;
-  const T* sufMin;
-  const T* sufMax;
-  T* outMin;
-  T* outMax;
-  AxisPass pass;
-
-  VAO_HD Index threads() const { return pass.lanes * pass.blocks(); }
-
-  VAO_HD void operator()(Index thread) const
+  VAO_HD void output(Index lane, Index start, Index end) const
   {
-    const VanHerkBlock block(pass, thread);
-    const Index lane = block.lane, start = block.start, end = block.end;
     T preMin = inMin[pass.in.at(lane, start)], preMax = inMax[pass.in.at(lane, start)];
     Index prefixEnd = start; // the prefix covers [start, prefixEnd]
     // The outputs whose window end hi = min(n - 1, i + r) lies in [start, end): windows
@@ -434,19 +433,19 @@ void runPasses(Executor& ex, const T* input, const RegionGeometry& g, bool withE
   auto s1 = ex.template allocate<T>(withExtrema ? g.afterX() : 0), s2 = ex.template allocate<T>(withExtrema ? g.afterX() : 0);
   if (withExtrema)
   {
-    ex.launch(ExtremaSuffixKernel<T>{ transposed.get(), transposed.get(), f1.get(), f2.get(), xPass },
+    ex.launch(VanHerkKernel<T, VanHerkStep::Suffix>{ transposed.get(), transposed.get(), f1.get(), f2.get(), nullptr, nullptr, xPass },
       "extrema x suffix", 3.0 * g.block() * sizeof(T));
-    ex.launch(ExtremaOutputKernel<T>{ transposed.get(), transposed.get(), f1.get(), f2.get(), e1.get(), e2.get(), xPass },
+    ex.launch(VanHerkKernel<T, VanHerkStep::Output>{ transposed.get(), transposed.get(), f1.get(), f2.get(), e1.get(), e2.get(), xPass },
       "extrema x", 2.0 * g.block() * sizeof(T) + 2.0 * g.afterX() * sizeof(T));
     ex.transpose(e1.get(), f1.get(), g.sy, g.rx, g.sz, "transpose extrema");
     ex.transpose(e2.get(), f2.get(), g.sy, g.rx, g.sz, "transpose extrema");
-    ex.launch(ExtremaSuffixKernel<T>{ f1.get(), f2.get(), s1.get(), s2.get(), yPass }, "extrema y suffix",
+    ex.launch(VanHerkKernel<T, VanHerkStep::Suffix>{ f1.get(), f2.get(), s1.get(), s2.get(), nullptr, nullptr, yPass }, "extrema y suffix",
       4.0 * g.afterX() * sizeof(T));
-    ex.launch(ExtremaOutputKernel<T>{ f1.get(), f2.get(), s1.get(), s2.get(), e1.get(), e2.get(), yPass },
+    ex.launch(VanHerkKernel<T, VanHerkStep::Output>{ f1.get(), f2.get(), s1.get(), s2.get(), e1.get(), e2.get(), yPass },
       "extrema y", 4.0 * g.afterX() * sizeof(T) + 2.0 * g.afterY() * sizeof(T));
-    ex.launch(ExtremaSuffixKernel<T>{ e1.get(), e2.get(), s1.get(), s2.get(), zPass }, "extrema z suffix",
+    ex.launch(VanHerkKernel<T, VanHerkStep::Suffix>{ e1.get(), e2.get(), s1.get(), s2.get(), nullptr, nullptr, zPass }, "extrema z suffix",
       4.0 * g.afterY() * sizeof(T));
-    ex.launch(ExtremaOutputKernel<T>{ e1.get(), e2.get(), s1.get(), s2.get(), f1.get(), f2.get(), zPass },
+    ex.launch(VanHerkKernel<T, VanHerkStep::Output>{ e1.get(), e2.get(), s1.get(), s2.get(), f1.get(), f2.get(), zPass },
       "extrema z", 4.0 * g.afterY() * sizeof(T) + 2.0 * g.region() * sizeof(T));
   }
   ex.progress(0.6);
