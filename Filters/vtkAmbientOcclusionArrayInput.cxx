@@ -214,6 +214,13 @@ std::string KernelError(const vao::Status& status, const ScalarVolume& scalars, 
   {
     return {};
   }
+  if (status.outOfMemory)
+  {
+    // Said like the filters' own allocation failures (vtkAmbientOcclusionMemory).
+    return "Not enough memory for " + status.message.substr(std::string("not enough memory for ").size()) +
+      "; compute it in smaller pieces (streaming or more MPI ranks), on a smaller extent, or with "
+      "lighter settings (StartAtHalfResolution, fewer outputs).";
+  }
   if (status.nonFiniteCount <= 0)
   {
     return failed + ": " + status.message + ".";

@@ -1,4 +1,5 @@
 #include "vtkAmbientOcclusionCollectives.h"
+#include "vtkAmbientOcclusionMemory.h"
 
 #include "vtkAmbientOcclusionExtents.h"
 
@@ -75,7 +76,7 @@ void AllocateWanted(vtkImageData* held, const int wanted[6], vtkImageData* outpu
     copy.TakeReference(array->NewInstance());
     copy->SetName(array->GetName());
     copy->SetNumberOfComponents(array->GetNumberOfComponents());
-    copy->SetNumberOfTuples(points);
+    vtkAmbientOcclusionMemory::Allocate(copy, points, std::string("the redistributed array ") + array->GetName());
     output->GetPointData()->AddArray(copy);
   }
   if (from->GetScalars())

@@ -1,4 +1,5 @@
 #include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionMemory.h"
 
 #include "vtkExtentTranslator.h"
 #include "vtkFieldData.h"
@@ -86,6 +87,13 @@ void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int ou
   output->SetOrigin(input->GetOrigin());
   output->SetSpacing(input->GetSpacing());
   output->SetDirectionMatrix(input->GetDirectionMatrix());
+  double bytes = 0.0;
+  for (int a = 0; a < input->GetPointData()->GetNumberOfArrays(); ++a)
+  {
+    if (vtkAbstractArray* array = input->GetPointData()->GetAbstractArray(a))
+      bytes += static_cast<double>(points) * array->GetNumberOfComponents() * array->GetDataTypeSize();
+  }
+  vtkAmbientOcclusionMemory::Reserve(bytes, "the input's arrays cropped to the requested extent");
   output->GetPointData()->CopyAllocate(input->GetPointData(), points);
   output->GetPointData()->CopyStructuredData(input->GetPointData(), inExt, outExt);
   output->GetFieldData()->ShallowCopy(input->GetFieldData());

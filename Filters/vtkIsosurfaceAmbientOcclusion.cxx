@@ -1,5 +1,7 @@
 #include "vtkIsosurfaceAmbientOcclusion.h"
 
+#include "vtkAmbientOcclusionMemory.h"
+
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionCollectives.h"
 #include "vtkAmbientOcclusionExtents.h"
@@ -372,14 +374,14 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
   const vao::Execution execution = ExecutionOf(this, this->NumberOfThreads);
   vtkNew<vtkFloatArray> occlusion;
   occlusion->SetName("AmbientOcclusion");
-  occlusion->SetNumberOfTuples(n);
+  vtkAmbientOcclusionMemory::Allocate(occlusion, n, "the AmbientOcclusion output");
   vao::Status status = vao::surfaceAmbientOcclusion(cache.levels, cache.scalars.view, cache.origin, cache.spacing,
     points.data(), normals.data(), n, parameters, occlusion->GetPointer(0), execution);
   vtkNew<vtkFloatArray> shadow;
   if (status.ok && this->ComputeShadows)
   {
     shadow->SetName("Shadow");
-    shadow->SetNumberOfTuples(n);
+    vtkAmbientOcclusionMemory::Allocate(shadow, n, "the Shadow output");
     const double* l = this->LightDirection;
     status = vao::surfaceShadow(cache.levels, points.data(), normals.data(), n, { l[0], l[1], l[2] }, parameters,
       shadow->GetPointer(0), execution);
@@ -405,48 +407,52 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
 int vtkIsosurfaceAmbientOcclusion::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkPolyData* surface = vtkPolyData::GetData(inputVector[0]);
-  vtkImageData* volume = vtkImageData::GetData(inputVector[1]);
-  vtkPolyData* output = vtkPolyData::GetData(outputVector);
-  output->Initialize();
-  if (!surface || !volume)
-  {
-    vtkErrorMacro(<< "Needs a surface (input 0) and a volume (input 1).");
-    return 1;
-  }
-  int whole[6];
-  inputVector[1]->GetInformationObject(0)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  const bool distributed = this->IsDistributed();
-  if (!distributed && !std::equal(whole, whole + 6, volume->GetExtent()))
-  {
-    // Happens when the surface is extracted from the same source output in pieces (MPI):
-    // the shared output then holds the surface's piece, not the whole volume.
-    vtkErrorMacro(<< "The volume arrived as a piece, not whole: under MPI, feed the Volume input from its own "
-                     "reader rather than from the output the surface was extracted from.");
-    return 1;
-  }
-  if (!this->CheckParameters()) // the same answer on every process
-  {
-    return 1;
-  }
-  int piece[6];
-  std::copy(whole, whole + 6, piece);
-  vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
-  if (distributed ? !this->UpdateDistributedPyramid(volume, chosen, whole, piece)
-                  : !this->UpdatePyramid(volume, chosen))
-  {
-    return 1;
-  }
-  output->ShallowCopy(surface);
-  if (surface->GetNumberOfPoints() == 0)
-  {
-    return 1; // an empty surface (or an empty piece of one): nothing to shade
-  }
-  if (!this->CheckSurfaceInVolume(surface, volume, whole, piece) || !this->Shade(surface, output))
-  {
+  // Allocation failure anywhere below is an error and an empty output, not an abort.
+  return vtkAmbientOcclusionMemory::Guard(this, vtkDataObject::GetData(outputVector, 0),
+    "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.", [&]() -> int {
+    vtkPolyData* surface = vtkPolyData::GetData(inputVector[0]);
+    vtkImageData* volume = vtkImageData::GetData(inputVector[1]);
+    vtkPolyData* output = vtkPolyData::GetData(outputVector);
     output->Initialize();
-  }
-  return 1;
+    if (!surface || !volume)
+    {
+      vtkErrorMacro(<< "Needs a surface (input 0) and a volume (input 1).");
+      return 1;
+    }
+    int whole[6];
+    inputVector[1]->GetInformationObject(0)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+    const bool distributed = this->IsDistributed();
+    if (!distributed && !std::equal(whole, whole + 6, volume->GetExtent()))
+    {
+      // Happens when the surface is extracted from the same source output in pieces (MPI):
+      // the shared output then holds the surface's piece, not the whole volume.
+      vtkErrorMacro(<< "The volume arrived as a piece, not whole: under MPI, feed the Volume input from its own "
+                       "reader rather than from the output the surface was extracted from.");
+      return 1;
+    }
+    if (!this->CheckParameters()) // the same answer on every process
+    {
+      return 1;
+    }
+    int piece[6];
+    std::copy(whole, whole + 6, piece);
+    vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
+    if (distributed ? !this->UpdateDistributedPyramid(volume, chosen, whole, piece)
+                    : !this->UpdatePyramid(volume, chosen))
+    {
+      return 1;
+    }
+    output->ShallowCopy(surface);
+    if (surface->GetNumberOfPoints() == 0)
+    {
+      return 1; // an empty surface (or an empty piece of one): nothing to shade
+    }
+    if (!this->CheckSurfaceInVolume(surface, volume, whole, piece) || !this->Shade(surface, output))
+    {
+      output->Initialize();
+    }
+    return 1;
+  });
 }
 
 //------------------------------------------------------------------------------

@@ -1,5 +1,7 @@
 #include "vtkVolumetricAmbientOcclusion.h"
 
+#include "vtkAmbientOcclusionMemory.h"
+
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionExtents.h"
 
@@ -65,7 +67,7 @@ vtkSmartPointer<vtkFloatArray> NewFloatArray(const char* name, vtkIdType values)
 {
   auto array = vtkSmartPointer<vtkFloatArray>::New();
   array->SetName(name);
-  array->SetNumberOfTuples(values);
+  vtkAmbientOcclusionMemory::Allocate(array, values, std::string("the ") + name + " output");
   return array;
 }
 
@@ -226,69 +228,73 @@ bool vtkVolumetricAmbientOcclusion::CheckVoxelRadius(vtkImageData* input, const 
 int vtkVolumetricAmbientOcclusion::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkImageData* input = vtkImageData::GetData(inputVector[0]);
-  vtkImageData* output = vtkImageData::GetData(outputVector);
-  output->Initialize();
-  this->LastBackend.clear();
-  if (!input || !this->CheckParameters())
-  {
-    return 1;
-  }
-  int whole[6], outExt[6], radius[3];
-  std::string error;
-  if (!vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, whole, outExt, error))
-  {
-    vtkErrorMacro(<< error);
-    return 1;
-  }
-  if (input->GetNumberOfPoints() == 0)
-  {
-    return 1; // an empty piece of a distributed data set (e.g. MetaImage on rank > 0)
-  }
-  if (!this->CheckInputCovers(input, outExt) || !this->CheckVoxelRadius(input, whole, radius))
-  {
-    return 1;
-  }
-  vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
-  if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
-        this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error))
-  {
-    vtkErrorMacro(<< error);
-    return 1;
-  }
-
-  vao::Region region;
-  for (int a = 0; a < 3; ++a)
-  {
-    region.begin[a] = outExt[2 * a] - input->GetExtent()[2 * a];
-    region.size[a] = outExt[2 * a + 1] - outExt[2 * a] + 1;
-  }
-  auto openness = NewFloatArray(this->OutputArrayName.c_str(), region.voxelCount());
-  auto variance = this->ComputeVariance ? NewFloatArray("Variance", region.voxelCount()) : nullptr;
-  const vao::Status status = this->Compute(scalars.view, region, this->Parameters(radius),
-    { openness->GetPointer(0), variance ? variance->GetPointer(0) : nullptr });
-  if (!status.ok)
-  {
-    error = vtkAmbientOcclusionArrayInput::KernelError(status, scalars, "Ambient occlusion failed");
-    if (!error.empty())
+  // Allocation failure anywhere below is an error and an empty output, not an abort.
+  return vtkAmbientOcclusionMemory::Guard(this, vtkDataObject::GetData(outputVector, 0),
+    "compute it in pieces (streaming or more MPI ranks), on a smaller extent, or without ComputeVariance.", [&]() -> int {
+    vtkImageData* input = vtkImageData::GetData(inputVector[0]);
+    vtkImageData* output = vtkImageData::GetData(outputVector);
+    output->Initialize();
+    this->LastBackend.clear();
+    if (!input || !this->CheckParameters())
+    {
+      return 1;
+    }
+    int whole[6], outExt[6], radius[3];
+    std::string error;
+    if (!vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, whole, outExt, error))
     {
       vtkErrorMacro(<< error);
+      return 1;
     }
-    return 1;
-  }
+    if (input->GetNumberOfPoints() == 0)
+    {
+      return 1; // an empty piece of a distributed data set (e.g. MetaImage on rank > 0)
+    }
+    if (!this->CheckInputCovers(input, outExt) || !this->CheckVoxelRadius(input, whole, radius))
+    {
+      return 1;
+    }
+    vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
+    if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
+          this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error))
+    {
+      vtkErrorMacro(<< error);
+      return 1;
+    }
 
-  // The output is exactly the requested extent: the input's arrays cropped to it.
-  vtkAmbientOcclusionExtents::CopyRequestedExtent(input, output, outExt);
-  output->GetPointData()->AddArray(openness);
-  if (variance)
-  {
-    output->GetPointData()->AddArray(variance);
-  }
-  vtkNew<vtkStringArray> backend;
-  backend->SetName("AmbientOcclusionBackend");
-  backend->InsertNextValue(this->LastBackend);
-  output->GetFieldData()->AddArray(backend);
-  return 1;
+    vao::Region region;
+    for (int a = 0; a < 3; ++a)
+    {
+      region.begin[a] = outExt[2 * a] - input->GetExtent()[2 * a];
+      region.size[a] = outExt[2 * a + 1] - outExt[2 * a] + 1;
+    }
+    auto openness = NewFloatArray(this->OutputArrayName.c_str(), region.voxelCount());
+    auto variance = this->ComputeVariance ? NewFloatArray("Variance", region.voxelCount()) : nullptr;
+    const vao::Status status = this->Compute(scalars.view, region, this->Parameters(radius),
+      { openness->GetPointer(0), variance ? variance->GetPointer(0) : nullptr });
+    if (!status.ok)
+    {
+      error = vtkAmbientOcclusionArrayInput::KernelError(status, scalars, "Ambient occlusion failed");
+      if (!error.empty())
+      {
+        vtkErrorMacro(<< error);
+      }
+      return 1;
+    }
+
+    // The output is exactly the requested extent: the input's arrays cropped to it.
+    vtkAmbientOcclusionExtents::CopyRequestedExtent(input, output, outExt);
+    output->GetPointData()->AddArray(openness);
+    if (variance)
+    {
+      output->GetPointData()->AddArray(variance);
+    }
+    vtkNew<vtkStringArray> backend;
+    backend->SetName("AmbientOcclusionBackend");
+    backend->InsertNextValue(this->LastBackend);
+    output->GetFieldData()->AddArray(backend);
+    return 1;
+  });
 }
 
 //------------------------------------------------------------------------------

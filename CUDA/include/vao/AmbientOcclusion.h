@@ -119,11 +119,18 @@ struct Status
   // fastest), so that a caller can name its voxel in its own coordinates.
   std::int64_t nonFiniteCount = 0;
   std::int64_t firstNonFinite = -1;
+  bool outOfMemory = false; // an allocation failed: smaller pieces may succeed
 
   static Status success() { return {}; }
   static Status failure(std::string why) { return { false, false, std::move(why) }; }
   static Status cancelled() { return { false, true, "cancelled" }; }
   static Status nonFinite(std::int64_t count, std::int64_t first);
+  static Status noMemory(const std::string& what)
+  {
+    Status status = failure("not enough memory for " + what);
+    status.outOfMemory = true;
+    return status;
+  }
 };
 
 /// Checks the volume, region and radius; returns the first problem found

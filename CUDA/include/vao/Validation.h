@@ -7,6 +7,7 @@
 #include "vao/AmbientOcclusion.h"
 
 #include <array>
+#include <functional>
 
 namespace vao
 {
@@ -63,6 +64,10 @@ Status checkMomentMagnitude(const ValueScan& scan);
 /// No NaN or infinite voxel; otherwise Status::nonFinite (count and first index). One
 /// parallel pass over the data (none for integer types).
 Status checkFiniteValues(const VolumeView& volume);
+
+/// f(), with std::bad_alloc from anywhere inside it (its buffers, its worker threads)
+/// turned into Status::noMemory(what): the entry points never throw.
+Status catchOutOfMemory(const char* what, const std::function<Status()>& f);
 
 /// The checks of a call on box moments (Volumetric AO on the CPU or the GPU): validate(),
 /// then, where the type needs it, one scan for non-finite values and for magnitudes whose

@@ -47,7 +47,10 @@ Status separableOpenness(const VolumeView& view, const Region& region,
 
 } // namespace
 
-Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
+namespace
+{
+
+Status ambientOcclusion(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
   const Execution& execution)
 {
@@ -81,6 +84,16 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
       isSeparableMethod(parameters.method) ? execution
                                            : detail::stageExecution(execution, 0.9, 1.0));
   });
+}
+
+} // namespace
+
+Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
+  const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
+  const Execution& execution)
+{
+  return catchOutOfMemory("the working buffers of Volumetric AO (box statistics or the exact count)",
+    [&] { return ambientOcclusion(volume, region, parameters, output, execution); });
 }
 
 } // namespace vao

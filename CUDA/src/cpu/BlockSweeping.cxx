@@ -163,7 +163,7 @@ Status BlockSweeper::initialise()
   }
   catch (const std::bad_alloc&)
   {
-    return Status::failure("not enough memory for the sweeping buffers");
+    return Status::noMemory("the sweeping buffers (signed distance, octant visibility)");
   }
   s.threads = detail::resolveThreadCount(s.execution.threads);
   const BlockPlacement& b = s.placement;

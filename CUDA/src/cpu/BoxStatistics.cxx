@@ -2,6 +2,8 @@
 // benchmarks and users who want the fields themselves).
 #include "BoxEngine.h"
 
+#include "vao/Validation.h"
+
 namespace vao
 {
 
@@ -15,6 +17,7 @@ Status computeBoxStatistics(const VolumeView& view, const Region& region, const 
   }
   const detail::BoxGeometry geometry(view.dims, region, radius);
   const bool withExtrema = output.minimum || output.maximum;
+  return catchOutOfMemory("the working buffers of the box statistics", [&] {
   return detail::dispatchScalarType(view.type, [&](auto tag) -> Status {
     const detail::TypedVolume<decltype(tag)> volume(view);
     // Only the shift matters here: the statistics are written as they are.
@@ -34,6 +37,7 @@ Status computeBoxStatistics(const VolumeView& view, const Region& region, const 
           output.maximum[k] = voxel.stats.maximum;
       });
     return ok ? Status::success() : Status::cancelled();
+  });
   });
 }
 

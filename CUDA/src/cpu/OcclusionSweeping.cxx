@@ -9,6 +9,7 @@
 
 #include "Parallel.h"
 #include "SweepingCore.h"
+#include "vao/Validation.h"
 
 #include <algorithm>
 #include <new>
@@ -134,16 +135,8 @@ Status computeOcclusionSweeping(const VolumeView& volume, const std::array<doubl
     return status;
   }
   SweepReport local;
-  try
-  {
-    const Status result =
-      occlusionSweeping(volume, spacing, parameters, output, execution, report ? *report : local);
-    return result;
-  }
-  catch (const std::bad_alloc&)
-  {
-    return Status::failure("not enough memory for the sweeping buffers");
-  }
+  return catchOutOfMemory("the sweeping buffers (signed distance, fixed voxels, octant visibility)",
+    [&] { return occlusionSweeping(volume, spacing, parameters, output, execution, report ? *report : local); });
 }
 
 } // namespace vao

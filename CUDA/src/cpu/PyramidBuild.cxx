@@ -288,7 +288,10 @@ Status checkPyramidRequest(const VolumeView& volume, const std::array<double, 3>
 
 } // namespace
 
-Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
+namespace
+{
+
+Status buildPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const PyramidParameters& parameters,
   std::vector<MomentLevel>& pyramid, const Execution& execution)
 {
@@ -352,6 +355,21 @@ Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>&
   }
   pyramid = std::move(result);
   return Status::success();
+}
+
+} // namespace
+
+Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
+  std::vector<MomentLevel>& pyramid, const Execution& execution)
+{
+  const Status status = catchOutOfMemory("the levels of the moment pyramid",
+    [&] { return buildPyramid(volume, origin, spacing, parameters, pyramid, execution); });
+  if (status.outOfMemory)
+  {
+    pyramid.clear();
+  }
+  return status;
 }
 
 } // namespace vao

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <new>
 #include <sstream>
 
 namespace vao
@@ -197,6 +198,18 @@ Status validateMomentRequest(const VolumeView& volume, const Region& region, con
   if (status.ok)
     status = checkMomentMagnitude(scan);
   return status;
+}
+
+Status catchOutOfMemory(const char* what, const std::function<Status()>& f)
+{
+  try
+  {
+    return f();
+  }
+  catch (const std::bad_alloc&)
+  {
+    return Status::noMemory(what);
+  }
 }
 
 std::int64_t countNonFinite(const VolumeView& view, std::int64_t* firstIndex)
