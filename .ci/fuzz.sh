@@ -14,4 +14,5 @@ cmake -S CUDA -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMP
 cmake --build build-fuzz --target vao_fuzz
 mkdir -p build-fuzz/corpus
 cd build-fuzz
-exec ./tests/vao_fuzz -max_total_time="$seconds" -timeout=120 -rss_limit_mb=6144 -print_final_stats=1 corpus
+exec ./tests/vao_fuzz -max_total_time="$seconds" -timeout=120 -rss_limit_mb=6144 -max_len=8192 -len_control=0 \
+  -print_final_stats=1 corpus

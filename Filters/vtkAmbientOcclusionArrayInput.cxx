@@ -1,5 +1,6 @@
 #include "vtkAmbientOcclusionArrayInput.h"
 
+#include "vao/Validation.h"
 #include "vao/VarianceOcclusionMap.h"
 
 #include "vtkAlgorithm.h"
@@ -205,6 +206,39 @@ std::string NumberOfThreadsError(int threads)
   why << "NumberOfThreads must be 0 (the cores available, divided among the MPI ranks of the node) or "
          "positive (got "
       << threads << ").";
+  return why.str();
+}
+
+std::string NonFiniteError(vtkDataArray* array)
+{
+  vao::VolumeView view;
+  if (!array || array->GetNumberOfTuples() <= 0 || !ToKernelType(array->GetDataType(), view.type) ||
+    vao::scalarTypeIsIntegral(view.type))
+  {
+    return {};
+  }
+  if (!array->HasStandardMemoryLayout())
+  {
+    for (vtkIdType i = 0; i < array->GetNumberOfTuples(); ++i)
+      for (int c = 0; c < array->GetNumberOfComponents(); ++c)
+        if (!std::isfinite(array->GetComponent(i, c)))
+          return "Array '" + std::string(array->GetName() ? array->GetName() : "") + "' has NaN or infinite values (the first at point " +
+            std::to_string(i) + "): replace them (e.g. with the Calculator or Threshold filters) first.";
+    return {};
+  }
+  // Every component: each point's values, read in place as one long line of voxels.
+  view.data = array->GetVoidPointer(0);
+  view.dims = { array->GetNumberOfTuples() * array->GetNumberOfComponents(), 1, 1 };
+  const vao::ValueScan scan = vao::scanValues(view);
+  if (scan.nonFiniteCount == 0)
+  {
+    return {};
+  }
+  std::ostringstream why;
+  why << "Array '" << (array->GetName() ? array->GetName() : "") << "' has " << scan.nonFiniteCount
+      << " NaN or infinite values (the first at point " << scan.firstNonFinite / array->GetNumberOfComponents()
+      << "): they have no colour, opacity or shade; replace them (e.g. with the Calculator or Threshold "
+         "filters) first.";
   return why.str();
 }
 

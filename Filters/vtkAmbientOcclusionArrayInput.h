@@ -52,6 +52,10 @@ vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads);
 /// The error for a NumberOfThreads below 0; empty for a valid one.
 std::string NumberOfThreadsError(int threads);
 
+/// The error for a floating-point array with NaN or infinite values (how many, and the
+/// first one's point); empty for an array without any (or of an integer type).
+std::string NonFiniteError(vtkDataArray* array);
+
 /// The one message of a failed kernel call on `scalars`, for the user: for non-finite
 /// input, the array, how many such values it has and the first one's voxel in the input's
 /// coordinates; otherwise "<failed>: <the kernel's reason>.". Empty when the call

@@ -1,5 +1,6 @@
 #include "vtkAmbientOcclusionShading.h"
 
+#include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionMemory.h"
 
 #include "vtkAmbientOcclusionCollectives.h"
@@ -117,6 +118,24 @@ std::string vtkAmbientOcclusionShading::CheckInput(vtkPointData* pd, vtkDataArra
   else if (volume && this->ModulateOpacity && !pd->GetArray("Variance"))
     why << "ModulateOpacity needs the point array 'Variance' (Volumetric Ambient Occlusion with Compute "
            "Variance on).";
+  else if (!std::isfinite(this->ScalarRange[0]) || !std::isfinite(this->ScalarRange[1]))
+    why << "ScalarRange must be finite (got " << this->ScalarRange[0] << ", " << this->ScalarRange[1]
+        << "); an empty range such as (1, 0) means the data's.";
+  else if (!std::isfinite(this->OpacityRamp[0]) || !std::isfinite(this->OpacityRamp[1]))
+    why << "OpacityRamp must be finite (got " << this->OpacityRamp[0] << ", " << this->OpacityRamp[1]
+        << "); an empty ramp such as (1, 0) means the upper half of the range.";
+  if (!why.str().empty())
+    return why.str();
+  // The arrays the colours come from: one non-finite value would turn the automatic range,
+  // and with it every colour, into garbage.
+  const bool shadowUsed = !volume;
+  for (vtkDataArray* array : { scalars, ao, shadowUsed ? pd->GetArray("Shadow") : nullptr,
+         volume && this->ModulateOpacity ? pd->GetArray("Variance") : nullptr })
+  {
+    const std::string error = vtkAmbientOcclusionArrayInput::NonFiniteError(array);
+    if (!error.empty())
+      return error;
+  }
   return why.str();
 }
 

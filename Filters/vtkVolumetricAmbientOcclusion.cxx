@@ -205,7 +205,16 @@ bool vtkVolumetricAmbientOcclusion::CheckInputCovers(vtkImageData* input, const 
 bool vtkVolumetricAmbientOcclusion::CheckVoxelRadius(vtkImageData* input, const int whole[6], int radius[3])
 {
   const int wholeDims[3] = { whole[1] - whole[0] + 1, whole[3] - whole[2] + 1, whole[5] - whole[4] + 1 };
-  this->ComputeVoxelRadius(input->GetSpacing(), radius);
+  const double* h = input->GetSpacing();
+  if (this->RadiusUnits == WORLD &&
+    !(std::isfinite(h[0]) && h[0] > 0.0 && std::isfinite(h[1]) && h[1] > 0.0 && std::isfinite(h[2]) && h[2] > 0.0))
+  {
+    vtkErrorMacro(<< "A radius in world units needs a finite, positive spacing on every axis; the input's is "
+                  << h[0] << ", " << h[1] << ", " << h[2]
+                  << ". Fix the spacing (e.g. with Change Spacing) or give the radius in voxels.");
+    return false;
+  }
+  this->ComputeVoxelRadius(h, radius);
   if (radius[0] == 0 && radius[1] == 0 && radius[2] == 0)
   {
     vtkErrorMacro(<< "Radius " << this->Radius << (this->RadiusUnits == WORLD ? " (world units)" : "")

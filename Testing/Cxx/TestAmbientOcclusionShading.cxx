@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 using namespace vaotest;
 
@@ -74,6 +75,25 @@ TEST(AmbientOcclusionShadingFilter, VolumesGetRuizEquation5AndTheVarianceModulat
   EXPECT_EQ(std::string(vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetScalars()->GetName()), "ShadedRGBA");
 }
 
+TEST(AmbientOcclusionShadingFilter, TheVarianceModulationIsClampedBelowFullOpacity)
+{
+  // At opacity 0.4 an unclamped modulation s2 / VarianceMax (up to 1.75 here) would show
+  // as alpha above 0.4; at opacity 1 the byte conversion would hide it.
+  vtkNew<vtkAmbientOcclusionShading> shading;
+  shading->SetInputData(SmallVolume());
+  shading->ModulateOpacityOn();
+  shading->SetVarianceMax(4000);
+  vtkNew<vtkPiecewiseFunction> opacity;
+  opacity->AddPoint(0, 0.4);
+  opacity->AddPoint(700, 0.4);
+  shading->SetOpacityTransferFunction(opacity);
+  shading->Update();
+  vtkDataArray* rgba = vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGBA");
+  ASSERT_NE(rgba, nullptr);
+  for (vtkIdType i = 0; i < 8; ++i)
+    EXPECT_NEAR(rgba->GetComponent(i, 3), 0.4 * std::min(1.0, i * 1000.0 / 4000.0) * 255.0, 1.0) << i;
+}
+
 TEST(AmbientOcclusionShadingFilter, SurfacesGetColourTimesAmbientOcclusionTimesShadow)
 {
   vtkNew<vtkPolyData> surface;
@@ -117,6 +137,18 @@ TEST(AmbientOcclusionShadingFilter, RejectsBadInputWithAClearError)
   check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetAmbientIntensity(-1); }, "AmbientIntensity");
   check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetColorPreset(7); }, "ColorPreset");
   check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetScalarsArrayName("Nope"); }, "Nope");
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  check(SmallVolume(), [&](vtkAmbientOcclusionShading* s) { s->SetScalarRange(nan, 700); }, "ScalarRange must be finite");
+  check(SmallVolume(), [&](vtkAmbientOcclusionShading* s) { s->SetOpacityRamp(0, nan); }, "OpacityRamp must be finite");
+  auto infScalar = SmallVolume();
+  infScalar->GetPointData()->GetScalars()->SetComponent(5, 0, inf);
+  check(infScalar, [](vtkAmbientOcclusionShading*) {}, "Array 'Density' has 1 NaN or infinite values (the first at point 5)");
+  auto nanAO = SmallVolume();
+  nanAO->GetPointData()->GetArray("AmbientOcclusion")->SetComponent(3, 0, nan);
+  check(nanAO, [](vtkAmbientOcclusionShading*) {}, "Array 'AmbientOcclusion' has 1 NaN");
+  auto nanVariance = SmallVolume();
+  nanVariance->GetPointData()->GetArray("Variance")->SetComponent(2, 0, nan);
+  check(nanVariance, [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); }, "Array 'Variance' has 1 NaN");
 }
 
 } // namespace

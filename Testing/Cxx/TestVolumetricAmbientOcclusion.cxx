@@ -1,4 +1,5 @@
 // The VTK filter: translation of VTK data into kernel calls, streaming, bad input.
+#include "ReferenceFormulas.h"
 #include "TestHelpers.h"
 
 #include "vtkAmbientOcclusionPhantom.h"
@@ -21,6 +22,8 @@
 #include "vtkTrivialProducer.h"
 
 #include <gtest/gtest.h>
+
+#include <array>
 
 #include <cmath>
 #include <random>
@@ -94,20 +97,33 @@ double ReferenceOpenness(vtkImageData* image, int method, const int r[3], int i,
     for (int y = std::max(e[2], j - r[1]); y <= std::min(e[3], j + r[1]); ++y)
       for (int x = std::max(e[0], i - r[0]); x <= std::min(e[1], i + r[0]); ++x)
         m2 += (value(x, y, z) - mean) * (value(x, y, z) - mean);
-  const vao::NeighbourhoodStats s{ double(mean), double(m2 / n), double(lo), double(hi) };
-  return vao::opennessFromStats(static_cast<vao::Method>(method), value(i, j, k), s, vao::ErfMode::Exact);
+  // METHODS.md's formulas as the tests write them (CUDA/tests/ReferenceFormulas.h).
+  const vaotest::reference::Statistics s{ double(mean), double(m2 / n), double(lo), double(hi) };
+  const double q = value(i, j, k);
+  switch (method)
+  {
+    case vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION:
+      return vaotest::reference::cdfReconstruction(q, s);
+    case vtkVolumetricAmbientOcclusion::CHEBYSHEV:
+      return vaotest::reference::chebyshev(q, s);
+    default:
+      return vaotest::reference::gaussianCdf(q, s, false);
+  }
 }
 
 TEST(VolumetricAmbientOcclusion, MatchesBruteForceWithWorldRadiusOnAnOffsetExtent)
 {
   auto image = RandomImage(13, 9, 15, 1);
+  // Spacing 2, 1, 0.5: R = 4 is 2, 4, 8 voxels; R = 3 is 1.5, 3, 6, rounded to nearest: 2, 3, 6.
+  for (const auto& [worldRadius, voxels] : { std::make_pair(4.0, std::array<int, 3>{ 2, 4, 8 }),
+         std::make_pair(3.0, std::array<int, 3>{ 2, 3, 6 }) })
   for (int method : { vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION,
          vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, vtkVolumetricAmbientOcclusion::CHEBYSHEV })
   {
     const FilterRun run = RunFilter(image, [&](vtkVolumetricAmbientOcclusion* f) {
       f->SetMethod(method);
       f->SetRadiusUnits(vtkVolumetricAmbientOcclusion::WORLD);
-      f->SetRadius(4.0); // spacing 2, 1, 0.5 -> 2, 4, 8 voxels
+      f->SetRadius(worldRadius);
       f->ComputeVarianceOn();
     });
     ASSERT_TRUE(run.errors.empty()) << run.errors[0];
@@ -116,7 +132,7 @@ TEST(VolumetricAmbientOcclusion, MatchesBruteForceWithWorldRadiusOnAnOffsetExten
     ASSERT_NE(vtkFloatArray::SafeDownCast(run.output->GetPointData()->GetArray("Variance")), nullptr);
     ASSERT_NE(run.output->GetPointData()->GetArray("Density"), nullptr);
     EXPECT_EQ(std::string(run.output->GetPointData()->GetScalars()->GetName()), "Density");
-    const int r[3] = { 2, 4, 8 };
+    const int r[3] = { voxels[0], voxels[1], voxels[2] };
     const int* e = run.output->GetExtent();
     vtkIdType id = 0;
     for (int k = e[4]; k <= e[5]; ++k)
@@ -207,6 +223,49 @@ TEST(VolumetricAmbientOcclusion, StreamedPiecesEqualTheOnePieceResult)
   }
 }
 
+TEST(VolumetricAmbientOcclusion, RequestedSubExtentsEqualTheWholeResult)
+{
+  // Streaming by extent (UpdateExtent, as vtkImageDataStreamer and ParaView's slice views
+  // ask), not by piece: the input is the extent grown by the radius, the output exactly
+  // the extent asked for, and its values those of the whole run.
+  const int dims[3] = { 30, 28, 33 };
+  vtkNew<vtkAmbientOcclusionPhantom> phantom;
+  phantom->SetDimensions(dims[0], dims[1], dims[2]);
+  vtkNew<vtkVolumetricAmbientOcclusion> filter;
+  filter->SetInputConnection(phantom->GetOutputPort());
+  filter->SetRadius(3);
+  filter->Update();
+  const auto wholeAO = Values(filter->GetOutput()->GetPointData()->GetArray("AmbientOcclusion"));
+  const int extents[][6] = { { 0, 29, 0, 27, 10, 12 }, { 5, 9, 0, 27, 0, 32 }, { 0, 0, 27, 27, 32, 32 },
+    { 12, 20, 3, 9, 15, 30 } };
+  for (const auto& wanted : extents)
+  {
+    // A fresh pipeline per request: a cached whole output would already cover it.
+    vtkNew<vtkAmbientOcclusionPhantom> source;
+    source->SetDimensions(dims[0], dims[1], dims[2]);
+    vtkNew<vtkVolumetricAmbientOcclusion> streamed;
+    streamed->SetInputConnection(source->GetOutputPort());
+    streamed->SetRadius(3);
+    streamed->UpdateExtent(wanted);
+    vtkImageData* out = streamed->GetOutput();
+    const int* e = out->GetExtent();
+    const int* in = source->GetOutput()->GetExtent();
+    for (int a = 0; a < 6; ++a)
+      ASSERT_EQ(e[a], wanted[a]) << "the output is not the requested extent";
+    for (int a = 0; a < 3; ++a)
+    {
+      EXPECT_EQ(in[2 * a], std::max(0, wanted[2 * a] - 3)) << "input not grown by exactly the radius";
+      EXPECT_EQ(in[2 * a + 1], std::min(dims[a] - 1, wanted[2 * a + 1] + 3));
+    }
+    const auto ao = Values(out->GetPointData()->GetArray("AmbientOcclusion"));
+    vtkIdType id = 0;
+    for (int k = e[4]; k <= e[5]; ++k)
+      for (int j = e[2]; j <= e[3]; ++j)
+        for (int i = e[0]; i <= e[1]; ++i, ++id)
+          ASSERT_EQ(ao[id], wholeAO[(vtkIdType(k) * 28 + j) * 30 + i]) << i << "," << j << "," << k;
+  }
+}
+
 TEST(VolumetricAmbientOcclusion, BackendCudaFallsBackToCpuWithAWarning)
 {
   auto image = RandomImage(8, 8, 8, 4);
@@ -288,6 +347,15 @@ TEST(VolumetricAmbientOcclusion, RejectsBadInputWithAClearError)
   ExpectRejected(flat, none, "needs a 3-D volume");
 
   ExpectRejected(RandomImage(6, 6, 6, 1), radius(0), "rounds to 0 voxels");
+  for (double zero : { 0.0, -1.0, std::nan("") })
+  {
+    auto badSpacing = RandomImage(6, 6, 6, 1);
+    badSpacing->SetSpacing(1, zero, 1);
+    ExpectRejected(badSpacing, [](vtkVolumetricAmbientOcclusion* f) {
+      f->SetRadiusUnits(vtkVolumetricAmbientOcclusion::WORLD);
+      f->SetRadius(2);
+    }, "finite, positive spacing");
+  }
   ExpectRejected(RandomImage(6, 6, 6, 1), radius(0.4), "rounds to 0 voxels");
   ExpectRejected(RandomImage(6, 6, 6, 1), radius(-3), "non-negative");
   ExpectRejected(RandomImage(6, 6, 6, 1), radius(std::nan("")), "finite");
