@@ -100,6 +100,47 @@ TEST(SurfaceAO, ChebyshevIsExactOnTwoValuedData)
   }
 }
 
+TEST(SurfaceAO, FlatRegionsOfLargeMagnitudeDataAreOpen)
+{
+  // Zeros with a block of large values in one corner: far from the block every level is
+  // flat at 0, and a surface there queried at 0 is fully open (Penner & Mitchell's flat
+  // case). The blurred moments round with the data's magnitude; the flat rule must see
+  // through that at every magnitude and for both estimators.
+  const vao::Index3 dims = { 40, 40, 40 };
+  for (double magnitude : { 1.0, 1e3, 1e6, 1e12 })
+    for (int type = 0; type < 2; ++type)
+    {
+      std::vector<float> f(40 * 40 * 40, 0.0f);
+      std::vector<double> d(f.size(), 0.0);
+      for (std::int64_t z = 0; z < 8; ++z)
+        for (std::int64_t y = 0; y < 8; ++y)
+          for (std::int64_t x = 0; x < 8; ++x)
+          {
+            f[(z * 40 + y) * 40 + x] = static_cast<float>(magnitude * (1.0 + 0.01 * x));
+            d[(z * 40 + y) * 40 + x] = magnitude * (1.0 + 0.01 * x);
+          }
+      const vao::VolumeView view = type == 0 ? viewOf(f, dims) : viewOf(d, dims);
+      std::vector<vao::MomentLevel> pyramid;
+      vao::PyramidParameters pp;
+      pp.levels = 3;
+      ASSERT_TRUE(vao::buildMomentPyramid(view, { 0, 0, 0 }, { 1, 1, 1 }, pp, pyramid).ok);
+      for (vao::Method estimator : { vao::Method::Chebyshev, vao::Method::GaussianCdf })
+      {
+        vao::SurfaceOcclusionParameters p;
+        p.query = vao::SurfaceQuery::IsoValue;
+        p.isoValue = 0.0;
+        p.estimator = estimator;
+        // Three levels reach 2 + 4 + 8 = 14 voxels (offsets up to 8): the points stay 16+ away.
+        const double points[6] = { 33.0, 32.0, 31.0, 36.5, 30.0, 35.0 };
+        const double normals[6] = { 0, 0, 1, 1, 0, 0 };
+        float out[2] = { -1, -1 };
+        ASSERT_TRUE(vao::surfaceAmbientOcclusion(pyramid, view, { 0, 0, 0 }, { 1, 1, 1 }, points, normals, 2, p, out).ok);
+        EXPECT_EQ(out[0], 1.0f) << "magnitude " << magnitude << (type ? " float64" : " float32");
+        EXPECT_EQ(out[1], 1.0f) << "magnitude " << magnitude << (type ? " float64" : " float32");
+      }
+    }
+}
+
 TEST(SurfaceAO, BadInputFailsWithMessage)
 {
   const Field f = makeField({ 16, 16, 16 }, [](double, double, double z) { return z - 8.0; });
