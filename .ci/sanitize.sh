@@ -37,5 +37,8 @@ if [[ "${1:-}" == "--filters" ]]; then
     -DCMAKE_CXX_FLAGS="$asan" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
     -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined"
   cmake --build build-asan-filters -j "$(nproc)"
-  ctest --test-dir build-asan-filters -j "$(nproc)" --output-on-failure -L "kernels|filters" -LE rendering
+  # The out-of-memory tests make allocations fail on purpose, which ASan's allocator
+  # reports as its own error: they run in the plain build.
+  ctest --test-dir build-asan-filters -j "$(nproc)" --output-on-failure -L "kernels|filters" -LE rendering \
+    -E "OutOfMemory"
 fi
