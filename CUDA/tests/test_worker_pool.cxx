@@ -8,6 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <memory>
 #include <new>
@@ -164,6 +167,28 @@ TEST(WorkerPool, FourBlockSweepingRoundsStartAtMostTheWorkersOfOneTeam)
     }
   }
   EXPECT_LE(workerThreadsStarted() - before, kThreads - 1);
+}
+
+TEST(WorkerPool, AForkedChildRunsItsLoopsWithoutItsParentsWorkers)
+{
+  // Python's multiprocessing forks pvpython: the child has none of the parent's threads,
+  // so waiting on the parent's workers would hang it.
+  parallelFor(8, 8, 3, [](std::int64_t, std::int64_t) {}); // the parent has workers
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0)
+  {
+    alarm(20); // a hang ends the child with SIGALRM instead of the test run
+    std::atomic<std::int64_t> sum{ 0 };
+    parallelFor(100, 4, 3, [&](std::int64_t begin, std::int64_t end) {
+      for (std::int64_t i = begin; i < end; ++i)
+        sum += i;
+    });
+    _exit(sum.load() == 4950 ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "the child's loop hung or went wrong";
 }
 
 TEST(WorkerPool, DefaultThreadsDivideTheNodeByItsRanks)

@@ -11,6 +11,11 @@
 #if defined(__linux__)
 #include <sched.h>
 #endif
+#if defined(_WIN32)
+#include <process.h>
+#else
+#include <unistd.h>
+#endif
 
 namespace vao
 {
@@ -20,6 +25,15 @@ namespace
 {
 
 std::atomic<std::int64_t> startedWorkers{ 0 };
+
+long processId()
+{
+#if defined(_WIN32)
+  return _getpid();
+#else
+  return static_cast<long>(getpid());
+#endif
+}
 
 /// Cores this process may run on: its affinity mask where the system has one.
 int availableCores(bool& restricted)
@@ -65,23 +79,12 @@ class WorkerPool
 public:
   using Task = std::function<void(int member, int team)>;
 
+  /// Never destroyed: its workers wait on a condition variable and end with the process,
+  /// so no static destructor can join them while another static still uses the pool.
   static WorkerPool& shared()
   {
-    static WorkerPool pool;
-    return pool;
-  }
-
-  ~WorkerPool()
-  {
-    {
-      std::lock_guard<std::mutex> lock(this->Mutex);
-      this->Stopping = true;
-    }
-    this->Wake.notify_all();
-    for (std::thread& worker : this->Workers)
-    {
-      worker.join();
-    }
+    static WorkerPool* pool = new WorkerPool;
+    return *pool;
   }
 
   /// task(member, team) for every member of a team of up to `wanted` threads, the caller
@@ -89,7 +92,8 @@ public:
   void run(int wanted, const Task& task)
   {
     bool idle = false;
-    if (wanted <= 1 || !this->Busy.compare_exchange_strong(idle, true))
+    // A forked child (Python's multiprocessing, say) has none of its parent's workers.
+    if (wanted <= 1 || processId() != this->Owner || !this->Busy.compare_exchange_strong(idle, true))
     {
       task(0, 1);
       return;
@@ -159,11 +163,7 @@ private:
     std::unique_lock<std::mutex> lock(this->Mutex);
     for (;;)
     {
-      this->Wake.wait(lock, [&] { return this->Stopping || this->Generation != seen; });
-      if (this->Stopping)
-      {
-        return;
-      }
+      this->Wake.wait(lock, [&] { return this->Generation != seen; });
       seen = this->Generation;
       if (member >= this->Team)
       {
@@ -193,6 +193,7 @@ private:
     }
   }
 
+  const long Owner = processId(); // the process whose workers these are
   std::atomic<bool> Busy{ false };
   std::mutex Mutex;
   std::condition_variable Wake;
@@ -203,7 +204,6 @@ private:
   int Pending = 0;
   std::uint64_t Generation = 0;
   std::exception_ptr Failure;
-  bool Stopping = false;
 };
 
 } // namespace
