@@ -318,7 +318,7 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
     status = vao::cuda::computeAmbientOcclusion(volume, region, parameters, arrays, execution);
     // Bad input fails on the CPU too, with the same message: only a device failure
     // falls back.
-    if (!status.ok && !status.aborted && status.nonFiniteCount == 0)
+    if (!status.ok && status.deviceFailure)
     {
       vtkWarningMacro(<< "The CUDA backend failed (" << status.message << "); computing on the CPU.");
       onDevice = false;

@@ -47,6 +47,8 @@ TEST(CudaBackend, ReportsItsStateWithoutCrashing)
     EXPECT_FALSE(statsStatus.message.empty()) << "a failure without a device must say why";
     EXPECT_FALSE(aoStatus.ok);
     EXPECT_FALSE(aoStatus.message.empty()) << "a failure without a device must say why";
+    EXPECT_TRUE(statsStatus.deviceFailure && aoStatus.deviceFailure)
+      << "no device is a device failure: the CPU may still compute it";
     EXPECT_EQ(vao::cuda::measureCopyBandwidth(1 << 24), 0.0);
     std::cout << "[          ] built() = " << vao::cuda::built() << ", no device: " << device.description
               << "\n[          ] computeBoxStatistics says: " << statsStatus.message << std::endl;

@@ -120,11 +120,18 @@ struct Status
   std::int64_t nonFiniteCount = 0;
   std::int64_t firstNonFinite = -1;
   bool outOfMemory = false; // an allocation failed: smaller pieces may succeed
+  bool deviceFailure = false; // the GPU could not do it (no device, a CUDA error): the CPU may
 
   static Status success() { return {}; }
   static Status failure(std::string why) { return { false, false, std::move(why) }; }
   static Status cancelled() { return { false, true, "cancelled" }; }
   static Status nonFinite(std::int64_t count, std::int64_t first);
+  static Status device(std::string why)
+  {
+    Status status = failure(std::move(why));
+    status.deviceFailure = true;
+    return status;
+  }
   static Status noMemory(const std::string& what)
   {
     Status status = failure("not enough memory for " + what);

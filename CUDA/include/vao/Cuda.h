@@ -47,7 +47,9 @@ struct Timing
   std::vector<PassTiming> passes;
 };
 
-/// Openness (and optionally the variance) of every voxel of the region, on the GPU.
+/// Openness (and optionally the variance) of every voxel of the region, on the GPU. A
+/// failure of the device (none, a CUDA error) has Status::deviceFailure set: the CPU
+/// function may still succeed; bad input fails here as it would there.
 /// Execution: progress and cancellation between stages (a running kernel is not
 /// interrupted); the thread count does not apply.
 /// Method must be CdfReconstruction, GaussianCdf or Chebyshev: the exact references run

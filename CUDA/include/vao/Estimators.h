@@ -65,11 +65,14 @@ constexpr double kFlatEpsilon = 1e-14;
 /// stays far below any variance the sums could resolve.
 constexpr double kSumRoundingUlps = 1024.0;
 
+/// The spacing of doubles at 1 (DBL_EPSILON, here without <cfloat> for device code).
+constexpr double kDoubleUlp = 2.220446049250313e-16;
+
 /// The variance rounding can give a flat box when every value of the data lies within
 /// `deviation` of the shift its double sums were taken about.
 VAO_HD double sumRoundingVariance(double deviation)
 {
-  return kSumRoundingUlps * 2.220446049250313e-16 * deviation * deviation;
+  return kSumRoundingUlps * kDoubleUlp * deviation * deviation;
 }
 
 VAO_HD bool isFlatVariance(double mean, double variance, double roundingVariance = 0.0)
@@ -94,7 +97,7 @@ VAO_HD double flatOpenness(double query, double mean, double roundingVariance = 
 {
   const double scale = mean > 1.0 ? mean : (mean < -1.0 ? -mean : 1.0);
   const double relative = kFlatSpread * scale;
-  const double rounding = sqrt(roundingVariance * kSumRoundingUlps * 2.220446049250313e-16);
+  const double rounding = sqrt(roundingVariance * kSumRoundingUlps * kDoubleUlp);
   return query >= mean - (rounding > relative ? rounding : relative) ? 1.0 : 0.0;
 }
 

@@ -304,7 +304,7 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   const DeviceStatus device = deviceStatus();
   if (!device.available)
   {
-    return Status::failure("no CUDA device: " + device.description);
+    return Status::device("no CUDA device: " + device.description);
   }
   const auto start = std::chrono::steady_clock::now();
   if (timing)
@@ -321,7 +321,7 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   catch (const CudaFailure& failure)
   {
     cudaGetLastError(); // clear a non-sticky error so the next call starts clean
-    return Status::failure(failure.what());
+    return Status::device(failure.what());
   }
   catch (const Cancelled&)
   {
@@ -330,7 +330,7 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   }
   catch (const std::bad_alloc&)
   {
-    return Status::failure("out of host memory for the transfer");
+    return Status::device("out of host memory for the transfer");
   }
   if (timing)
   {
@@ -382,7 +382,7 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
 {
   if (!isSeparableMethod(p.method))
   {
-    return Status::failure("the exact references (Exact Box, Exact Sphere) run on the CPU only");
+    return Status::device("the exact references (Exact Box, Exact Sphere) run on the CPU only");
   }
   if (p.queryMode == QueryMode::IsoValue)
   {

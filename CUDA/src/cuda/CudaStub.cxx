@@ -19,13 +19,13 @@ DeviceStatus deviceStatus()
 Status computeAmbientOcclusion(const VolumeView&, const Region&, const AmbientOcclusionParameters&,
   const AmbientOcclusionOutput&, const Execution&, Timing*)
 {
-  return Status::failure("no CUDA device: " + deviceStatus().description);
+  return Status::device("no CUDA device: " + deviceStatus().description);
 }
 
 Status computeBoxStatistics(const VolumeView&, const Region&, const Radius&, const BoxStatisticsOutput&,
   const Execution&, Timing*)
 {
-  return Status::failure("no CUDA device: " + deviceStatus().description);
+  return Status::device("no CUDA device: " + deviceStatus().description);
 }
 
 double measureCopyBandwidth(double)
