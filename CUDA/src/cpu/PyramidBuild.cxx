@@ -33,6 +33,7 @@ namespace vao
 namespace
 {
 
+using namespace detail;
 using namespace detail::pyramid;
 
 /// Normalised weights of the clipped 5-tap Gaussian for each kept output index along one
