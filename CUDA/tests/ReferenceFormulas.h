@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
+#include <vector>
 
 namespace vaotest
 {
@@ -68,6 +70,26 @@ inline double chebyshev(double q, const Statistics& s)
   if (q <= s.mean)
     return 0.0;
   return 1.0 - s.variance / (s.variance + (q - s.mean) * (q - s.mean));
+}
+
+/// METHODS.md 8, Histogram CDF: with F(t) = P(v <= t) over the box, O = 0 when q is below
+/// the lowest threshold, 1 at or above the highest, F(t_k) at q = t_k, and between the two
+/// enclosing thresholds the straight line through (t_k, F(t_k)) and (t_k+1, F(t_k+1)).
+template <class Fraction>
+double histogramCdf(double q, const std::vector<double>& t, Fraction&& fractionAtOrBelow)
+{
+  if (t.empty() || q < t.front())
+    return 0.0;
+  if (q >= t.back())
+    return 1.0;
+  size_t k = 0;
+  while (!(t[k] <= q && q < t[k + 1]))
+    ++k;
+  const double f0 = fractionAtOrBelow(t[k]);
+  if (q == t[k])
+    return f0;
+  const double f1 = fractionAtOrBelow(t[k + 1]);
+  return f0 + (q - t[k]) / (t[k + 1] - t[k]) * (f1 - f0);
 }
 
 } // namespace reference

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace vao
 {
@@ -73,7 +74,12 @@ enum class QueryMode : int
 {
   VoxelValue = 0,
   IsoValue = 1,
+  SmoothedValue = 2, // METHODS.md 9: a normalised Gaussian average of v around the voxel
 };
+
+/// The accepted QuerySmoothing (sigma in voxels): the window of ceil(3 sigma) voxels each
+/// side costs O(sigma) per voxel and pass, and wider ones blur structures that AO shows.
+constexpr double kMaximumQuerySmoothing = 100.0;
 
 struct AmbientOcclusionParameters
 {
@@ -82,7 +88,15 @@ struct AmbientOcclusionParameters
   QueryMode queryMode = QueryMode::VoxelValue;
   double isoValue = 0.0;
   ErfMode erfMode = ErfMode::Exact;
+  double querySmoothing = 1.0; // sigma in voxels of QueryMode::SmoothedValue
+  // Histogram CDF: the ascending thresholds t_k, fixed from the whole data set's values
+  // (vao/HistogramCdf.h), never from one piece's.
+  std::vector<double> thresholds;
 };
+
+/// The half-width in voxels of the smoothed query's window (ceil(3 sigma)): a piece of a
+/// data set must be grown by it, as by the radius, for its voxels to get the serial query.
+int querySmoothingHalfWidth(double sigma);
 
 /// How the work runs: thread count, progress in [0, 1] and cancellation. The callbacks are
 /// invoked on the calling thread only, so they may touch non-thread-safe state (VTK).

@@ -24,6 +24,7 @@ enum class Method : int
   Chebyshev = 2,
   ExactBox = 3,
   ExactSphere = 4,
+  HistogramCdf = 5,
 };
 
 enum class ErfMode : int
@@ -171,6 +172,63 @@ VAO_HD double opennessChebyshev(double query, const NeighbourhoodStats& s)
   }
   const double d = query - s.mean;
   return clamp01(1.0 - s.variance / (s.variance + d * d));
+}
+
+/// Index of the first threshold >= q among the n ascending thresholds (n when none is):
+/// a voxel of value v counts in channel k (v <= t_k) exactly when thresholdIndex(v) <= k.
+VAO_HD int thresholdIndex(double q, const double* thresholds, int n)
+{
+  int lo = 0, hi = n;
+  while (lo < hi)
+  {
+    const int mid = (lo + hi) / 2;
+    if (thresholds[mid] < q)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/// Histogram CDF (METHODS.md 8): O = F at q, where F_k = P(v <= t_k) over the box is known
+/// at the n ascending thresholds; linear between the two that enclose q, F_k itself at
+/// q = t_k, 0 below t_0 and 1 at or above t_(n-1). The thresholds start at the data set's
+/// lowest value and end at its highest, so both ends are exact. The box holds `count`
+/// voxels, `below` of them at or under t_(upper-1) (0 for upper = 0) and `at` in
+/// (t_(upper-1), t_upper], where upper = thresholdIndex(q).
+VAO_HD double opennessHistogramCdfAt(double q, const double* thresholds, int n, int upper,
+  double count, double below, double at)
+{
+  if (n <= 0 || q < thresholds[0])
+  {
+    return 0.0;
+  }
+  if (upper >= n - 1 && q >= thresholds[n - 1])
+  {
+    return 1.0;
+  }
+  const double fUpper = (below + at) / count;
+  if (q == thresholds[upper])
+  {
+    return fUpper;
+  }
+  const double fLower = below / count;
+  const double a = (q - thresholds[upper - 1]) / (thresholds[upper] - thresholds[upper - 1]);
+  return clamp01(fLower + a * (fUpper - fLower));
+}
+
+/// The same from the box's counts per bin: histogram[b] voxels with thresholdIndex(v) = b.
+template <class Count>
+VAO_HD double opennessHistogramCdf(double q, const double* thresholds, int n, double count, const Count* histogram)
+{
+  const int upper = thresholdIndex(q, thresholds, n);
+  double below = 0.0;
+  for (int b = 0; b < upper && b < n; ++b)
+  {
+    below += static_cast<double>(histogram[b]);
+  }
+  return opennessHistogramCdfAt(
+    q, thresholds, n, upper, count, below, upper < n ? static_cast<double>(histogram[upper]) : 0.0);
 }
 
 /// Dispatch for the separable methods (the exact references count voxels instead).

@@ -31,6 +31,13 @@ Status checkFinitePoint(const std::array<double, 3>& point, const char* what);
 /// A parameter that must be a finite number.
 Status checkFiniteParameter(double value, const char* what);
 
+/// "" or why sigma is not an accepted QuerySmoothing: finite, > 0, at most
+/// kMaximumQuerySmoothing voxels.
+std::string checkQuerySmoothing(double sigma);
+
+/// Histogram CDF's thresholds: 1 to kMaximumHistogramBins, finite, strictly ascending.
+Status checkHistogramThresholds(const std::vector<double>& thresholds);
+
 /// What one parallel pass over the values finds: the non-finite ones, and the range of
 /// the finite ones (0, 0 when there is none).
 struct ValueScan

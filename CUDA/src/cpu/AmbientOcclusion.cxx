@@ -1,9 +1,15 @@
 // computeAmbientOcclusion: the estimators of Estimators.h fed by the streamed box moments
-// (and the box extrema for CDF Reconstruction), or the exact references.
+// (and the box extrema for CDF Reconstruction), the box histograms of Histogram CDF, or the
+// exact references; with the voxel's value, the iso value or the smoothed query as q.
 #include "BoxEngine.h"
 #include "ExactReference.h"
+#include "HistogramChannels.h"
+#include "SmoothedQuery.h"
 
 #include "vao/Validation.h"
+
+#include <cmath>
+#include <vector>
 
 
 namespace vao
@@ -19,9 +25,10 @@ const char* scalarTypeName(ScalarType type)
 namespace
 {
 
+/// The openness (from the streamed moments) and the variance of the box, as asked.
 template <class T>
 Status separableOpenness(const VolumeView& view, const Region& region,
-  const AmbientOcclusionParameters& p, const AmbientOcclusionOutput& output,
+  const AmbientOcclusionParameters& p, const AmbientOcclusionOutput& output, const double* query,
   const ValueScan& scan, const Execution& execution)
 {
   const detail::TypedVolume<T> volume(view);
@@ -37,7 +44,7 @@ Status separableOpenness(const VolumeView& view, const Region& region,
       }
       if (output.openness)
       {
-        const double q = voxelQuery ? voxel.value : p.isoValue;
+        const double q = query ? query[voxel.index] : (voxelQuery ? voxel.value : p.isoValue);
         output.openness[voxel.index] =
           static_cast<float>(opennessFromStats(p.method, q, voxel.stats, p.erfMode));
       }
@@ -45,54 +52,104 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   return ok ? Status::success() : Status::cancelled();
 }
 
-} // namespace
-
-namespace
+/// The parameters' own checks (the volume's come after).
+Status checkParameters(const AmbientOcclusionParameters& p)
 {
+  if (p.queryMode == QueryMode::IsoValue)
+  {
+    return checkFiniteParameter(p.isoValue, "the iso value");
+  }
+  if (p.queryMode == QueryMode::SmoothedValue)
+  {
+    const std::string why = checkQuerySmoothing(p.querySmoothing);
+    if (!why.empty())
+      return Status::failure(why);
+  }
+  if (p.method == Method::HistogramCdf)
+  {
+    return checkHistogramThresholds(p.thresholds);
+  }
+  return Status::success();
+}
 
 Status ambientOcclusion(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
   const Execution& execution)
 {
-  Status status = parameters.queryMode == QueryMode::IsoValue
-    ? checkFiniteParameter(parameters.isoValue, "the iso value")
-    : Status::success();
+  Status status = checkParameters(parameters);
+  const bool moments = output.variance || (output.openness && isSeparableMethod(parameters.method));
   ValueScan scan;
-  if (status.ok)
+  if (status.ok && moments)
+  {
     status = validateMomentRequest(volume, region, parameters.radius, scan);
+  }
+  else if (status.ok)
+  {
+    status = validate(volume, region, parameters.radius);
+    if (status.ok && !scalarTypeIsIntegral(volume.type))
+      status = finiteStatus(scan = scanValues(volume));
+  }
   if (!status.ok)
   {
     return status;
   }
-  AmbientOcclusionOutput separable = output;
-  if (!isSeparableMethod(parameters.method))
+  // Stages of the progress: the smoothed query, the openness, the variance.
+  const bool smoothed = parameters.queryMode == QueryMode::SmoothedValue;
+  const bool separate = output.openness && !isSeparableMethod(parameters.method);
+  const double queryEnd = smoothed ? 0.2 : 0.0;
+  const double opennessEnd = separate ? (output.variance ? 0.9 : 1.0) : queryEnd;
+  std::vector<double> query;
+  if (smoothed && output.openness)
   {
-    const bool withVariance = output.variance != nullptr;
-    const Execution exact = detail::stageExecution(execution, 0.0, withVariance ? 0.9 : 1.0);
-    if (output.openness)
-    {
-      status = detail::computeExactOpenness(volume, region, parameters, output.openness, exact);
-    }
-    if (!status.ok || !withVariance)
-    {
+    query.resize(static_cast<std::size_t>(region.voxelCount()));
+    if (!detail::computeSmoothedQuery(volume, region, parameters.querySmoothing, query.data(),
+          detail::stageExecution(execution, 0.0, queryEnd)))
+      return Status::cancelled();
+  }
+  const double* q = query.empty() ? nullptr : query.data();
+  const Execution stage = detail::stageExecution(execution, queryEnd, opennessEnd);
+  if (separate && parameters.method == Method::HistogramCdf)
+  {
+    detail::HistogramQuery source;
+    source.values = q;
+    source.isoValue = parameters.queryMode == QueryMode::IsoValue ? &parameters.isoValue : nullptr;
+    if (!detail::computeHistogramOpenness(
+          volume, region, parameters.radius, parameters.thresholds, source, output.openness, stage))
+      return Status::cancelled();
+  }
+  else if (separate)
+  {
+    status = detail::computeExactOpenness(volume, region, parameters, q, output.openness, stage);
+    if (!status.ok)
       return status;
-    }
-    separable.openness = nullptr; // the variance still comes from the moments
+  }
+  if (!moments)
+  {
+    return Status::success();
+  }
+  AmbientOcclusionOutput separable = output;
+  if (separate)
+  {
+    separable.openness = nullptr; // done: only the variance comes from the moments
   }
   return detail::dispatchScalarType(volume.type, [&](auto tag) {
-    return separableOpenness<decltype(tag)>(volume, region, parameters, separable, scan,
-      isSeparableMethod(parameters.method) ? execution
-                                           : detail::stageExecution(execution, 0.9, 1.0));
+    return separableOpenness<decltype(tag)>(volume, region, parameters, separable, q, scan,
+      detail::stageExecution(execution, opennessEnd, 1.0));
   });
 }
 
 } // namespace
 
+int querySmoothingHalfWidth(double sigma)
+{
+  return std::isfinite(sigma) && sigma > 0.0 ? static_cast<int>(std::ceil(3.0 * std::min(sigma, kMaximumQuerySmoothing))) : 0;
+}
+
 Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
   const Execution& execution)
 {
-  return catchOutOfMemory("the working buffers of Volumetric AO (box statistics or the exact count)",
+  return catchOutOfMemory("the working buffers of Volumetric AO (box statistics, histograms, the smoothed query)",
     [&] { return ambientOcclusion(volume, region, parameters, output, execution); });
 }
 

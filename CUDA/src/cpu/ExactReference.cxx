@@ -56,7 +56,7 @@ std::int64_t rowHalfWidth(const Radius& r, std::int64_t dy, std::int64_t dz, boo
 template <class T>
 void exactSlice(const TypedVolume<T>& volume, const Region& region,
   const AmbientOcclusionParameters& p, const std::vector<std::int64_t>& halfWidths,
-  std::int64_t z, float* out)
+  std::int64_t z, const double* query, float* out)
 {
   const Radius& r = p.radius;
   const Index3& n = volume.dims;
@@ -65,7 +65,9 @@ void exactSlice(const TypedVolume<T>& volume, const Region& region,
   {
     for (std::int64_t x = region.begin[0]; x < region.begin[0] + region.size[0]; ++x)
     {
-      const double q = iso ? p.isoValue : static_cast<double>(volume.value(x, y, z));
+      const std::int64_t k = ((z - region.begin[2]) * region.size[1] + (y - region.begin[1])) *
+          region.size[0] + (x - region.begin[0]);
+      const double q = query ? query[k] : (iso ? p.isoValue : static_cast<double>(volume.value(x, y, z)));
       std::int64_t below = 0, total = 0;
       for (std::int64_t dz = -r.z; dz <= r.z; ++dz)
       {
@@ -90,8 +92,6 @@ void exactSlice(const TypedVolume<T>& volume, const Region& region,
           total += hi - lo + 1;
         }
       }
-      const std::int64_t k = ((z - region.begin[2]) * region.size[1] + (y - region.begin[1])) *
-          region.size[0] + (x - region.begin[0]);
       out[k] = static_cast<float>(static_cast<double>(below) / static_cast<double>(total));
     }
   }
@@ -100,7 +100,7 @@ void exactSlice(const TypedVolume<T>& volume, const Region& region,
 } // namespace
 
 Status computeExactOpenness(const VolumeView& view, const Region& region,
-  const AmbientOcclusionParameters& p, float* openness, const Execution& execution)
+  const AmbientOcclusionParameters& p, const double* query, float* openness, const Execution& execution)
 {
   const bool sphere = p.method == Method::ExactSphere;
   const Radius& r = p.radius;
@@ -120,7 +120,7 @@ Status computeExactOpenness(const VolumeView& view, const Region& region,
       [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
         for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
         {
-          exactSlice(volume, region, p, halfWidths, region.begin[2] + k, openness);
+          exactSlice(volume, region, p, halfWidths, region.begin[2] + k, query, openness);
           progress.advance();
         }
       });

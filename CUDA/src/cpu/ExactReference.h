@@ -9,8 +9,10 @@ namespace vao
 namespace detail
 {
 
+/// `query`: the query of each region voxel (x fastest), or null for the voxel's own value
+/// or the iso value (parameters.queryMode).
 Status computeExactOpenness(const VolumeView& volume, const Region& region,
-  const AmbientOcclusionParameters& parameters, float* openness, const Execution& execution);
+  const AmbientOcclusionParameters& parameters, const double* query, float* openness, const Execution& execution);
 
 } // namespace detail
 } // namespace vao

@@ -1,6 +1,7 @@
 // The argument checks of every entry point (vao/Validation.h), and the parallel scan for
 // non-finite values.
 #include "vao/Validation.h"
+#include "vao/HistogramCdf.h"
 
 #include "Parallel.h"
 #include "VolumeAccess.h"
@@ -167,6 +168,36 @@ ValueScan scanValues(const VolumeView& view)
     }
     return total;
   });
+}
+
+std::string checkQuerySmoothing(double sigma)
+{
+  if (std::isfinite(sigma) && sigma > 0.0 && sigma <= kMaximumQuerySmoothing)
+  {
+    return std::string();
+  }
+  std::ostringstream why;
+  why << "QuerySmoothing (the smoothed query's sigma in voxels) must be a finite number in (0, "
+      << kMaximumQuerySmoothing << "] (got " << sigma << ")";
+  return why.str();
+}
+
+Status checkHistogramThresholds(const std::vector<double>& thresholds)
+{
+  if (thresholds.empty() || thresholds.size() > static_cast<std::size_t>(kMaximumHistogramBins))
+  {
+    return Status::failure("Histogram CDF needs 1 to " + std::to_string(kMaximumHistogramBins) +
+      " thresholds (got " + std::to_string(thresholds.size()) + ")");
+  }
+  for (std::size_t k = 0; k < thresholds.size(); ++k)
+  {
+    if (!std::isfinite(thresholds[k]) || (k > 0 && !(thresholds[k] > thresholds[k - 1])))
+    {
+      return Status::failure("Histogram CDF's thresholds must be finite and strictly ascending (threshold " +
+        std::to_string(k) + " is not)");
+    }
+  }
+  return Status::success();
 }
 
 Status finiteStatus(const ValueScan& scan)

@@ -382,7 +382,13 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
 {
   if (!isSeparableMethod(p.method))
   {
-    return Status::device("the exact references (Exact Box, Exact Sphere) run on the CPU only");
+    return Status::device(p.method == Method::HistogramCdf
+        ? "Histogram CDF runs on the CPU only"
+        : "the exact references (Exact Box, Exact Sphere) run on the CPU only");
+  }
+  if (p.queryMode == QueryMode::SmoothedValue)
+  {
+    return Status::device("the smoothed query runs on the CPU only");
   }
   if (p.queryMode == QueryMode::IsoValue)
   {

@@ -1,0 +1,302 @@
+// Histogram CDF (METHODS.md 8): the thresholds' properties, and the openness against a
+// brute force of the definition (ReferenceFormulas.h) on random volumes of every kind.
+#include "ReferenceFormulas.h"
+#include "TestVolumes.h"
+
+#include "vao/HistogramCdf.h"
+#include "vao/Validation.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+
+using namespace vaotest;
+
+namespace
+{
+
+std::vector<float> histogramOpenness(const vao::VolumeView& view, const vao::Region& region, vao::Radius r,
+  const std::vector<double>& thresholds, vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0.0)
+{
+  std::vector<float> out(region.voxelCount(), -1.0f);
+  vao::AmbientOcclusionParameters p;
+  p.method = vao::Method::HistogramCdf;
+  p.radius = r;
+  p.queryMode = query;
+  p.isoValue = iso;
+  p.thresholds = thresholds;
+  const vao::Status status = vao::computeAmbientOcclusion(view, region, p, { out.data(), nullptr });
+  EXPECT_TRUE(status.ok) << status.message;
+  return out;
+}
+
+/// Fraction of the clipped box of (x, y, z) with v <= t, counted voxel by voxel.
+template <class T>
+double fractionAtOrBelow(const std::vector<T>& v, const vao::Index3& d, const vao::Radius& r,
+  std::int64_t x, std::int64_t y, std::int64_t z, double t)
+{
+  double below = 0, total = 0;
+  for (std::int64_t k = std::max<std::int64_t>(0, z - r.z); k <= std::min(d[2] - 1, z + r.z); ++k)
+    for (std::int64_t j = std::max<std::int64_t>(0, y - r.y); j <= std::min(d[1] - 1, y + r.y); ++j)
+      for (std::int64_t i = std::max<std::int64_t>(0, x - r.x); i <= std::min(d[0] - 1, x + r.x); ++i)
+      {
+        total += 1;
+        below += static_cast<double>(v[(k * d[1] + j) * d[0] + i]) <= t ? 1 : 0;
+      }
+  return below / total;
+}
+
+template <class T>
+void expectMatchesDefinition(const std::vector<T>& v, const vao::Index3& dims, vao::Radius r,
+  const std::vector<double>& thresholds, vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0.0)
+{
+  const auto view = viewOf(v, dims);
+  const auto got = histogramOpenness(view, vao::Region::whole(view), r, thresholds, query, iso);
+  std::int64_t k = 0, failures = 0;
+  for (std::int64_t z = 0; z < dims[2]; ++z)
+    for (std::int64_t y = 0; y < dims[1]; ++y)
+      for (std::int64_t x = 0; x < dims[0]; ++x, ++k)
+      {
+        const double q = query == vao::QueryMode::IsoValue ? iso : static_cast<double>(v[k]);
+        const double expected = reference::histogramCdf(
+          q, thresholds, [&](double t) { return fractionAtOrBelow(v, dims, r, x, y, z, t); });
+        if (!(std::abs(got[k] - expected) <= 2e-6) && failures++ < 8)
+          ADD_FAILURE() << "(" << x << "," << y << "," << z << ") q " << q << ": " << got[k] << " vs " << expected;
+      }
+  EXPECT_EQ(failures, 0);
+}
+
+template <class T>
+std::set<double> distinctValues(const std::vector<T>& v)
+{
+  std::set<double> values;
+  for (const T x : v)
+    values.insert(static_cast<double>(x));
+  return values;
+}
+
+} // namespace
+
+TEST(HistogramCdf, ThresholdsSpanTheDataAndAscend)
+{
+  const vao::Index3 dims = { 23, 19, 17 };
+  const auto v = randomVolume<std::int16_t>(dims, -1024, 3000, 5);
+  const auto values = distinctValues(v);
+  for (int bins : { 2, 3, 16, 64, 1024 })
+  {
+    std::vector<double> t;
+    ASSERT_TRUE(vao::volumeThresholds(viewOf(v, dims), bins, t).ok);
+    ASSERT_EQ(t.size(), std::min<size_t>(bins, values.size())) << bins;
+    EXPECT_EQ(t.front(), *values.begin());
+    EXPECT_EQ(t.back(), *values.rbegin());
+    for (size_t k = 1; k < t.size(); ++k)
+      EXPECT_LT(t[k - 1], t[k]);
+    for (const double x : t)
+      EXPECT_EQ(values.count(x), 1u) << "a threshold that is not a value of the data: " << x;
+  }
+}
+
+TEST(HistogramCdf, ATieCostsOneThreshold)
+{
+  // 80% of the voxels at 0 (air clamped), the rest spread over 1..2000.
+  const vao::Index3 dims = { 40, 40, 40 };
+  std::vector<std::int16_t> v(dims[0] * dims[1] * dims[2], 0);
+  std::mt19937 rng(3);
+  for (size_t i = 0; i < v.size(); ++i)
+    if (rng() % 5 == 0)
+      v[i] = static_cast<std::int16_t>(1 + rng() % 2000);
+  std::vector<double> t;
+  ASSERT_TRUE(vao::volumeThresholds(viewOf(v, dims), 32, t).ok);
+  ASSERT_EQ(t.size(), 32u);
+  EXPECT_EQ(t[0], 0.0);
+  // The other 31 share the spread values: no threshold is spent twice on the tie.
+  EXPECT_GT(t[1], 0.0);
+  std::vector<std::int64_t> perBin(t.size(), 0);
+  for (const auto x : v)
+    if (x > 0)
+      ++perBin[std::lower_bound(t.begin(), t.end(), double(x)) - t.begin()];
+  for (size_t k = 2; k + 1 < t.size(); ++k)
+    EXPECT_LT(perBin[k], 13 * static_cast<std::int64_t>(v.size()) / 50 / 31) << "bin " << k << " holds too much";
+}
+
+TEST(HistogramCdf, SummariesOfPartsMergeToTheWholeVolumes)
+{
+  const vao::Index3 dims = { 21, 13, 30 };
+  for (int kind = 0; kind < 2; ++kind)
+  {
+    const auto vi = randomVolume<std::int32_t>(dims, -70000, 90000, 8);
+    const auto vf = randomVolume<float>(dims, -3.5e6, 1e7, 9);
+    const vao::VolumeView view = kind == 0 ? viewOf(vi, dims) : viewOf(vf, dims);
+    const auto range = vao::valueRange(view);
+    auto whole = vao::ValueHistogram::forRange(view.type, range[0], range[1]);
+    ASSERT_TRUE(vao::addToValueHistogram(view, vao::Region::whole(view), whole).ok);
+    EXPECT_EQ(whole.totalCount(), view.voxelCount());
+    // Three slabs in another order, merged.
+    auto merged = vao::ValueHistogram::forRange(view.type, range[0], range[1]);
+    for (const auto& slab : { std::array<std::int64_t, 2>{ 20, 10 }, { 0, 7 }, { 7, 13 } })
+    {
+      auto part = vao::ValueHistogram::forRange(view.type, range[0], range[1]);
+      ASSERT_TRUE(vao::addToValueHistogram(view, { { 0, 0, slab[0] }, { dims[0], dims[1], slab[1] } }, part).ok);
+      merged.merge(part);
+    }
+    for (int bins : { 5, 64, 300 })
+      EXPECT_EQ(vao::histogramThresholds(merged, bins), vao::histogramThresholds(whole, bins));
+  }
+}
+
+TEST(HistogramCdf, MatchesTheDefinitionOnRandomVolumes)
+{
+  const vao::Index3 dims = { 17, 11, 9 };
+  const auto v8 = randomVolume<std::uint8_t>(dims, 0, 255, 31);
+  const auto v16 = randomVolume<std::int16_t>(dims, -1024, 1600, 32);
+  const auto vf = randomVolume<float>(dims, -1, 1, 33);
+  const auto vd = randomVolume<double>(dims, -1e9, 1e9, 34);
+  const auto vu32 = randomVolume<std::uint32_t>(dims, 0, 4e9, 35);
+  for (int bins : { 2, 7, 64 })
+  {
+    SCOPED_TRACE(bins);
+    std::vector<double> t8, t16, tf, td, tu;
+    ASSERT_TRUE(vao::volumeThresholds(viewOf(v8, dims), bins, t8).ok);
+    ASSERT_TRUE(vao::volumeThresholds(viewOf(v16, dims), bins, t16).ok);
+    ASSERT_TRUE(vao::volumeThresholds(viewOf(vf, dims), bins, tf).ok);
+    ASSERT_TRUE(vao::volumeThresholds(viewOf(vd, dims), bins, td).ok);
+    ASSERT_TRUE(vao::volumeThresholds(viewOf(vu32, dims), bins, tu).ok);
+    for (int r = 1; r <= 4; r += 3)
+    {
+      expectMatchesDefinition(v8, dims, { r, r, r }, t8);
+      expectMatchesDefinition(v16, dims, { r, r, r }, t16);
+      expectMatchesDefinition(vf, dims, { r, r, r }, tf);
+      expectMatchesDefinition(vd, dims, { r, r, r }, td);
+      expectMatchesDefinition(vu32, dims, { r, r, r }, tu);
+    }
+    expectMatchesDefinition(v16, dims, { 3, 0, 2 }, t16);
+    expectMatchesDefinition(v16, dims, { 30, 30, 30 }, t16);
+    expectMatchesDefinition(vf, dims, { 2, 2, 2 }, tf, vao::QueryMode::IsoValue, 0.3);
+    expectMatchesDefinition(vf, dims, { 2, 2, 2 }, tf, vao::QueryMode::IsoValue, -5.0);
+    expectMatchesDefinition(vf, dims, { 2, 2, 2 }, tf, vao::QueryMode::IsoValue, 5.0);
+  }
+  // Thresholds that are not values of the data, nor span it.
+  expectMatchesDefinition(v16, dims, { 2, 3, 1 }, { -500.5, 0.25, 1.0, 700.0 });
+}
+
+TEST(HistogramCdf, SixteenBitCountsWrapSafelyAndWideBoxesUseWiderLanes)
+{
+  // 39^3 = 59319 voxels fit 16-bit lanes; 41^3 = 68921 do not.
+  const vao::Index3 dims = { 48, 45, 44 };
+  const auto v = randomVolume<std::uint8_t>(dims, 0, 40, 41);
+  std::vector<double> t;
+  ASSERT_TRUE(vao::volumeThresholds(viewOf(v, dims), 16, t).ok);
+  for (int r : { 19, 20 })
+  {
+    const auto view = viewOf(v, dims);
+    const auto got = histogramOpenness(view, vao::Region::whole(view), { r, r, r }, t);
+    for (std::int64_t k = 0; k < view.voxelCount(); k += 997)
+    {
+      const std::int64_t x = k % dims[0], y = (k / dims[0]) % dims[1], z = k / (dims[0] * dims[1]);
+      const double expected = reference::histogramCdf(double(v[k]), t,
+        [&](double th) { return fractionAtOrBelow(v, dims, { r, r, r }, x, y, z, th); });
+      ASSERT_NEAR(got[k], expected, 2e-6) << "r " << r << " voxel " << k;
+    }
+  }
+}
+
+TEST(HistogramCdf, AtMostKDistinctValuesGiveExactBox)
+{
+  const vao::Index3 dims = { 19, 23, 14 };
+  auto v8 = randomVolume<std::uint8_t>(dims, 0, 256, 51);
+  auto vf = randomVolume<float>(dims, 0, 10, 52);
+  for (auto& x : vf)
+    x = std::floor(x) * 0.37f - 1.0f; // 10 distinct floats
+  auto v16 = randomVolume<std::int16_t>(dims, -1000, 1000, 53);
+  for (auto& x : v16)
+    x = static_cast<std::int16_t>(x / 50 * 50); // 41 distinct values
+  auto check = [&](auto& v, int bins) {
+    const auto view = viewOf(v, dims);
+    std::vector<double> t;
+    ASSERT_TRUE(vao::volumeThresholds(view, bins, t).ok);
+    const vao::Radius r{ 3, 2, 4 };
+    const auto got = histogramOpenness(view, vao::Region::whole(view), r, t);
+    std::vector<float> exact(view.voxelCount());
+    vao::AmbientOcclusionParameters p;
+    p.method = vao::Method::ExactBox;
+    p.radius = r;
+    ASSERT_TRUE(vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { exact.data(), nullptr }).ok);
+    for (std::int64_t k = 0; k < view.voxelCount(); ++k)
+      ASSERT_NEAR(got[k], exact[k], 1e-6) << k;
+  };
+  check(v8, 256);
+  check(vf, 10);
+  check(v16, 64);
+}
+
+TEST(HistogramCdf, APieceGrownByTheRadiusGivesTheWholeVolumesNumbers)
+{
+  const vao::Index3 dims = { 60, 21, 33 };
+  const auto v = randomVolume<std::int16_t>(dims, -1024, 2000, 61);
+  const auto view = viewOf(v, dims);
+  std::vector<double> t;
+  ASSERT_TRUE(vao::volumeThresholds(view, 64, t).ok);
+  const vao::Radius r{ 5, 3, 4 };
+  const auto whole = histogramOpenness(view, vao::Region::whole(view), r, t);
+  // The piece x in [20, 50), z in [10, 20), grown by the radius, as its own block.
+  const vao::Index3 lo = { 15, 0, 6 }, hi = { 55, 21, 24 };
+  const vao::Index3 pd = { hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2] };
+  std::vector<std::int16_t> piece;
+  for (std::int64_t z = lo[2]; z < hi[2]; ++z)
+    for (std::int64_t y = lo[1]; y < hi[1]; ++y)
+      for (std::int64_t x = lo[0]; x < hi[0]; ++x)
+        piece.push_back(v[(z * dims[1] + y) * dims[0] + x]);
+  const vao::Region region{ { 5, 0, 4 }, { 30, 21, 10 } };
+  const auto got = histogramOpenness(viewOf(piece, pd), region, r, t);
+  std::int64_t k = 0;
+  for (std::int64_t z = 10; z < 20; ++z)
+    for (std::int64_t y = 0; y < 21; ++y)
+      for (std::int64_t x = 20; x < 50; ++x, ++k)
+        ASSERT_EQ(got[k], whole[(z * dims[1] + y) * dims[0] + x]) << x << "," << y << "," << z;
+}
+
+TEST(HistogramCdf, RefusesBadThresholdsAndBins)
+{
+  const vao::Index3 dims = { 8, 8, 8 };
+  const auto v = randomVolume<float>(dims, 0, 1, 71);
+  const auto view = viewOf(v, dims);
+  std::vector<float> out(view.voxelCount());
+  vao::AmbientOcclusionParameters p;
+  p.method = vao::Method::HistogramCdf;
+  p.radius = { 2, 2, 2 };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& t : std::vector<std::vector<double>>{ {}, { 0.5, 0.2 }, { 0.1, 0.1 }, { 0.0, nan },
+         { -std::numeric_limits<double>::infinity(), 1.0 }, std::vector<double>(1025, 0.0) })
+  {
+    p.thresholds = t;
+    const vao::Status status = vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { out.data(), nullptr });
+    EXPECT_FALSE(status.ok);
+    EXPECT_NE(status.message.find("threshold"), std::string::npos) << status.message;
+  }
+  for (int bins : { -1, 0, 1, 1025, 1 << 30 })
+    EXPECT_NE(vao::checkHistogramBins(bins).find("NumberOfBins"), std::string::npos) << bins;
+  for (int bins : { 2, 64, 1024 })
+    EXPECT_EQ(vao::checkHistogramBins(bins), "");
+  // Non-finite data: the thresholds refuse it with the count.
+  auto bad = v;
+  bad[100] = nan;
+  std::vector<double> t;
+  const vao::Status status = vao::volumeThresholds(viewOf(bad, dims), 64, t);
+  EXPECT_FALSE(status.ok);
+  EXPECT_EQ(status.nonFiniteCount, 1);
+}
+
+TEST(HistogramCdf, ExtremeMagnitudesKeepTheirCells)
+{
+  // Values at the edges of double: the cell grid's width must not overflow.
+  const vao::Index3 dims = { 6, 5, 4 };
+  std::vector<double> v(dims[0] * dims[1] * dims[2]);
+  for (size_t i = 0; i < v.size(); ++i)
+    v[i] = (i % 3 == 0 ? -1.7e308 : (i % 3 == 1 ? 1.7e308 : 4.9e-324 * double(i)));
+  std::vector<double> t;
+  ASSERT_TRUE(vao::volumeThresholds(viewOf(v, dims), 8, t).ok);
+  EXPECT_EQ(t.front(), -1.7e308);
+  EXPECT_EQ(t.back(), 1.7e308);
+  expectMatchesDefinition(v, dims, { 1, 1, 1 }, t);
+}
