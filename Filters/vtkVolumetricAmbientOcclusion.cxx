@@ -4,9 +4,11 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionThresholds.h"
 
 #include "vao/AmbientOcclusion.h"
 #include "vao/Cuda.h"
+#include "vao/HistogramCdf.h"
 #include "vao/Validation.h"
 
 #include "vtkDataArray.h"
@@ -15,6 +17,7 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -33,7 +36,8 @@ namespace
 {
 
 const char* const MethodNames[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box",
-  "Exact Sphere" };
+  "Exact Sphere", "Histogram CDF" };
+const char* const QueryModeNames[] = { "Voxel Value", "Iso Value", "Smoothed Voxel Value" };
 
 vao::Method KernelMethod(int method)
 {
@@ -47,6 +51,8 @@ vao::Method KernelMethod(int method)
       return vao::Method::ExactBox;
     case vtkVolumetricAmbientOcclusion::EXACT_SPHERE:
       return vao::Method::ExactSphere;
+    case vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF:
+      return vao::Method::HistogramCdf;
     case vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF:
     default: // CheckParameters rejects any other value
       return vao::Method::GaussianCdf;
@@ -55,7 +61,15 @@ vao::Method KernelMethod(int method)
 
 vao::QueryMode KernelQueryMode(int mode)
 {
-  return mode == vtkVolumetricAmbientOcclusion::ISO_VALUE ? vao::QueryMode::IsoValue : vao::QueryMode::VoxelValue;
+  switch (mode)
+  {
+    case vtkVolumetricAmbientOcclusion::ISO_VALUE:
+      return vao::QueryMode::IsoValue;
+    case vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE:
+      return vao::QueryMode::SmoothedValue;
+    default:
+      return vao::QueryMode::VoxelValue;
+  }
 }
 
 vao::ErfMode KernelErfMode(int erf)
@@ -75,6 +89,7 @@ vtkSmartPointer<vtkFloatArray> NewFloatArray(const char* name, vtkIdType values)
 
 //------------------------------------------------------------------------------
 vtkVolumetricAmbientOcclusion::vtkVolumetricAmbientOcclusion()
+  : Controller(vtkMultiProcessController::GetGlobalController())
 {
   this->SetInputArrayToProcess(
     0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
@@ -97,6 +112,40 @@ void vtkVolumetricAmbientOcclusion::ComputeVoxelRadius(const double spacing[3], 
 }
 
 //------------------------------------------------------------------------------
+void vtkVolumetricAmbientOcclusion::SetController(vtkMultiProcessController* controller)
+{
+  if (this->Controller != controller)
+  {
+    this->Controller = controller;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+vtkMultiProcessController* vtkVolumetricAmbientOcclusion::GetController() const
+{
+  return this->Controller;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumetricAmbientOcclusion::IsDistributed() const
+{
+  return this->Method == HISTOGRAM_CDF && this->Controller && this->Controller->GetNumberOfProcesses() > 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumetricAmbientOcclusion::ComputeReach(const double spacing[3], int reach[3]) const
+{
+  this->ComputeVoxelRadius(spacing, reach);
+  if (this->QueryMode == SMOOTHED_VALUE)
+  {
+    const int window = vao::querySmoothingHalfWidth(this->QuerySmoothing);
+    for (int a = 0; a < 3; ++a)
+      reach[a] = std::max(reach[a], window);
+  }
+}
+
+//------------------------------------------------------------------------------
 bool vtkVolumetricAmbientOcclusion::CheckParameters()
 {
   // The VTK side: enums, names, the radius before it becomes voxels. The kernel's own
@@ -106,13 +155,17 @@ bool vtkVolumetricAmbientOcclusion::CheckParameters()
                                                        : vao::Status::success();
   if (!std::isfinite(this->Radius) || this->Radius < 0.0)
     why << "Radius must be a finite, non-negative number (got " << this->Radius << ").";
-  else if (this->Method < CDF_RECONSTRUCTION || this->Method > EXACT_SPHERE)
+  else if (this->Method < CDF_RECONSTRUCTION || this->Method > HISTOGRAM_CDF)
     why << "Unknown Method " << this->Method
-        << " (0 CDF Reconstruction, 1 Gaussian CDF, 2 Chebyshev, 3 Exact Box, 4 Exact Sphere).";
+        << " (0 CDF Reconstruction, 1 Gaussian CDF, 2 Chebyshev, 3 Exact Box, 4 Exact Sphere, 5 Histogram CDF).";
+  else if (this->Method == HISTOGRAM_CDF && !vao::checkHistogramBins(this->NumberOfBins).empty())
+    why << vao::checkHistogramBins(this->NumberOfBins) << ".";
   else if (this->RadiusUnits != VOXELS && this->RadiusUnits != WORLD)
     why << "Unknown RadiusUnits " << this->RadiusUnits << " (0 Voxels, 1 World).";
-  else if (this->QueryMode != VOXEL_VALUE && this->QueryMode != ISO_VALUE)
-    why << "Unknown QueryMode " << this->QueryMode << " (0 Voxel Value, 1 Iso Value).";
+  else if (this->QueryMode < VOXEL_VALUE || this->QueryMode > SMOOTHED_VALUE)
+    why << "Unknown QueryMode " << this->QueryMode << " (0 Voxel Value, 1 Iso Value, 2 Smoothed Voxel Value).";
+  else if (this->QueryMode == SMOOTHED_VALUE && !vao::checkQuerySmoothing(this->QuerySmoothing).empty())
+    why << vao::checkQuerySmoothing(this->QuerySmoothing) << ".";
   else if (!iso.ok)
     why << iso.message << ".";
   else if (this->ErfApproximation != ERF_EXACT && this->ErfApproximation != ERF_WINITZKI)
@@ -140,6 +193,7 @@ vao::AmbientOcclusionParameters vtkVolumetricAmbientOcclusion::Parameters(const 
   parameters.queryMode = KernelQueryMode(this->QueryMode);
   parameters.isoValue = this->IsoValue;
   parameters.erfMode = KernelErfMode(this->ErfApproximation);
+  parameters.querySmoothing = this->QuerySmoothing;
   return parameters;
 }
 
@@ -159,6 +213,12 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
 {
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  if (this->Method == HISTOGRAM_CDF && !this->IsDistributed())
+  {
+    // One process: the thresholds need every voxel of the data set.
+    vtkAmbientOcclusionExtents::RequestWholeExtent(inInfo);
+    return 1;
+  }
   int ext[6], whole[6], radius[3];
   outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), ext);
   inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
@@ -167,7 +227,7 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
   {
     inInfo->Get(vtkDataObject::SPACING(), spacing);
   }
-  this->ComputeVoxelRadius(spacing, radius);
+  this->ComputeReach(spacing, radius);
   // Every neighbourhood of the requested extent, clipped to the whole extent, must arrive.
   // An extent request is grown here; a piece request (MPI ranks, streaming by pieces) is
   // turned into an extent by the source's executive, which grows it by the ghost levels:
@@ -244,30 +304,59 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     vtkImageData* output = vtkImageData::GetData(outputVector);
     output->Initialize();
     this->LastBackend.clear();
-    if (!input || !this->CheckParameters())
+    if (!this->CheckParameters()) // the same on every process
     {
       return 1;
     }
     int whole[6], outExt[6], radius[3];
     std::string error;
-    if (!vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, whole, outExt, error))
+    bool ok = input != nullptr;
+    if (ok && !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, whole, outExt, error))
     {
       vtkErrorMacro(<< error);
-      return 1;
+      return 1; // the whole extent is the same on every process
     }
-    if (input->GetNumberOfPoints() == 0)
-    {
-      return 1; // an empty piece of a distributed data set (e.g. MetaImage on rank > 0)
-    }
-    if (!this->CheckInputCovers(input, outExt) || !this->CheckVoxelRadius(input, whole, radius))
-    {
-      return 1;
-    }
+    // An empty piece of a distributed data set (e.g. MetaImage on rank > 0) has nothing
+    // to compute, but still takes part in the thresholds of Histogram CDF.
+    const bool emptyPiece = ok && input->GetNumberOfPoints() == 0;
+    ok = ok && !emptyPiece && this->CheckInputCovers(input, outExt) && this->CheckVoxelRadius(input, whole, radius);
     vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
-    if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
-          this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error))
+    if (ok &&
+      !vtkAmbientOcclusionArrayInput::PrepareScalars(
+        this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error))
     {
       vtkErrorMacro(<< error);
+      ok = false;
+    }
+    if (ok && this->Method == HISTOGRAM_CDF)
+    {
+      // Before the thresholds, which count finite values only: the kernel's own message.
+      const vao::Status finite = vao::checkFiniteValues(scalars.view);
+      if (!finite.ok)
+      {
+        vtkErrorMacro(<< vtkAmbientOcclusionArrayInput::KernelError(finite, scalars, "Ambient occlusion failed"));
+        ok = false;
+      }
+    }
+    std::vector<double> thresholds;
+    const bool distributed = this->IsDistributed();
+    if (this->Method == HISTOGRAM_CDF && (ok || distributed))
+    {
+      // Distributed: each process counts its output piece (together they tile the data
+      // set); one process counts its input, which is the whole extent.
+      error.clear();
+      if (!vtkAmbientOcclusionThresholds::Compute(distributed ? this->Controller.Get() : nullptr,
+            ok ? &scalars.view : nullptr, ok ? input->GetExtent() : outExt,
+            distributed || !ok ? outExt : input->GetExtent(), whole, this->NumberOfBins, !ok && !emptyPiece,
+            thresholds, error))
+      {
+        if (!error.empty())
+          vtkErrorMacro(<< error);
+        return 1;
+      }
+    }
+    if (!ok)
+    {
       return 1;
     }
 
@@ -279,7 +368,9 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     }
     auto openness = NewFloatArray(this->OutputArrayName.c_str(), region.voxelCount());
     auto variance = this->ComputeVariance ? NewFloatArray("Variance", region.voxelCount()) : nullptr;
-    const vao::Status status = this->Compute(scalars.view, region, this->Parameters(radius),
+    vao::AmbientOcclusionParameters parameters = this->Parameters(radius);
+    parameters.thresholds = std::move(thresholds);
+    const vao::Status status = this->Compute(scalars.view, region, parameters,
       { openness->GetPointer(0), variance ? variance->GetPointer(0) : nullptr });
     if (!status.ok)
     {
@@ -312,7 +403,9 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
 {
   const vao::Execution execution = vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads);
   vao::Status status;
-  bool onDevice = this->ChooseCuda(vao::isSeparableMethod(parameters.method), region.voxelCount());
+  bool onDevice = this->ChooseCuda(
+    vao::isSeparableMethod(parameters.method) && parameters.queryMode != vao::QueryMode::SmoothedValue,
+    region.voxelCount());
   if (onDevice)
   {
     status = vao::cuda::computeAmbientOcclusion(volume, region, parameters, arrays, execution);
@@ -347,7 +440,8 @@ bool vtkVolumetricAmbientOcclusion::ChooseCuda(bool separableMethod, long long v
   }
   if (!separableMethod)
   {
-    vtkWarningMacro(<< "Exact Box and Exact Sphere run on the CPU only; computing on the CPU.");
+    vtkWarningMacro(<< "Exact Box, Exact Sphere, Histogram CDF and the smoothed query run on the CPU only; "
+                       "computing on the CPU.");
     return false;
   }
   if (!device.available)
@@ -362,11 +456,15 @@ bool vtkVolumetricAmbientOcclusion::ChooseCuda(bool separableMethod, long long v
 void vtkVolumetricAmbientOcclusion::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  const bool knownMethod = this->Method >= CDF_RECONSTRUCTION && this->Method <= EXACT_SPHERE;
+  const bool knownMethod = this->Method >= CDF_RECONSTRUCTION && this->Method <= HISTOGRAM_CDF;
+  const bool knownQuery = this->QueryMode >= VOXEL_VALUE && this->QueryMode <= SMOOTHED_VALUE;
   os << indent << "Method: " << (knownMethod ? MethodNames[this->Method] : "(invalid)") << "\n";
+  os << indent << "NumberOfBins: " << this->NumberOfBins << "\n";
   os << indent << "Radius: " << this->Radius << (this->RadiusUnits == WORLD ? " world" : " voxels") << "\n";
-  os << indent << "QueryMode: " << (this->QueryMode == ISO_VALUE ? "Iso Value" : "Voxel Value") << "\n";
+  os << indent << "QueryMode: " << (knownQuery ? QueryModeNames[this->QueryMode] : "(invalid)") << "\n";
   os << indent << "IsoValue: " << this->IsoValue << "\n";
+  os << indent << "QuerySmoothing: " << this->QuerySmoothing << "\n";
+  os << indent << "Controller: " << this->Controller.Get() << "\n";
   os << indent << "ErfApproximation: " << (this->ErfApproximation == ERF_WINITZKI ? "Winitzki" : "Exact") << "\n";
   os << indent << "ComputeVariance: " << this->ComputeVariance << "\n";
   os << indent << "Component: " << this->Component << "\n";

@@ -5,9 +5,15 @@
  * For every voxel x the filter estimates the openness O(x) = P(v <= q) over the box
  * neighbourhood of half-width Radius centred on x, clipped to the whole extent of the
  * data set: 1 = open, 0 = occluded (denser values occlude). q is the voxel's own value
- * (QueryMode = VoxelValue) or IsoValue. The estimators:
- *  - CDF Reconstruction, Gaussian CDF, Chebyshev: from separable box statistics (mean,
- *    variance, minimum, maximum), O(1) per voxel whatever the radius;
+ * (QueryMode = VoxelValue), IsoValue, or the voxel's value smoothed by a small Gaussian
+ * (QueryMode = SmoothedValue, sigma QuerySmoothing voxels), which keeps CT noise from
+ * turning even the exact AO into salt and pepper. The estimators:
+ *  - Histogram CDF (default): the box's cumulative distribution at NumberOfBins thresholds
+ *    taken from the whole data set's values, interpolated at q; O(1) per voxel and bin
+ *    whatever the radius, within 0.015-0.025 RMS of Exact Box on the CT scans at 64 bins,
+ *    and exact for data with at most NumberOfBins distinct values (uint8 with 256);
+ *  - CDF Reconstruction, Gaussian CDF, Chebyshev: the papers' estimators from separable
+ *    box statistics (mean, variance, minimum, maximum), O(1) per voxel;
  *  - Exact Box, Exact Sphere: brute-force counts, O(R^3) per voxel (references).
  *
  * Output: the input image with a float32 array OutputArrayName (default
@@ -15,8 +21,12 @@
  * intensity variance of the box, for opacity modulation).
  *
  * Streaming and MPI: the filter asks its input for the requested extent grown by the
- * radius (clipped to the whole extent) and produces exactly the requested extent, so any
- * decomposition gives the serial numbers.
+ * radius (and by the smoothed query's window, 3 QuerySmoothing voxels), clipped to the
+ * whole extent, and produces exactly the requested extent, so any decomposition gives
+ * the serial numbers. Histogram CDF's thresholds come from every voxel of the data set:
+ * under MPI (Controller with several processes) each process summarises the voxels of
+ * its piece and the summaries are reduced; in one process the filter reads the whole
+ * extent (and still produces only the requested one).
  *
  * Errors (vtkErrorMacro, empty output): missing or non-numeric array, multi-component
  * array without a chosen Component, NaN or infinite voxels (they have no rank in a
@@ -30,9 +40,13 @@
 #include "VolumetricAOFiltersModule.h" // for export macro
 #include "vtkImageAlgorithm.h"
 
+#include "vtkSmartPointer.h" // for the controller
+
 #include <string>
+#include <vector>
 
 class vtkImageData;
+class vtkMultiProcessController;
 namespace vao
 {
 struct AmbientOcclusionOutput;
@@ -55,7 +69,8 @@ public:
     GAUSSIAN_CDF = 1,
     CHEBYSHEV = 2,
     EXACT_BOX = 3,
-    EXACT_SPHERE = 4
+    EXACT_SPHERE = 4,
+    HISTOGRAM_CDF = 5
   };
   enum RadiusUnitsType
   {
@@ -65,7 +80,8 @@ public:
   enum QueryModeType
   {
     VOXEL_VALUE = 0,
-    ISO_VALUE = 1
+    ISO_VALUE = 1,
+    SMOOTHED_VALUE = 2
   };
   enum ErfApproximationType
   {
@@ -80,7 +96,7 @@ public:
   };
 
   ///@{
-  /// Estimator (default GAUSSIAN_CDF).
+  /// Estimator (default HISTOGRAM_CDF; before version 0.2 the default was GAUSSIAN_CDF).
   vtkSetMacro(Method, int);
   vtkGetMacro(Method, int);
   ///@}
@@ -94,11 +110,32 @@ public:
   ///@}
 
   ///@{
-  /// Query value: the voxel's own value (default) or IsoValue.
+  /// Query value: the voxel's own value (default), IsoValue, or the smoothed value.
   vtkSetMacro(QueryMode, int);
   vtkGetMacro(QueryMode, int);
   vtkSetMacro(IsoValue, double);
   vtkGetMacro(IsoValue, double);
+  ///@}
+
+  ///@{
+  /// Sigma of the smoothed query's Gaussian, in voxels on every axis (default 1; the
+  /// window reaches ceil(3 sigma) voxels each side). In (0, 100].
+  vtkSetMacro(QuerySmoothing, double);
+  vtkGetMacro(QuerySmoothing, double);
+  ///@}
+
+  ///@{
+  /// Histogram CDF: the number of thresholds, in [2, 1024] (default 64). More bins follow
+  /// the exact result more closely and cost time in proportion.
+  vtkSetMacro(NumberOfBins, int);
+  vtkGetMacro(NumberOfBins, int);
+  ///@}
+
+  ///@{
+  /// The processes that share the data set, for Histogram CDF's thresholds (default: the
+  /// global controller).
+  void SetController(vtkMultiProcessController* controller);
+  vtkMultiProcessController* GetController() const;
   ///@}
 
   ///@{
@@ -158,11 +195,14 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  int Method = GAUSSIAN_CDF;
+  int Method = HISTOGRAM_CDF;
   double Radius = 10.0;
   int RadiusUnits = VOXELS;
   int QueryMode = VOXEL_VALUE;
   double IsoValue = 0.0;
+  double QuerySmoothing = 1.0;
+  int NumberOfBins = 64;
+  vtkSmartPointer<vtkMultiProcessController> Controller;
   int ErfApproximation = ERF_EXACT;
   vtkTypeBool ComputeVariance = false;
   int Component = -1;
@@ -178,6 +218,11 @@ private:
   bool CheckParameters();
   /// The kernel's parameters for a radius in voxels (CheckParameters passed).
   vao::AmbientOcclusionParameters Parameters(const int radius[3]) const;
+  /// Half-widths in voxels of what a voxel's result reads: the radius, and the smoothed
+  /// query's window when it is used.
+  void ComputeReach(const double spacing[3], int reach[3]) const;
+  /// Histogram CDF in a distributed run: the thresholds come from every process's piece.
+  bool IsDistributed() const;
   /// The input covers the requested extent `outExt`.
   bool CheckInputCovers(vtkImageData* input, const int outExt[6]);
   /// The radius in voxels for the input's spacing; false when it is 0 on every axis or

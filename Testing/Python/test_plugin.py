@@ -23,17 +23,19 @@ ao = VolumetricAmbientOcclusion(Input=wavelet)
 expected_enums = {
     "Method": METHODS,
     "RadiusUnits": ["Voxels", "World"],
-    "QueryMode": ["Voxel Value", "Iso Value"],
+    "QueryMode": ["Voxel Value", "Iso Value", "Smoothed Voxel Value"],
     "ErfApproximation": ["Exact", "Winitzki"],
     "Backend": ["Auto", "CPU", "CUDA"],
 }
 for name, texts in expected_enums.items():
     check(list(ao.GetProperty(name).Available) == texts, "%s offers %s" % (name, texts))
-check(ao.Method == "Gaussian CDF", "Method defaults to Gaussian CDF")
+check(ao.Method == "Histogram CDF", "Method defaults to Histogram CDF")
+check(ao.NumberOfBins == 64 and ao.QuerySmoothing == 1.0, "NumberOfBins defaults to 64, QuerySmoothing to 1")
 check(ao.Radius == 10, "Radius defaults to 10")
 check(ao.OutputArrayName == "AmbientOcclusion", "OutputArrayName defaults to AmbientOcclusion")
-for name in ["Scalars", "Method", "Radius", "RadiusUnits", "QueryMode", "IsoValue", "ErfApproximation",
-             "ComputeVariance", "Backend", "OutputArrayName", "Component", "NumberOfThreads"]:
+for name in ["Scalars", "Method", "NumberOfBins", "Radius", "RadiusUnits", "QueryMode", "IsoValue",
+             "QuerySmoothing", "ErfApproximation", "ComputeVariance", "Backend", "OutputArrayName", "Component",
+             "NumberOfThreads"]:
     prop = ao.GetProperty(name)
     check(prop is not None, "property %s exists" % name)
     doc = prop.SMProperty.GetDocumentation()
@@ -76,12 +78,27 @@ for method in METHODS:
 # Iso value query and world units.
 iso = run(ct, "MetaImage", "Gaussian CDF", 10.0, RadiusUnits="World", QueryMode="Iso Value", IsoValue=400.0)
 check_result(iso, "CT head/iso 400 world 10 mm", ct_points)
+# The smoothed query with the exact count and with the default method.
+for method in ("Exact Box", "Histogram CDF"):
+    smoothed = run(ct, "MetaImage", method, 3, QueryMode="Smoothed Voxel Value", QuerySmoothing=1.5)
+    check_result(smoothed, "CT head/%s smoothed query" % method, ct_points)
+# Histogram CDF with as many bins as the data has values is Exact Box (the Wavelet's
+# RTData, rounded to 200 values by the Calculator).
+steps = Calculator(Input=wavelet, ResultArrayName="Steps", Function="floor(RTData / 2)")
+exact_steps = array_of(run(steps, "Steps", "Exact Box", 3), "AmbientOcclusion")
+binned_steps = array_of(run(steps, "Steps", "Histogram CDF", 3, NumberOfBins=1024), "AmbientOcclusion")
+check(np.abs(exact_steps - binned_steps).max() <= 1e-6,
+      "Wavelet steps: Histogram CDF with a bin per value equals Exact Box (max diff %.2g)"
+      % np.abs(exact_steps - binned_steps).max())
+Delete(steps)
 
 # Bad input: an error and an empty output, not a crash.
-bad = VolumetricAmbientOcclusion(Input=ct, Radius=0)
-bad.UpdatePipeline()
-check(servermanager.Fetch(bad).GetNumberOfPoints() == 0, "Radius 0 gives an empty output")
-Delete(bad)
+for what, settings in [("Radius 0", dict(Radius=0)), ("NumberOfBins 1", dict(NumberOfBins=1)),
+                       ("QuerySmoothing 0", dict(QueryMode="Smoothed Voxel Value", QuerySmoothing=0.0))]:
+    bad = VolumetricAmbientOcclusion(Input=ct, **settings)
+    bad.UpdatePipeline()
+    check(servermanager.Fetch(bad).GetNumberOfPoints() == 0, "%s gives an empty output" % what)
+    Delete(bad)
 
 # The project's own phantom source, straight into the filter with default settings
 # (Scalars left to the active point scalars).

@@ -2,7 +2,8 @@
 import os
 import sys
 
-METHODS = ["CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box", "Exact Sphere"]
+# In the order the Method menu lists them (the default first).
+METHODS = ["Histogram CDF", "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box", "Exact Sphere"]
 
 
 def fail(message):

@@ -1,0 +1,181 @@
+#include "vtkAmbientOcclusionThresholds.h"
+
+#include "vtkAmbientOcclusionCollectives.h"
+#include "vtkAmbientOcclusionExtents.h"
+
+#include "vao/HistogramCdf.h"
+#include "vao/Validation.h"
+
+#include "vtkCommunicator.h"
+#include "vtkMultiProcessController.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace vtkAmbientOcclusionThresholds
+{
+namespace
+{
+
+/// Sums the counts and combines the extrema of every process's summary.
+void Reduce(vtkMultiProcessController* controller, vao::ValueHistogram& histogram)
+{
+  const vtkIdType cells = static_cast<vtkIdType>(histogram.counts.size());
+  std::vector<long long> local(histogram.counts.begin(), histogram.counts.end()), total(local.size());
+  controller->AllReduce(local.data(), total.data(), cells, vtkCommunicator::SUM_OP);
+  std::copy(total.begin(), total.end(), histogram.counts.begin());
+  std::vector<double> reduced(histogram.minimum.size());
+  controller->AllReduce(histogram.minimum.data(), reduced.data(), cells, vtkCommunicator::MIN_OP);
+  histogram.minimum = reduced;
+  controller->AllReduce(histogram.maximum.data(), reduced.data(), cells, vtkCommunicator::MAX_OP);
+  histogram.maximum = reduced;
+}
+
+} // namespace
+
+std::vector<std::vector<int>> SubtractExtents(const int ext[6], const std::vector<const int*>& others)
+{
+  std::vector<std::vector<int>> boxes;
+  if (!vtkAmbientOcclusionExtents::EmptyExtent(ext))
+  {
+    boxes.emplace_back(ext, ext + 6);
+  }
+  for (const int* other : others)
+  {
+    std::vector<std::vector<int>> next;
+    for (std::vector<int> box : boxes)
+    {
+      int common[6];
+      if (!vtkAmbientOcclusionExtents::IntersectExtents(box.data(), other, common))
+      {
+        next.push_back(box);
+        continue;
+      }
+      // Peel the parts of the box outside `common`, one axis at a time.
+      for (int a = 0; a < 3; ++a)
+      {
+        if (box[2 * a] < common[2 * a])
+        {
+          std::vector<int> below = box;
+          below[2 * a + 1] = common[2 * a] - 1;
+          next.push_back(below);
+          box[2 * a] = common[2 * a];
+        }
+        if (box[2 * a + 1] > common[2 * a + 1])
+        {
+          std::vector<int> above = box;
+          above[2 * a] = common[2 * a + 1] + 1;
+          next.push_back(above);
+          box[2 * a + 1] = common[2 * a + 1];
+        }
+      }
+    }
+    boxes.swap(next);
+  }
+  return boxes;
+}
+
+bool Compute(vtkMultiProcessController* controller, const vao::VolumeView* volume, const int inExt[6],
+  const int outExt[6], const int whole[6], int bins, bool failed, std::vector<double>& thresholds,
+  std::string& error)
+{
+  const int ranks = controller ? controller->GetNumberOfProcesses() : 1;
+  const bool distributed = ranks > 1;
+  const bool holds = volume && !failed;
+  int mine[6] = { 0, -1, 0, -1, 0, -1 };
+  if (holds)
+  {
+    std::copy(outExt, outExt + 6, mine);
+  }
+  std::vector<int> all(mine, mine + 6);
+  if (distributed)
+  {
+    all.resize(6 * static_cast<size_t>(ranks));
+    controller->AllGather(mine, all.data(), 6);
+    if (vtkAmbientOcclusionCollectives::GlobalMax(controller, failed ? 1.0 : 0.0) > 0.0)
+    {
+      if (!failed)
+        error = "Histogram CDF: another process failed, so the thresholds of the whole data set are unknown.";
+      return false;
+    }
+  }
+  if (failed)
+  {
+    return false;
+  }
+  // Each voxel is counted by the lowest process whose output extent holds it.
+  std::vector<const int*> lower;
+  const int rank = distributed ? controller->GetLocalProcessId() : 0;
+  for (int r = 0; r < rank; ++r)
+  {
+    lower.push_back(&all[6 * static_cast<size_t>(r)]);
+  }
+  const auto owned = SubtractExtents(mine, lower);
+
+  double range[2] = { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() };
+  if (holds && !owned.empty())
+  {
+    const vao::ValueScan scan = vao::scanValues(*volume);
+    range[0] = scan.minimum;
+    range[1] = scan.maximum;
+  }
+  // The cells depend on the type (integers get one cell per value): take it from a
+  // process that has data, the same array everywhere.
+  double type = holds ? static_cast<double>(volume->type) : -1.0;
+  if (distributed)
+  {
+    vtkAmbientOcclusionCollectives::GlobalRange(controller, range);
+    type = vtkAmbientOcclusionCollectives::GlobalMax(controller, type);
+  }
+  if (!(range[0] <= range[1]) || type < 0.0)
+  {
+    error = "Histogram CDF: no process holds any voxel of the data set.";
+    return false;
+  }
+  vao::ValueHistogram histogram =
+    vao::ValueHistogram::forRange(static_cast<vao::ScalarType>(static_cast<int>(type)), range[0], range[1]);
+  for (const auto& box : owned)
+  {
+    vao::Region region;
+    for (int a = 0; a < 3; ++a)
+    {
+      region.begin[a] = box[2 * a] - inExt[2 * a];
+      region.size[a] = box[2 * a + 1] - box[2 * a] + 1;
+    }
+    const vao::Status status = vao::addToValueHistogram(*volume, region, histogram);
+    if (!status.ok)
+    {
+      if (!status.aborted)
+        error = "Histogram CDF's value histogram failed: " + status.message + ".";
+      failed = true;
+      break;
+    }
+  }
+  if (distributed)
+  {
+    if (vtkAmbientOcclusionCollectives::GlobalMax(controller, failed ? 1.0 : 0.0) > 0.0)
+    {
+      if (error.empty())
+        error = "Histogram CDF: another process failed, so the thresholds of the whole data set are unknown.";
+      return false;
+    }
+    Reduce(controller, histogram);
+  }
+  else if (failed)
+  {
+    return false;
+  }
+  const long long counted = histogram.totalCount();
+  const long long expected = vtkAmbientOcclusionExtents::ExtentPoints(whole);
+  if (counted != expected)
+  {
+    error = "Histogram CDF takes its thresholds from every voxel of the data set, but the processes' pieces hold " +
+      std::to_string(counted) + " of its " + std::to_string(expected) +
+      " voxels: request the whole extent, or pieces that cover it.";
+    return false;
+  }
+  thresholds = vao::histogramThresholds(histogram, bins);
+  return true;
+}
+
+} // namespace vtkAmbientOcclusionThresholds
