@@ -7,7 +7,7 @@
 // scipy.ndimage.distance_transform_edt in the same run.
 //
 // Usage: vao_benchmark [--shared DIR] [--scipy PATH/TO/scipy_peer.py] [--repeat N]
-//                      [--exact] [--threads N] [--sweeping | --penner (one table only)]
+//                      [--exact] [--threads N] [--volumetric | --sweeping | --penner (one table only)]
 // Last, the variance occlusion maps: pyramid builds and the surface query rate.
 // Exact Box and Exact Sphere are O(R^3) references: by default they are timed on a
 // 32-slice slab and the whole-volume time is extrapolated (marked "~"); --exact times
@@ -60,6 +60,7 @@ struct Options
   std::string scipyEdt = VAO_DEFAULT_SCIPY_EDT_PEER;
   bool sweepingOnly = false;
   bool pennerOnly = false;
+  bool volumetricOnly = false;
   int repeat = 3;
   bool exact = false;
   int threads = 0;
@@ -143,13 +144,20 @@ void Benchmark(const std::string& label, vtkImageData* image, const std::string&
   std::printf("\n%s: %d x %d x %d int16 (%.1f M voxels), %d threads\n", label.c_str(), d[0], d[1],
     d[2], voxels / 1e6, ResolvedThreads(options.threads));
   std::printf("  %-20s %12s %12s\n", "method", "R = 5 [ms]", "R = 10 [ms]");
-  const char* names[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box", "Exact Sphere" };
-  for (int method = 0; method < 5; ++method)
+  // Histogram CDF (the default) first; the peers it is measured against follow.
+  const int methods[] = { vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF, vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION,
+    vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, vtkVolumetricAmbientOcclusion::CHEBYSHEV,
+    vtkVolumetricAmbientOcclusion::EXACT_BOX, vtkVolumetricAmbientOcclusion::EXACT_SPHERE };
+  const char* names[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box", "Exact Sphere",
+    "Histogram CDF (64)" };
+  std::map<int, std::map<int, double>> seconds; // method -> radius -> time
+  for (const int method : methods)
   {
     std::printf("  %-20s", names[method]);
     for (int radius : { 5, 10 })
     {
-      const bool reference = method >= vtkVolumetricAmbientOcclusion::EXACT_BOX;
+      const bool reference = method == vtkVolumetricAmbientOcclusion::EXACT_BOX ||
+        method == vtkVolumetricAmbientOcclusion::EXACT_SPHERE;
       if (reference && !options.exact)
       {
         // A 32-slice slab, extrapolated by voxel count (the cost is uniform per voxel).
@@ -159,16 +167,25 @@ void Benchmark(const std::string& label, vtkImageData* image, const std::string&
         slab->SetVOI(e[0], e[1], e[2], e[3], e[4], e[4] + 31);
         slab->Update();
         const double t = TimeFilter(slab->GetOutput(), method, radius, 1, options.threads);
-        std::printf(" %11.0f~", 1e3 * t * voxels / slab->GetOutput()->GetNumberOfPoints());
+        seconds[method][radius] = t * voxels / slab->GetOutput()->GetNumberOfPoints();
+        std::printf(" %11.0f~", 1e3 * seconds[method][radius]);
       }
       else
       {
-        std::printf(" %12.1f", 1e3 * TimeFilter(image, method, radius, options.repeat, options.threads));
+        seconds[method][radius] = TimeFilter(image, method, radius, options.repeat, options.threads);
+        std::printf(" %12.1f", 1e3 * seconds[method][radius]);
       }
       std::fflush(stdout);
     }
     std::printf("\n");
   }
+  const auto& histogram = seconds[vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF];
+  const auto& gaussian = seconds[vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF];
+  const auto& exactBox = seconds[vtkVolumetricAmbientOcclusion::EXACT_BOX];
+  std::printf("  %-20s %11.2fx %11.2fx   (bar: at most 4x)\n", "Histogram / Gaussian", histogram.at(5) / gaussian.at(5),
+    histogram.at(10) / gaussian.at(10));
+  std::printf("  %-20s %11.0fx %11.0fx   (bar: at least 20x at R = 5)\n", "Exact Box / Histogram",
+    exactBox.at(5) / histogram.at(5), exactBox.at(10) / histogram.at(10));
   const double stats5 = TimeStatistics(image, 5, options.repeat, options.threads);
   const double stats10 = TimeStatistics(image, 10, options.repeat, options.threads);
   std::printf("  %-20s %12.1f %12.1f\n", "statistics (ours)", 1e3 * stats5, 1e3 * stats10);
@@ -386,9 +403,11 @@ int main(int argc, char* argv[])
       options.sweepingOnly = true;
     else if (arg == "--penner")
       options.pennerOnly = true;
+    else if (arg == "--volumetric")
+      options.volumetricOnly = true;
     else
     {
-      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--sweeping | --penner]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--volumetric | --sweeping | --penner]\n", argv[0]);
       return 2;
     }
   }
@@ -410,6 +429,10 @@ int main(int argc, char* argv[])
 
     const std::string ct = options.shared + "/ct_head_phantom/ct_head_phantom_512x512x209_int16.mha";
     Benchmark("ct_head_phantom_512x512x209_int16.mha", ReadScanOrExit(ct), ct, options);
+  }
+  if (options.volumetricOnly)
+  {
+    return 0;
   }
   const auto head = ReadScanOrExit(options.shared + "/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha");
   if (!options.pennerOnly)

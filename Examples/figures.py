@@ -5,13 +5,16 @@ Usage (rendering needs a display: run it under Xvfb):
     xvfb-run -a pvpython --force-offscreen-rendering Examples/figures.py PLUGIN OUTDIR [CT.mha] [--quick]
 
 For the generated head phantom (128^3; 64^3 with --quick) and, when CT.mha is given, for
-that CT head (int16 Hounsfield units), it writes four PNGs per data set, each a row of
+that CT head (int16 Hounsfield units), it writes five PNGs per data set, each a row of
 panels seen from the front (the face looks towards -y, LPS; view up +z):
 
     ruiz_ambient_lighting_<data>.png    volume rendering: no AO, Chebyshev, CDF Reconstruction,
                                         Gaussian CDF (R = 10) as ambient light (Ruiz et al. Eq. 5)
     ruiz_opacity_modulation_<data>.png  Gaussian CDF ambient light without and with opacity
                                         modulation by the intensity variance (Ruiz et al. 4.2)
+    accuracy_exact_gaussian_histogram_<data>.png
+                                        the same light from Exact Box, Gaussian CDF and
+                                        Histogram CDF (R = 10): the paper's estimator against ours
     singh_sweeping_<data>.png           the skin coloured by occlusion sweeping: skylight, the
                                         upper four octants (overcast), one octant (a shadow)
     penner_bone_<data>.png              the bone: diffuse light only, isosurface AO, AO x shadow
@@ -153,25 +156,46 @@ def grey_lut(name):
 
 # --------------------------------------------------------------------------------------
 # Figures
+SHADING_ARGS = dict(ColorPreset="Bone", ScalarRange=[-600.0, 1500.0], OpacityRamp=[-300.0, 1500.0])
+
+
+def render_rgba(shaded, text, path, bounds, spacing):
+    """A volume rendering of Ambient Occlusion Shading's RGBA, seen from the front."""
+    hide_all()
+    display = Show(shaded, view)
+    display.SetRepresentationType("Volume")
+    ColorBy(display, ("POINTS", "ShadedRGBA"))
+    display.MapScalars = 0
+    # Dependent components: colour = RGB, opacity = the opacity function of A (0..255).
+    pwf = GetOpacityTransferFunction("ShadedRGBA")
+    GetColorTransferFunction("ShadedRGBA").AutomaticRescaleRangeMode = "Never"
+    pwf.Points = [0.0, 0.0, 0.5, 0.0, 60.0, 0.03, 0.5, 0.0, 255.0, 1.0, 0.5, 0.0]
+    display.ScalarOpacityUnitDistance = spacing
+    label(text)
+    front_camera(bounds)
+    return grab(path)
+
+
+def accuracy(source, array, tag, spacing):
+    """The same ambient lighting from Exact Box, the paper's Gaussian CDF and Histogram CDF."""
+    bounds = bounds_of(source)
+    panels = []
+    for i, method in enumerate(["Exact Box", "Gaussian CDF", "Histogram CDF"]):
+        t0 = time.time()
+        ao = VolumetricAmbientOcclusion(Input=source, Method=method, Radius=10)
+        ao.Scalars = ["POINTS", array]
+        shaded = AmbientOcclusionShading(Input=ao, **SHADING_ARGS)
+        shaded.Scalars = array
+        panels.append(render_rgba(shaded, method + ", R = 10", os.path.join(out_dir, "_panel%d.png" % i),
+                                  bounds, spacing))
+        print("  accuracy %-20s %.1f s" % (method, time.time() - t0))
+    combine(panels, os.path.join(out_dir, "accuracy_exact_gaussian_histogram_%s.png" % tag))
+
+
 def ruiz(source, array, tag, spacing):
     """Volume rendering lit by AO alone (Ruiz et al. Eq. 5): RGBA from Ambient Occlusion Shading."""
     bounds = bounds_of(source)
-    shading_args = dict(ColorPreset="Bone", ScalarRange=[-600.0, 1500.0], OpacityRamp=[-300.0, 1500.0])
-
-    def render_rgba(shaded, text, path):
-        hide_all()
-        display = Show(shaded, view)
-        display.SetRepresentationType("Volume")
-        ColorBy(display, ("POINTS", "ShadedRGBA"))
-        display.MapScalars = 0
-        # Dependent components: colour = RGB, opacity = the opacity function of A (0..255).
-        pwf = GetOpacityTransferFunction("ShadedRGBA")
-        GetColorTransferFunction("ShadedRGBA").AutomaticRescaleRangeMode = "Never"
-        pwf.Points = [0.0, 0.0, 0.5, 0.0, 60.0, 0.03, 0.5, 0.0, 255.0, 1.0, 0.5, 0.0]
-        display.ScalarOpacityUnitDistance = spacing
-        label(text)
-        front_camera(bounds)
-        return grab(path)
+    shading_args = SHADING_ARGS
 
     methods = [("no AO", None), ("Chebyshev", "Chebyshev"), ("CDF Reconstruction", "CDF Reconstruction"),
                ("Gaussian CDF", "Gaussian CDF")]
@@ -191,7 +215,7 @@ def ruiz(source, array, tag, spacing):
                 gaussian = ao
         shaded.Scalars = array
         panels.append(render_rgba(shaded, text if method is None else text + ", R = 10",
-                                  os.path.join(out_dir, "_panel%d.png" % i)))
+                                  os.path.join(out_dir, "_panel%d.png" % i), bounds, spacing))
         print("  ruiz %-20s %.1f s" % (text, time.time() - t0))
     combine(panels, os.path.join(out_dir, "ruiz_ambient_lighting_%s.png" % tag))
 
@@ -205,7 +229,7 @@ def ruiz(source, array, tag, spacing):
                                          **dict(shading_args, OpacityRamp=[-600.0, 1500.0]))
         shaded.Scalars = array
         panels.append(render_rgba(shaded, "Gaussian CDF, opacity %s" % ("x variance" if modulate else "as is"),
-                                  os.path.join(out_dir, "_panel%d.png" % i)))
+                                  os.path.join(out_dir, "_panel%d.png" % i), bounds, spacing))
     combine(panels, os.path.join(out_dir, "ruiz_opacity_modulation_%s.png" % tag))
 
 
@@ -294,6 +318,7 @@ def figures(source, array, tag):
     print("%s: %d x %d x %d voxels, spacing %.2f mm" % (tag, extent[1] - extent[0] + 1, extent[3] - extent[2] + 1,
                                                         extent[5] - extent[4] + 1, spacing))
     ruiz(source, array, tag, spacing)
+    accuracy(source, array, tag, spacing)
     singh(source, array, tag, spacing)
     penner(source, array, tag)
     print("%s: %.1f s" % (tag, time.time() - t0))

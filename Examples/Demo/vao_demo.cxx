@@ -73,30 +73,40 @@ struct DemoError
 }
 
 //------------------------------------------------------------------------------
-// The methods, in the row order of the figure (Fig. 6 of Ruiz et al. first, then the two
-// exact references).
+// The methods, in the row order of the figure (Fig. 6 of Ruiz et al. first, then this
+// project's Histogram CDF, the two exact references, and the smoothed query's rows).
 struct MethodInfo
 {
   int id;            // vtkVolumetricAmbientOcclusion::MethodType
   const char* label; // for people: table rows and figure labels
   const char* key;   // for arrays: "<key>_R<radius>"
+  int query = vtkVolumetricAmbientOcclusion::VOXEL_VALUE;
 };
 
-const std::array<MethodInfo, 5> Methods = { {
+constexpr int Smoothed = vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE;
+const std::array<MethodInfo, 8> Methods = { {
   { vtkVolumetricAmbientOcclusion::CHEBYSHEV, "Chebyshev (Penner)", "Chebyshev" },
   { vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION, "CDF Reconstruction", "CDFReconstruction" },
   { vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, "Gaussian CDF", "GaussianCDF" },
+  { vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF, "Histogram CDF", "HistogramCDF" },
   { vtkVolumetricAmbientOcclusion::EXACT_BOX, "Exact Box", "ExactBox" },
   { vtkVolumetricAmbientOcclusion::EXACT_SPHERE, "Exact Sphere", "ExactSphere" },
+  { vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF, "Histogram CDF, smooth q", "HistogramCDFSmoothed", Smoothed },
+  { vtkVolumetricAmbientOcclusion::EXACT_BOX, "Exact Box, smooth q", "ExactBoxSmoothed", Smoothed },
 } };
 
-const MethodInfo& MethodWithId(int id)
+/// The row of method `id` with query mode `query`.
+const MethodInfo& MethodWithId(int id, int query = vtkVolumetricAmbientOcclusion::VOXEL_VALUE)
 {
-  return *std::find_if(Methods.begin(), Methods.end(), [id](const MethodInfo& m) { return m.id == id; });
+  return *std::find_if(
+    Methods.begin(), Methods.end(), [id, query](const MethodInfo& m) { return m.id == id && m.query == query; });
 }
 
-/// The oracle every estimator is compared with (METHODS.md).
-const MethodInfo& ReferenceMethod = MethodWithId(vtkVolumetricAmbientOcclusion::EXACT_BOX);
+/// The oracle a row is compared with (METHODS.md): Exact Box with the same query.
+const MethodInfo& ReferenceOf(const MethodInfo& method)
+{
+  return MethodWithId(vtkVolumetricAmbientOcclusion::EXACT_BOX, method.query);
+}
 
 std::string ArrayName(const char* key, int radius)
 {
@@ -400,6 +410,7 @@ Computation RunFilter(vtkImageData* image, const std::string& scalars, const Met
   filter->SetInputData(image);
   filter->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, scalars.c_str());
   filter->SetMethod(method.id);
+  filter->SetQueryMode(method.query);
   filter->SetRadius(radius);
   filter->SetOutputArrayName(ArrayName(method.key, radius).c_str());
   filter->SetComputeVariance(variance);
@@ -426,7 +437,7 @@ std::vector<Computation> ComputeAll(vtkImageData* image, const std::string& scal
   std::vector<Computation> results;
   const std::size_t total = radii.size() * Methods.size() + 1;
   auto report = [&](const Computation& c, const char* label) {
-    std::printf("[%2zu/%zu] %-20s R = %-3d %8.3f s\n", results.size(), total, label, c.radius, c.seconds);
+    std::printf("[%2zu/%zu] %-24s R = %-3d %8.3f s\n", results.size(), total, label, c.radius, c.seconds);
     std::fflush(stdout);
   };
   for (int radius : radii)
@@ -490,24 +501,25 @@ const Computation& Find(const std::vector<Computation>& results, const MethodInf
 
 void PrintTable(const std::vector<Computation>& results)
 {
-  std::printf("\n%-20s %6s %9s %9s %20s %8s\n", "method", "radius", "seconds", "AO mean", "RMSE vs Exact Box",
+  std::printf("\n%-24s %6s %9s %9s %20s %8s\n", "method", "radius", "seconds", "AO mean", "RMSE vs Exact Box",
     "bias");
   for (const Computation& c : results)
   {
     if (!c.method)
     {
-      std::printf("%-20s %6d %9.3f %9s %20s %8s   (mean variance %.4g)\n", "Variance", c.radius, c.seconds, "-",
+      std::printf("%-24s %6d %9.3f %9s %20s %8s   (mean variance %.4g)\n", "Variance", c.radius, c.seconds, "-",
         "-", "-", Mean(c.values));
       continue;
     }
     std::string rmse = "(reference)", bias;
-    if (c.method != &ReferenceMethod)
+    const MethodInfo& reference = ReferenceOf(*c.method);
+    if (c.method != &reference)
     {
-      const Deviation d = Compare(c.values, Find(results, &ReferenceMethod, c.radius).values);
+      const Deviation d = Compare(c.values, Find(results, &reference, c.radius).values);
       rmse = Format("%.3f", d.rmse);
       bias = Format("%+.3f", d.bias);
     }
-    std::printf("%-20s %6d %9.3f %9.3f %20s %8s\n", c.method->label, c.radius, c.seconds, Mean(c.values),
+    std::printf("%-24s %6d %9.3f %9.3f %20s %8s\n", c.method->label, c.radius, c.seconds, Mean(c.values),
       rmse.c_str(), bias.c_str());
   }
   std::printf("\n");

@@ -44,3 +44,15 @@ direct = VolumetricAmbientOcclusion(Input=extent_logger(reader, target + ".piece
                                     OutputArrayName="Direct")
 direct.Scalars = ["POINTS", "MetaImage"]
 SaveData(target[:-len(".pvti")] + "_direct.pvti", proxy=direct, DataMode="Binary")
+
+# Histogram CDF takes its thresholds from the whole data set: the ranks reduce the value
+# histograms of their pieces, so each still needs only its piece grown by the radii
+# (5 + the smoothed query's window of 6 = 11 voxels).
+histogram = VolumetricAmbientOcclusion(Input=extent_logger(reader, target + ".histogram"), Method="Histogram CDF",
+                                       Radius=5, OutputArrayName="Histogram")
+histogram.Scalars = ["POINTS", "MetaImage"]
+smoothed = VolumetricAmbientOcclusion(Input=histogram, Method="Histogram CDF", Radius=3, NumberOfBins=40,
+                                      QueryMode="Smoothed Voxel Value", QuerySmoothing=2.0,
+                                      OutputArrayName="HistogramSmoothed")
+smoothed.Scalars = ["POINTS", "MetaImage"]
+SaveData(target[:-len(".pvti")] + "_histogram.pvti", proxy=smoothed, DataMode="Binary")

@@ -59,8 +59,13 @@ def run(ranks, script="mpi_run.py", extension="pvti", input_path=source):
 exact = ["GaussianCDF", "Variance", "CDFReconstruction", "Chebyshev", "ExactBox", "ShadedRGBA"]
 converged = {"SignedDistance": 1e-3, "AmbientOcclusion": 1e-5}
 names = exact + list(converged)
-serial = read_image(run(1))
+serial_target = run(1)
+serial = read_image(serial_target)
 reference = {name: array_of(serial, name) for name in names}
+serial_histogram = read_image(serial_target[:-len(".pvti")] + "_histogram.pvti")
+for name in ("Histogram", "HistogramSmoothed"):
+    reference[name] = array_of(serial_histogram, name)
+    check(reference[name].size == 128 * 128 * 136 and reference[name].std() > 0.05, "serial %s is a real field" % name)
 for name in names:
     values = reference[name]
     check(values.size % (128 * 128 * 136) == 0 and values.max() > values.min(), "serial %s is a real field" % name)
@@ -83,7 +88,7 @@ for input_path in (source, partitioned):
         extents = [tuple(int(v) for v in p.get("Extent").split()) for p in pieces]
         check(len(extents) == ranks, "%s np %d wrote %d pieces %s" % (kind, ranks, len(extents), extents))
         received = {(label, rank): logged_extent("%s.%s" % (target, label), rank)
-                    for label in ("local", "sweeping", "piece") for rank in range(ranks)}
+                    for label in ("local", "sweeping", "piece", "histogram") for rank in range(ranks)}
         for rank, piece in enumerate(extents):
             slab = received.get(("sweeping", rank))
             thickness = max(slab[2 * a + 1] - slab[2 * a] + 1 for a in range(3) if slab[2 * a:2 * a + 2] !=
@@ -105,6 +110,19 @@ for input_path in (source, partitioned):
             check(asked is not None and asked != WHOLE and inside(asked, grown(piece, 10)),
                   "%s np %d rank %d: Volumetric AO of the piece %s received %s (the piece grown by R = 10)"
                   % (kind, ranks, rank, piece, asked))
+        histogram_target = target[:-len(".pvti")] + "_histogram.pvti"
+        histogram_pieces = [tuple(int(v) for v in p.get("Extent").split())
+                            for p in ET.parse(histogram_target).getroot().findall(".//Piece")]
+        for rank, piece in enumerate(histogram_pieces):
+            asked = received.get(("histogram", rank))
+            check(asked is not None and asked != WHOLE and inside(asked, grown(piece, 11)),
+                  "%s np %d rank %d: Histogram CDF of the piece %s received %s (the piece grown by 5 + 6)"
+                  % (kind, ranks, rank, piece, asked))
+        histogram_run = read_image(histogram_target)
+        for name in ("Histogram", "HistogramSmoothed"):
+            difference = np.abs(array_of(histogram_run, name) - reference[name]).max()
+            check(difference == 0.0, "%s np %d: %s (thresholds reduced over the ranks) equals serial "
+                  "(max difference %.3g)" % (kind, ranks, name, difference))
         difference = np.abs(array_of(read_image(direct_target), "Direct") - reference["GaussianCDF"]).max()
         check(difference == 0.0, "%s np %d: Volumetric AO of the pieces equals serial (max difference %.3g)"
               % (kind, ranks, difference))
