@@ -33,79 +33,96 @@ namespace detail
 namespace
 {
 
-constexpr std::int64_t kTileSize = 48;
 constexpr int kLaneMultiple = 16;
 
+/// Lanes of a bin count: a multiple of kLaneMultiple (the AVX2 width of 16-bit lanes).
+int laneCount(int bins)
+{
+  return (bins + kLaneMultiple - 1) / kLaneMultiple * kLaneMultiple;
+}
+
+/// Bytes of one worker's state for tiles of `tile` columns: the window counts of the tile
+/// grown by the radius, and the rows summed along x.
+std::int64_t tileStateBytes(std::int64_t tile, const Radius& r, int lanes, int laneBytes)
+{
+  const std::int64_t span = tile + 2 * std::max(r.x, r.y);
+  return (span * span + span * tile) * lanes * laneBytes;
+}
+
+/// The tile's side: 64 (the fastest measured on 256^2 slices at R = 5 and 10; larger tiles
+/// leave the L2 cache, smaller ones recount more of their border), smaller when the
+/// workers' states would exceed a fifth of the input, down to 16.
+std::int64_t tileSize(std::int64_t inputBytes, const Radius& r, int lanes, int laneBytes, int threads)
+{
+  std::int64_t tile = 64;
+  while (tile > 16 && threads * tileStateBytes(tile, r, lanes, laneBytes) > inputBytes / 5)
+  {
+    tile -= 16;
+  }
+  return tile;
+}
+
 /// dst = window sum along x of `src` (width pixels of `lanes`), for outputs starting at
-/// pixel `first`, `count` of them, half-width r; `run` is scratch of `lanes`.
+/// pixel `first`, `count` of them, half-width r. Each output is the previous one plus the
+/// pixel entering the window minus the one leaving it (`zeros` stands for a pixel outside
+/// the row): three loads and one store per vector of lanes.
 template <class L>
 struct RowSums
 {
-  static VAO_ALWAYS_INLINE void run(const L* src, std::int64_t width, std::int64_t first, std::int64_t count,
-    std::int64_t r, int lanes, L* run, L* dst)
+  static VAO_ALWAYS_INLINE void run(const L* __restrict src, std::int64_t width, std::int64_t first,
+    std::int64_t count, std::int64_t r, int lanes, const L* __restrict zeros, L* __restrict dst)
   {
     for (int c = 0; c < lanes; ++c)
-      run[c] = 0;
+      dst[c] = 0;
     const std::int64_t lo = std::max<std::int64_t>(0, first - r);
     const std::int64_t hi = std::min<std::int64_t>(width - 1, first + r);
     for (std::int64_t x = lo; x <= hi; ++x)
     {
-      const L* s = src + x * lanes;
+      const L* __restrict s = src + x * lanes;
       for (int c = 0; c < lanes; ++c)
-        run[c] = static_cast<L>(run[c] + s[c]);
+        dst[c] = static_cast<L>(dst[c] + s[c]);
     }
-    for (std::int64_t i = 0; i < count; ++i)
+    for (std::int64_t i = 1; i < count; ++i)
     {
-      L* d = dst + i * lanes;
+      const std::int64_t entering = first + i + r, leaving = first + i - r - 1;
+      const L* __restrict in = entering < width ? src + entering * lanes : zeros;
+      const L* __restrict out = leaving >= 0 ? src + leaving * lanes : zeros;
+      const L* __restrict previous = dst + (i - 1) * lanes;
+      L* __restrict d = dst + i * lanes;
       for (int c = 0; c < lanes; ++c)
-        d[c] = run[c];
-      const std::int64_t entering = first + i + r + 1;
-      const std::int64_t leaving = first + i - r;
-      if (entering < width)
-      {
-        const L* s = src + entering * lanes;
-        for (int c = 0; c < lanes; ++c)
-          run[c] = static_cast<L>(run[c] + s[c]);
-      }
-      if (leaving >= 0)
-      {
-        const L* s = src + leaving * lanes;
-        for (int c = 0; c < lanes; ++c)
-          run[c] = static_cast<L>(run[c] - s[c]);
-      }
+        d[c] = static_cast<L>(previous[c] + in[c] - out[c]);
     }
   }
 };
 
-/// run += entering - leaving (either may be null), over count * lanes values.
+/// run += entering - leaving over `values` lanes (`zeros` for a row outside the volume).
 template <class L>
 struct SlideRun
 {
-  static VAO_ALWAYS_INLINE void run(L* run, const L* entering, const L* leaving, std::int64_t values)
+  static VAO_ALWAYS_INLINE void run(L* __restrict run, const L* __restrict entering, const L* __restrict leaving,
+    std::int64_t values)
   {
-    if (entering)
-      for (std::int64_t c = 0; c < values; ++c)
-        run[c] = static_cast<L>(run[c] + entering[c]);
-    if (leaving)
-      for (std::int64_t c = 0; c < values; ++c)
-        run[c] = static_cast<L>(run[c] - leaving[c]);
+    for (std::int64_t c = 0; c < values; ++c)
+      run[c] = static_cast<L>(run[c] + entering[c] - leaving[c]);
   }
 };
 
-/// below[i] = sum of the lanes of histogram i under upper[i].
+/// below[i] = sum of the lanes of histogram i under upper[i]: the lanes ANDed with row
+/// upper[i] of `masks` (all ones below it) and added in the lanes' own width, which holds
+/// any sum of a box's counts.
 template <class L>
 struct MaskedPrefix
 {
   static VAO_ALWAYS_INLINE void run(const L* histograms, const int* upper, std::int64_t count, int lanes,
-    std::uint32_t* below)
+    const L* masks, std::uint32_t* below)
   {
     for (std::int64_t i = 0; i < count; ++i)
     {
       const L* h = histograms + i * lanes;
-      const int u = upper[i];
-      std::uint32_t sum = 0;
+      const L* m = masks + static_cast<std::int64_t>(upper[i]) * lanes;
+      L sum = 0;
       for (int c = 0; c < lanes; ++c)
-        sum += c < u ? static_cast<std::uint32_t>(h[c]) : 0u;
+        sum = static_cast<L>(sum + (h[c] & m[c]));
       below[i] = sum;
     }
   }
@@ -151,6 +168,7 @@ private:
 
 struct HistogramJob
 {
+  std::int64_t tile; // side of the tiles in columns
   const Region& region;
   const Radius& radius;
   const std::vector<double>& thresholds;
@@ -169,16 +187,21 @@ public:
     , Job(job)
     , Bin(bin)
     , Bins(static_cast<int>(job.thresholds.size()))
-    , Lanes((Bins + kLaneMultiple - 1) / kLaneMultiple * kLaneMultiple)
+    , Lanes(laneCount(Bins))
   {
-    const std::int64_t span = kTileSize + 2 * std::max(job.radius.x, job.radius.y);
+    const std::int64_t tile = job.tile;
+    const std::int64_t span = tile + 2 * std::max(job.radius.x, job.radius.y);
     this->Window.resize(static_cast<std::size_t>(span * span * this->Lanes));
-    this->Rows.resize(static_cast<std::size_t>(span * kTileSize * this->Lanes));
-    this->Run.resize(static_cast<std::size_t>(kTileSize * this->Lanes));
-    this->Scratch.resize(static_cast<std::size_t>(this->Lanes));
-    this->Upper.resize(kTileSize);
-    this->Below.resize(kTileSize);
-    this->Query.resize(kTileSize);
+    this->Rows.resize(static_cast<std::size_t>(span * tile * this->Lanes));
+    this->Run.resize(static_cast<std::size_t>(tile * this->Lanes));
+    this->Zeros.assign(static_cast<std::size_t>(tile * this->Lanes), L(0));
+    this->Upper.resize(tile);
+    this->Below.resize(tile);
+    this->Query.resize(tile);
+    this->Masks.assign(static_cast<std::size_t>((this->Lanes + 1) * this->Lanes), L(0));
+    for (int u = 0; u <= this->Lanes; ++u)
+      for (int c = 0; c < u; ++c)
+        this->Masks[u * this->Lanes + c] = static_cast<L>(~L(0));
   }
 
   /// Output columns [x0, x0 + nx) x [y0, y0 + ny) (volume coordinates), slices [z0, z1).
@@ -212,6 +235,8 @@ public:
   }
 
 private:
+  const L* zeros() const { return this->Zeros.data(); }
+
   void addSlice(std::int64_t s, int sign)
   {
     const std::int64_t width = this->HX1 - this->HX0;
@@ -242,15 +267,15 @@ private:
     const std::int64_t rowValues = nx * this->Lanes;
     for (std::int64_t y = this->HY0; y < this->HY1; ++y)
     {
-      runRows<RowSums<L>>(this->Job.avx2, &this->Window[(y - this->HY0) * width * this->Lanes], width,
-        this->X0 - this->HX0, nx, std::int64_t(r.x), this->Lanes, this->Scratch.data(),
+      runRows<RowSums<L>>(this->Job.avx2, static_cast<const L*>(&this->Window[(y - this->HY0) * width * this->Lanes]),
+        width, this->X0 - this->HX0, nx, std::int64_t(r.x), this->Lanes, this->zeros(),
         &this->Rows[(y - this->HY0) * rowValues]);
     }
     std::fill(this->Run.begin(), this->Run.end(), L(0));
     for (std::int64_t y = std::max<std::int64_t>(0, y0 - r.y); y <= std::min<std::int64_t>(dims[1] - 1, y0 + r.y); ++y)
     {
-      runRows<SlideRun<L>>(this->Job.avx2, this->Run.data(), &this->Rows[(y - this->HY0) * rowValues],
-        static_cast<const L*>(nullptr), rowValues);
+      runRows<SlideRun<L>>(this->Job.avx2, this->Run.data(),
+        static_cast<const L*>(&this->Rows[(y - this->HY0) * rowValues]), this->zeros(), rowValues);
     }
     const double* t = this->Job.thresholds.data();
     const HistogramQuery& query = this->Job.query;
@@ -272,7 +297,8 @@ private:
         this->Upper[i] = query.values || query.isoValue ? thresholdIndex(q, t, this->Bins) : this->Bin(v);
       }
       runRows<MaskedPrefix<L>>(this->Job.avx2, static_cast<const L*>(this->Run.data()),
-        static_cast<const int*>(this->Upper.data()), nx, this->Lanes, this->Below.data());
+        static_cast<const int*>(this->Upper.data()), nx, this->Lanes, static_cast<const L*>(this->Masks.data()),
+        this->Below.data());
       const double countYZ = static_cast<double>(clippedWindowCount(y, r.y, dims[1])) * countZ;
       for (std::int64_t i = 0; i < nx; ++i)
       {
@@ -286,8 +312,8 @@ private:
       {
         const std::int64_t entering = y + r.y + 1, leaving = y - r.y;
         runRows<SlideRun<L>>(this->Job.avx2, this->Run.data(),
-          entering < dims[1] ? static_cast<const L*>(&this->Rows[(entering - this->HY0) * rowValues]) : nullptr,
-          leaving >= 0 ? static_cast<const L*>(&this->Rows[(leaving - this->HY0) * rowValues]) : nullptr, rowValues);
+          entering < dims[1] ? static_cast<const L*>(&this->Rows[(entering - this->HY0) * rowValues]) : this->zeros(),
+          leaving >= 0 ? static_cast<const L*>(&this->Rows[(leaving - this->HY0) * rowValues]) : this->zeros(), rowValues);
       }
     }
   }
@@ -297,7 +323,9 @@ private:
   const BinOf<T>& Bin;
   int Bins, Lanes;
   std::int64_t X0 = 0, NX = 0, HX0 = 0, HX1 = 0, HY0 = 0, HY1 = 0;
-  std::vector<L> Window, Rows, Run, Scratch;
+  std::vector<L> Window, Rows, Run;
+  std::vector<L> Zeros; // a row of pixels outside the volume
+  std::vector<L> Masks; // row u: all ones in the lanes below u
   std::vector<int> Upper;
   std::vector<std::uint32_t> Below;
   std::vector<double> Query;
@@ -308,8 +336,9 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
 {
   const BinOf<T> bin(job.thresholds);
   const Region& region = job.region;
-  const std::int64_t tilesX = (region.size[0] + kTileSize - 1) / kTileSize;
-  const std::int64_t tilesY = (region.size[1] + kTileSize - 1) / kTileSize;
+  const std::int64_t tile = job.tile;
+  const std::int64_t tilesX = (region.size[0] + tile - 1) / tile;
+  const std::int64_t tilesY = (region.size[1] + tile - 1) / tile;
   const int threads = resolveThreadCount(execution.threads);
   // Enough units for every thread several times over; each z-range starts its window anew.
   const std::int64_t zParts = std::min<std::int64_t>(
@@ -317,16 +346,16 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
   const std::int64_t units = tilesX * tilesY * zParts;
   return parallelFor(units, static_cast<int>(std::min<std::int64_t>(units, 1 << 20)), threads, execution,
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
-      TileHistograms<T, L> tile(volume, job, bin);
+      TileHistograms<T, L> state(volume, job, bin);
       for (std::int64_t u = begin; u < end && !progress.stopped(); ++u)
       {
         const std::int64_t part = u % zParts, t = u / zParts;
         const std::int64_t tx = t % tilesX, ty = t / tilesX;
-        const std::int64_t x0 = region.begin[0] + tx * kTileSize, y0 = region.begin[1] + ty * kTileSize;
+        const std::int64_t x0 = region.begin[0] + tx * tile, y0 = region.begin[1] + ty * tile;
         const std::int64_t z0 = region.begin[2] + region.size[2] * part / zParts;
         const std::int64_t z1 = region.begin[2] + region.size[2] * (part + 1) / zParts;
-        tile.compute(x0, std::min(kTileSize, region.begin[0] + region.size[0] - x0), y0,
-          std::min(kTileSize, region.begin[1] + region.size[1] - y0), z0, z1);
+        state.compute(x0, std::min(tile, region.begin[0] + region.size[0] - x0), y0,
+          std::min(tile, region.begin[1] + region.size[1] - y0), z0, z1);
         progress.advance();
       }
     });
@@ -337,17 +366,21 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
 bool computeHistogramOpenness(const VolumeView& view, const Region& region, const Radius& radius,
   const std::vector<double>& thresholds, const HistogramQuery& query, float* openness, const Execution& execution)
 {
-  const HistogramJob job{ region, radius, thresholds, query, openness, cpuHasAvx2() };
   // The largest box: its count must fit the lanes.
   std::int64_t largest = 1;
   const int r[3] = { radius.x, radius.y, radius.z };
   for (int a = 0; a < 3; ++a)
     largest *= std::min<std::int64_t>(2 * std::int64_t(r[a]) + 1, view.dims[a]);
+  const int laneBytes = largest <= 0xFFFF ? 2 : 4;
+  const int lanes = laneCount(static_cast<int>(thresholds.size()));
   return dispatchScalarType(view.type, [&](auto tag) {
     using T = decltype(tag);
     const TypedVolume<T> volume(view);
-    return largest <= 0xFFFF ? computeTiles<T, std::uint16_t>(volume, job, execution)
-                             : computeTiles<T, std::uint32_t>(volume, job, execution);
+    const std::int64_t inputBytes = view.voxelCount() * static_cast<std::int64_t>(sizeof(T));
+    const HistogramJob job{ tileSize(inputBytes, radius, lanes, laneBytes, resolveThreadCount(execution.threads)),
+      region, radius, thresholds, query, openness, cpuHasAvx2() };
+    return laneBytes == 2 ? computeTiles<T, std::uint16_t>(volume, job, execution)
+                          : computeTiles<T, std::uint32_t>(volume, job, execution);
   });
 }
 

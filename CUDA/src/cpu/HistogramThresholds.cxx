@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <type_traits>
 
 namespace vao
 {
@@ -88,6 +89,18 @@ Status addToValueHistogram(
             for (std::int64_t j = 0; j < region.size[1]; ++j)
             {
               const T* row = volume.row(region.begin[1] + j, region.begin[2] + k);
+              if constexpr (std::is_integral<T>::value && sizeof(T) <= 2)
+              {
+                // A cell per value: count only; the cells' extrema are their values.
+                const auto lowest = static_cast<std::int64_t>(part.lowest);
+                const auto last = static_cast<std::int64_t>(part.counts.size()) - 1;
+                for (std::int64_t i = region.begin[0]; i < region.begin[0] + region.size[0]; ++i)
+                {
+                  const std::int64_t c = static_cast<std::int64_t>(row[i * volume.stride]) - lowest;
+                  ++part.counts[std::min(last, std::max<std::int64_t>(0, c))];
+                }
+                continue;
+              }
               for (std::int64_t i = region.begin[0]; i < region.begin[0] + region.size[0]; ++i)
               {
                 const double v = static_cast<double>(row[i * volume.stride]);
@@ -100,6 +113,12 @@ Status addToValueHistogram(
               }
             }
             progress.advance();
+          }
+          if (part.integerCells)
+          {
+            for (std::size_t c = 0; c < part.counts.size(); ++c)
+              if (part.counts[c] > 0)
+                part.minimum[c] = part.maximum[c] = part.lowest + static_cast<double>(c);
           }
           const std::lock_guard<std::mutex> lock(merging);
           // Counts add and extrema combine in any order: the result does not depend on it.
