@@ -1,6 +1,7 @@
 # The streaming test: -DVAO_STREAM=<vao_stream> -DWORK_DIR=<folder>. Generates a 97x83x61
-# phantom, computes Gaussian CDF AO (R = 5) in one piece and in 7, and CDF Reconstruction
-# (extrema too) in 1 and 5; the raw outputs must be identical, the reader must never
+# phantom, computes Gaussian CDF AO (R = 5) in one piece and in 7, CDF Reconstruction
+# (extrema too) in 1 and 5, and Histogram CDF (its thresholds read slab by slab first) in 1
+# and 6; the raw outputs must be identical, the reader must never
 # have held all 61 slices when streaming, and both files, read back with VTK's MetaImage
 # reader, must give the filter's in-memory result exactly. Bad files and arguments must
 # fail with exit code 2 and a message.
@@ -17,7 +18,7 @@ function(run_stream)
 endfunction()
 
 run_stream(generate "${WORK_DIR}/phantom.mhd" 97 83 61)
-foreach(case "gaussian;7" "cdf;5")
+foreach(case "gaussian;7" "cdf;5" "histogram;6")
   list(GET case 0 method)
   list(GET case 1 pieces)
   run_stream(ao "${WORK_DIR}/phantom.mhd" "${WORK_DIR}/${method}_1.mhd" --pieces 1 --radius 5 --method ${method})

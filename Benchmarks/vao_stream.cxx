@@ -5,8 +5,9 @@
 //
 //   vao_stream generate OUT.mhd NX NY NZ
 //       the project's head phantom (int16), generated and written slab by slab
-//   vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method gaussian|cdf|chebyshev]
-//       float32 AmbientOcclusion of an uncompressed MetaImage (.mhd + raw data file)
+//   vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method gaussian|cdf|chebyshev|histogram]
+//       float32 AmbientOcclusion of an uncompressed MetaImage (.mhd + raw data file);
+//       histogram: Histogram CDF, whose thresholds are first read from the slabs
 //   vao_stream check IN.mhd AO.mhd [--radius R] [--method ...]
 //       reads both back with vtkMetaImageReader and compares AO.mhd with the filter run on
 //       the whole input in memory (for volumes that fit)
@@ -17,7 +18,10 @@
 #include "vtkAmbientOcclusionPhantom.h"
 #include "vtkVolumetricAmbientOcclusion.h"
 
+#include <vtkCallbackCommand.h>
+#include <vtkCommand.h>
 #include <vtkDataArray.h>
+#include <vtkDoubleArray.h>
 #include <vtkImageData.h>
 #include <vtkImageReader.h>
 #include <vtkMetaImageReader.h>
@@ -258,10 +262,36 @@ int AmbientOcclusion(const std::string& inPath, const std::string& outPath, int 
   in.bigEndian ? reader->SetDataByteOrderToBigEndian() : reader->SetDataByteOrderToLittleEndian();
   reader->SetScalarArrayName("Scalars");
 
+  // The most slices the reader held at once, whatever asked for them.
+  int mostSlicesRead = 0;
+  vtkNew<vtkCallbackCommand> watch;
+  watch->SetClientData(&mostSlicesRead);
+  watch->SetCallback([](vtkObject* caller, unsigned long, void* most, void*) {
+    const int* read = static_cast<vtkImageReader*>(caller)->GetOutput()->GetExtent();
+    int& slices = *static_cast<int*>(most);
+    slices = std::max(slices, read[5] - read[4] + 1);
+  });
+  reader->AddObserver(vtkCommand::EndEvent, watch);
+
   vtkNew<vtkVolumetricAmbientOcclusion> filter;
   filter->SetInputConnection(reader->GetOutputPort());
   filter->SetMethod(method);
   filter->SetRadius(radius);
+  pieces = std::max(1, std::min(pieces, in.dims[2]));
+  if (method == vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF)
+  {
+    // The thresholds of the whole volume, read slab by slab (twice: range, histogram).
+    vtkSmartPointer<vtkDoubleArray> thresholds = filter->ComputeHistogramThresholds(pieces);
+    if (!thresholds)
+    {
+      std::fprintf(stderr, "vao_stream: the thresholds of %s could not be computed\n", inPath.c_str());
+      return 1;
+    }
+    filter->SetHistogramThresholds(thresholds);
+    std::printf("thresholds: %lld, from %g to %g, read in %d slabs\n",
+      static_cast<long long>(thresholds->GetNumberOfTuples()), thresholds->GetValue(0),
+      thresholds->GetValue(thresholds->GetNumberOfTuples() - 1), pieces);
+  }
 
   Header out = in;
   out.dataFile = outPath.substr(0, outPath.find_last_of('.')) + ".raw";
@@ -271,8 +301,6 @@ int AmbientOcclusion(const std::string& inPath, const std::string& outPath, int 
     std::fprintf(stderr, "vao_stream: cannot write %s\n", outPath.c_str());
     return 2;
   }
-  pieces = std::max(1, std::min(pieces, in.dims[2]));
-  int mostSlicesRead = 0;
   for (int p = 0; p < pieces; ++p)
   {
     int ext[6];
@@ -286,8 +314,6 @@ int AmbientOcclusion(const std::string& inPath, const std::string& outPath, int 
       std::fprintf(stderr, "vao_stream: slab %d (z %d..%d) failed\n", p, ext[4], ext[5]);
       return 1;
     }
-    const int* read = reader->GetOutput()->GetExtent();
-    mostSlicesRead = std::max(mostSlicesRead, read[5] - read[4] + 1);
     if (!AppendSlab(raw, ao))
     {
       std::fprintf(stderr, "vao_stream: writing %s failed\n", out.dataFile.c_str());
@@ -307,8 +333,8 @@ int Usage()
 {
   std::fprintf(stderr,
     "usage: vao_stream generate OUT.mhd NX NY NZ\n"
-    "       vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method gaussian|cdf|chebyshev]\n"
-    "       vao_stream check IN.mhd AO.mhd [--radius R] [--method gaussian|cdf|chebyshev]\n");
+    "       vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method gaussian|cdf|chebyshev|histogram]\n"
+    "       vao_stream check IN.mhd AO.mhd [--radius R] [--method gaussian|cdf|chebyshev|histogram]\n");
   return 2;
 }
 
@@ -375,6 +401,8 @@ bool ParseOptions(int argc, char* argv[], int first, bool piecesAllowed, int& pi
         method = vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION;
       else if (m == "chebyshev")
         method = vtkVolumetricAmbientOcclusion::CHEBYSHEV;
+      else if (m == "histogram")
+        method = vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF;
       else
         return false;
     }

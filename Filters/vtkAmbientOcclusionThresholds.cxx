@@ -6,8 +6,14 @@
 #include "vao/HistogramCdf.h"
 #include "vao/Validation.h"
 
+#include "vtkAlgorithm.h"
 #include "vtkCommunicator.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
 #include "vtkMultiProcessController.h"
+#include "vtkNew.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <algorithm>
 #include <limits>
@@ -176,6 +182,83 @@ bool Compute(vtkMultiProcessController* controller, const vao::VolumeView* volum
   }
   thresholds = vao::histogramThresholds(histogram, bins);
   return true;
+}
+
+bool ComputeInSlabs(vtkAlgorithm* producer, int port, int slabs, int bins,
+  const std::function<bool(vtkImageData*, vao::VolumeView&, std::string&)>& view,
+  std::vector<double>& thresholds, std::string& error)
+{
+  producer->UpdateInformation();
+  int whole[6];
+  producer->GetOutputInformation(port)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  const int nz = whole[5] - whole[4] + 1;
+  if (vtkAmbientOcclusionExtents::EmptyExtent(whole))
+  {
+    error = "the input is empty";
+    return false;
+  }
+  slabs = std::max(1, std::min(slabs, nz));
+  double range[2] = { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() };
+  vao::ValueHistogram histogram;
+  long long counted = 0;
+  // Pass 0: the range (it fixes the cells); pass 1: the histogram of each slab.
+  for (int pass = 0; pass < 2; ++pass)
+  {
+    for (int s = 0; s < slabs; ++s)
+    {
+      int slab[6] = { whole[0], whole[1], whole[2], whole[3], whole[4] + nz * s / slabs,
+        whole[4] + nz * (s + 1) / slabs - 1 };
+      vtkNew<vtkInformationVector> requests;
+      vtkNew<vtkInformation> request;
+      request->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), slab, 6);
+      requests->Append(request);
+      producer->Update(port, requests);
+      vtkImageData* image = vtkImageData::SafeDownCast(producer->GetOutputDataObject(port));
+      vao::VolumeView volume;
+      int common[6];
+      if (!image || !vtkAmbientOcclusionExtents::IntersectExtents(image->GetExtent(), slab, common) ||
+        !std::equal(common, common + 6, slab))
+      {
+        error = "the input did not deliver the slab z = " + std::to_string(slab[4]) + ".." + std::to_string(slab[5]);
+        return false;
+      }
+      if (!view(image, volume, error))
+      {
+        return false;
+      }
+      vao::Region region;
+      for (int a = 0; a < 3; ++a)
+      {
+        region.begin[a] = slab[2 * a] - image->GetExtent()[2 * a];
+        region.size[a] = slab[2 * a + 1] - slab[2 * a] + 1;
+      }
+      if (pass == 0)
+      {
+        const vao::ValueScan scan = vao::scanValues(volume);
+        const vao::Status finite = vao::finiteStatus(scan);
+        if (!finite.ok)
+        {
+          error = "the slab z = " + std::to_string(slab[4]) + ".." + std::to_string(slab[5]) + " holds " +
+            std::to_string(finite.nonFiniteCount) + " NaN or infinite values";
+          return false;
+        }
+        range[0] = std::min(range[0], scan.minimum);
+        range[1] = std::max(range[1], scan.maximum);
+        if (s + 1 == slabs)
+          histogram = vao::ValueHistogram::forRange(volume.type, range[0], range[1]);
+        continue;
+      }
+      const vao::Status status = vao::addToValueHistogram(volume, region, histogram);
+      if (!status.ok)
+      {
+        error = status.message;
+        return false;
+      }
+      counted += region.voxelCount();
+    }
+  }
+  thresholds = vao::histogramThresholds(histogram, bins);
+  return counted == vtkAmbientOcclusionExtents::ExtentPoints(whole);
 }
 
 } // namespace vtkAmbientOcclusionThresholds

@@ -4,9 +4,12 @@
 #ifndef vtkAmbientOcclusionThresholds_h
 #define vtkAmbientOcclusionThresholds_h
 
+#include <functional>
 #include <string>
 #include <vector>
 
+class vtkAlgorithm;
+class vtkImageData;
 class vtkMultiProcessController;
 namespace vao
 {
@@ -27,6 +30,15 @@ namespace vtkAmbientOcclusionThresholds
 bool Compute(vtkMultiProcessController* controller, const vao::VolumeView* volume, const int inExt[6],
   const int outExt[6], const int whole[6], int bins, bool failed, std::vector<double>& thresholds,
   std::string& error);
+
+/// The thresholds of the data set produced by `producer` (output `port`), read in `slabs`
+/// slabs along z, each an update of the upstream pipeline with that extent, so that a
+/// volume larger than memory is summarised slab by slab (two passes: the value range,
+/// then the histogram). `array(image)` picks the array of each slab. False, with the
+/// reason in `error`, when a slab cannot be read or holds a NaN or infinite value.
+bool ComputeInSlabs(vtkAlgorithm* producer, int port, int slabs, int bins,
+  const std::function<bool(vtkImageData*, vao::VolumeView&, std::string&)>& view,
+  std::vector<double>& thresholds, std::string& error);
 
 /// The boxes of `ext` not covered by any extent of `others` (each 6 ints), as extents.
 std::vector<std::vector<int>> SubtractExtents(const int ext[6], const std::vector<const int*>& others);

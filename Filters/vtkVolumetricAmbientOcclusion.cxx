@@ -12,6 +12,7 @@
 #include "vao/Validation.h"
 
 #include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -128,12 +129,6 @@ vtkMultiProcessController* vtkVolumetricAmbientOcclusion::GetController() const
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumetricAmbientOcclusion::IsDistributed() const
-{
-  return this->Method == HISTOGRAM_CDF && this->Controller && this->Controller->GetNumberOfProcesses() > 1;
-}
-
-//------------------------------------------------------------------------------
 void vtkVolumetricAmbientOcclusion::ComputeReach(const double spacing[3], int reach[3]) const
 {
   this->ComputeVoxelRadius(spacing, reach);
@@ -213,7 +208,7 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
 {
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  if (this->Method == HISTOGRAM_CDF && !this->IsDistributed())
+  if (this->Method == HISTOGRAM_CDF && !this->HistogramThresholds && !this->IsDistributed())
   {
     // One process: the thresholds need every voxel of the data set.
     vtkAmbientOcclusionExtents::RequestWholeExtent(inInfo);
@@ -339,21 +334,10 @@ int vtkVolumetricAmbientOcclusion::RequestData(
       }
     }
     std::vector<double> thresholds;
-    const bool distributed = this->IsDistributed();
-    if (this->Method == HISTOGRAM_CDF && (ok || distributed))
+    if (this->Method == HISTOGRAM_CDF && (ok || this->IsDistributed()) &&
+      !this->Thresholds(input, ok ? &scalars.view : nullptr, outExt, whole, !ok && !emptyPiece, thresholds))
     {
-      // Distributed: each process counts its output piece (together they tile the data
-      // set); one process counts its input, which is the whole extent.
-      error.clear();
-      if (!vtkAmbientOcclusionThresholds::Compute(distributed ? this->Controller.Get() : nullptr,
-            ok ? &scalars.view : nullptr, ok ? input->GetExtent() : outExt,
-            distributed || !ok ? outExt : input->GetExtent(), whole, this->NumberOfBins, !ok && !emptyPiece,
-            thresholds, error))
-      {
-        if (!error.empty())
-          vtkErrorMacro(<< error);
-        return 1;
-      }
+      return 1;
     }
     if (!ok)
     {
@@ -388,6 +372,14 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     if (variance)
     {
       output->GetPointData()->AddArray(variance);
+    }
+    if (this->Method == HISTOGRAM_CDF)
+    {
+      vtkNew<vtkDoubleArray> used; // for a later run to reuse, e.g. on other pieces
+      used->SetName("HistogramThresholds");
+      for (const double t : parameters.thresholds)
+        used->InsertNextValue(t);
+      output->GetFieldData()->AddArray(used);
     }
     vtkNew<vtkStringArray> backend;
     backend->SetName("AmbientOcclusionBackend");

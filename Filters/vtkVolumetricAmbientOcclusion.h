@@ -45,6 +45,8 @@
 #include <string>
 #include <vector>
 
+class vtkDataArray;
+class vtkDoubleArray;
 class vtkImageData;
 class vtkMultiProcessController;
 namespace vao
@@ -132,6 +134,23 @@ public:
   ///@}
 
   ///@{
+  /// Histogram CDF: the ascending thresholds to use instead of the whole data set's
+  /// (nullptr, the default: the filter computes them). With them set, the filter reads only
+  /// the requested extent grown by the radius, also in one process, so it streams. Take
+  /// them from ComputeHistogramThresholds, or from the field-data array
+  /// "HistogramThresholds" that every Histogram CDF output carries.
+  void SetHistogramThresholds(vtkDataArray* thresholds);
+  vtkDataArray* GetHistogramThresholds() const;
+  ///@}
+
+  /// The thresholds Histogram CDF takes from the whole data set upstream of this filter
+  /// (with NumberOfBins, the array to process and Component), read in `slabs` slabs along
+  /// z, each an update of the upstream pipeline, so that a volume larger than memory is
+  /// summarised slab by slab (the range first, then the histogram: the input is read
+  /// twice). nullptr, with an error, on failure.
+  vtkSmartPointer<vtkDoubleArray> ComputeHistogramThresholds(int slabs);
+
+  ///@{
   /// The processes that share the data set, for Histogram CDF's thresholds (default: the
   /// global controller).
   void SetController(vtkMultiProcessController* controller);
@@ -203,6 +222,7 @@ protected:
   double QuerySmoothing = 1.0;
   int NumberOfBins = 64;
   vtkSmartPointer<vtkMultiProcessController> Controller;
+  vtkSmartPointer<vtkDataArray> HistogramThresholds;
   int ErfApproximation = ERF_EXACT;
   vtkTypeBool ComputeVariance = false;
   int Component = -1;
@@ -223,6 +243,10 @@ private:
   void ComputeReach(const double spacing[3], int reach[3]) const;
   /// Histogram CDF in a distributed run: the thresholds come from every process's piece.
   bool IsDistributed() const;
+  /// Histogram CDF's thresholds for this run: the given ones, or the whole data set's
+  /// (collective in a distributed run; see RequestData).
+  bool Thresholds(vtkImageData* input, const vao::VolumeView* volume, const int outExt[6], const int whole[6],
+    bool failed, std::vector<double>& thresholds);
   /// The input covers the requested extent `outExt`.
   bool CheckInputCovers(vtkImageData* input, const int outExt[6]);
   /// The radius in voxels for the input's spacing; false when it is 0 on every axis or

@@ -6,6 +6,8 @@
 
 #include "vtkAmbientOcclusionPhantom.h"
 
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 
 #include <cmath>
@@ -187,4 +189,53 @@ TEST(HistogramCdfFilter, NonFiniteValuesAreNamed)
   image->GetPointData()->SetScalars(values);
   ExpectRejected(image, [](vtkVolumetricAmbientOcclusion* f) { f->SetRadius(2); },
     "NaN or infinite values (the first at voxel 7, 2, 7)");
+}
+
+TEST(HistogramCdfFilter, GivenThresholdsStreamOnlyTheGrownPiece)
+{
+  int dims[3] = { 34, 30, 37 };
+  auto whole = WholeRun(dims, [](vtkVolumetricAmbientOcclusion* f) { f->SetRadius(3); });
+  vtkDataArray* used = whole->GetFieldData()->GetArray("HistogramThresholds");
+  ASSERT_NE(used, nullptr) << "the output carries the thresholds it used";
+  EXPECT_EQ(used->GetNumberOfTuples(), 64);
+
+  // The same thresholds, read slab by slab from a fresh pipeline.
+  vtkNew<vtkAmbientOcclusionPhantom> source;
+  source->SetDimensions(dims[0], dims[1], dims[2]);
+  vtkNew<vtkVolumetricAmbientOcclusion> streamed;
+  streamed->SetInputConnection(source->GetOutputPort());
+  streamed->SetRadius(3);
+  vtkSmartPointer<vtkDoubleArray> computed = streamed->ComputeHistogramThresholds(5);
+  ASSERT_NE(computed, nullptr);
+  ASSERT_EQ(computed->GetNumberOfTuples(), used->GetNumberOfTuples());
+  for (vtkIdType i = 0; i < computed->GetNumberOfTuples(); ++i)
+    ASSERT_EQ(computed->GetValue(i), used->GetComponent(i, 0)) << i;
+  EXPECT_LT(source->GetOutput()->GetNumberOfPoints(), dims[0] * dims[1] * dims[2]) << "a slab, not the volume";
+
+  // With them given, a sub-extent needs only itself grown by the radius.
+  streamed->SetHistogramThresholds(computed);
+  const int wanted[6] = { 4, 20, 0, 29, 10, 14 };
+  streamed->UpdateExtent(wanted);
+  const int* in = source->GetOutput()->GetExtent();
+  EXPECT_EQ(in[4], 7);
+  EXPECT_EQ(in[5], 17);
+  const auto ao = Values(streamed->GetOutput()->GetPointData()->GetArray("AmbientOcclusion"));
+  const auto wholeAO = Values(whole->GetPointData()->GetArray("AmbientOcclusion"));
+  vtkIdType id = 0;
+  for (int k = wanted[4]; k <= wanted[5]; ++k)
+    for (int j = wanted[2]; j <= wanted[3]; ++j)
+      for (int i = wanted[0]; i <= wanted[1]; ++i, ++id)
+        ASSERT_EQ(ao[id], wholeAO[(vtkIdType(k) * dims[1] + j) * dims[0] + i]) << i << "," << j << "," << k;
+}
+
+TEST(HistogramCdfFilter, RejectsBadGivenThresholds)
+{
+  for (const std::vector<double>& bad : { std::vector<double>{ 5.0, 1.0 }, std::vector<double>{}, { 0.0, std::nan("") } })
+  {
+    vtkNew<vtkDoubleArray> thresholds;
+    for (const double t : bad)
+      thresholds->InsertNextValue(t);
+    ExpectRejected(RandomImage(6, 6, 6, 1), [&](vtkVolumetricAmbientOcclusion* f) { f->SetHistogramThresholds(thresholds); },
+      "HistogramThresholds");
+  }
 }

@@ -1,0 +1,103 @@
+// vtkVolumetricAmbientOcclusion: Histogram CDF's thresholds (given, computed from the whole
+// data set, or read from a streamed input in slabs) and the distributed run's test.
+#include "vtkVolumetricAmbientOcclusion.h"
+
+#include "vtkAmbientOcclusionArrayInput.h"
+#include "vtkAmbientOcclusionThresholds.h"
+
+#include "vao/HistogramCdf.h"
+#include "vao/Validation.h"
+
+#include "vtkAlgorithmOutput.h"
+#include "vtkDoubleArray.h"
+#include "vtkImageData.h"
+#include "vtkMultiProcessController.h"
+
+//------------------------------------------------------------------------------
+bool vtkVolumetricAmbientOcclusion::IsDistributed() const
+{
+  return this->Method == HISTOGRAM_CDF && !this->HistogramThresholds && this->Controller &&
+    this->Controller->GetNumberOfProcesses() > 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumetricAmbientOcclusion::SetHistogramThresholds(vtkDataArray* thresholds)
+{
+  if (this->HistogramThresholds != thresholds)
+  {
+    this->HistogramThresholds = thresholds;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+vtkDataArray* vtkVolumetricAmbientOcclusion::GetHistogramThresholds() const
+{
+  return this->HistogramThresholds;
+}
+
+//------------------------------------------------------------------------------
+vtkSmartPointer<vtkDoubleArray> vtkVolumetricAmbientOcclusion::ComputeHistogramThresholds(int slabs)
+{
+  vtkAlgorithm* producer = this->GetNumberOfInputConnections(0) > 0 ? this->GetInputAlgorithm(0, 0) : nullptr;
+  std::string error = vao::checkHistogramBins(this->NumberOfBins);
+  std::vector<double> thresholds;
+  if (!producer && error.empty())
+    error = "no input connection";
+  if (error.empty())
+  {
+    const int port = this->GetInputConnection(0, 0)->GetIndex();
+    vtkAmbientOcclusionArrayInput::ScalarVolume scalars; // the slab being read
+    vtkAmbientOcclusionThresholds::ComputeInSlabs(producer, port, slabs, this->NumberOfBins,
+      [&](vtkImageData* image, vao::VolumeView& view, std::string& why) {
+        if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
+              this, this->GetInputArrayToProcess(0, image), image, this->Component, scalars, why))
+          return false;
+        view = scalars.view;
+        return true;
+      },
+      thresholds, error);
+  }
+  if (!error.empty())
+  {
+    vtkErrorMacro(<< "ComputeHistogramThresholds: " << error);
+    return nullptr;
+  }
+  auto array = vtkSmartPointer<vtkDoubleArray>::New();
+  array->SetName("HistogramThresholds");
+  for (const double t : thresholds)
+    array->InsertNextValue(t);
+  return array;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumetricAmbientOcclusion::Thresholds(vtkImageData* input, const vao::VolumeView* volume,
+  const int outExt[6], const int whole[6], bool failed, std::vector<double>& thresholds)
+{
+  std::string error;
+  if (this->HistogramThresholds)
+  {
+    for (vtkIdType i = 0; i < this->HistogramThresholds->GetNumberOfTuples(); ++i)
+      thresholds.push_back(this->HistogramThresholds->GetComponent(i, 0));
+    const vao::Status status = vao::checkHistogramThresholds(thresholds);
+    if (!status.ok)
+      error = "HistogramThresholds: " + status.message + ".";
+  }
+  else
+  {
+    // Distributed: each process counts its output piece (together they tile the data
+    // set); one process counts its input, which is the whole extent.
+    const bool distributed = this->IsDistributed();
+    const bool computed = vtkAmbientOcclusionThresholds::Compute(distributed ? this->Controller.Get() : nullptr,
+      volume, volume ? input->GetExtent() : outExt, distributed || !volume ? outExt : input->GetExtent(), whole,
+      this->NumberOfBins, failed, thresholds, error);
+    if (!computed && error.empty())
+      return false; // aborted, or this process failed and said why before
+  }
+  if (!error.empty())
+  {
+    vtkErrorMacro(<< error);
+  }
+  return error.empty() && !failed;
+}
+
