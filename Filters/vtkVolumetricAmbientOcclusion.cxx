@@ -395,8 +395,11 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
 {
   const vao::Execution execution = vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads);
   vao::Status status;
+  // The device runs the separable methods and Histogram CDF, with the voxel's value or an
+  // iso value as the query.
   bool onDevice = this->ChooseCuda(
-    vao::isSeparableMethod(parameters.method) && parameters.queryMode != vao::QueryMode::SmoothedValue,
+    (vao::isSeparableMethod(parameters.method) || parameters.method == vao::Method::HistogramCdf) &&
+      parameters.queryMode != vao::QueryMode::SmoothedValue,
     region.voxelCount());
   if (onDevice)
   {
@@ -432,8 +435,7 @@ bool vtkVolumetricAmbientOcclusion::ChooseCuda(bool separableMethod, long long v
   }
   if (!separableMethod)
   {
-    vtkWarningMacro(<< "Exact Box, Exact Sphere, Histogram CDF and the smoothed query run on the CPU only; "
-                       "computing on the CPU.");
+    vtkWarningMacro(<< "Exact Box, Exact Sphere and the smoothed query run on the CPU only; computing on the CPU.");
     return false;
   }
   if (!device.available)

@@ -178,9 +178,10 @@ public:
   ///@}
 
   ///@{
-  /// Compute backend: AUTO (default: CUDA for the separable methods when a device is
-  /// present and the extent has at least AutoCudaMinimumVoxels voxels, else the CPU),
-  /// CPU, or CUDA. Without a CUDA build or device, for the exact methods, or when the
+  /// Compute backend: AUTO (default: CUDA for the separable methods and Histogram CDF,
+  /// with the voxel value or an iso value as the query, when a device is present and the
+  /// extent has at least AutoCudaMinimumVoxels voxels, else the CPU), CPU, or CUDA.
+  /// Without a CUDA build or device, for the exact methods or the smoothed query, or when the
   /// device fails (e.g. out of memory), the CPU runs, with a warning when CUDA was asked
   /// for. The backend that ran ("CPU" or "CUDA") is reported by GetLastBackend() and in
   /// the output's field data string "AmbientOcclusionBackend".

@@ -6,6 +6,8 @@
 // reason, where there is none; CudaBackend.ReportsItsStateWithoutCrashing runs everywhere.
 #include "CudaTestSupport.h"
 
+#include "vao/HistogramCdf.h"
+
 using namespace vaotest;
 
 namespace
@@ -205,3 +207,43 @@ TEST(CudaTiming, FillsTimingAndRepeatsBitForBit)
 }
 
 } // namespace
+
+// ---------------------------------------------------------------------------------------
+// Histogram CDF: the same counts on the device, so the same floats as the CPU.
+
+TEST(CudaAmbientOcclusion, HistogramCdfEqualsTheCpu)
+{
+  VAO_REQUIRE_CUDA_DEVICE();
+  const vao::Index3 dims = { 67, 45, 39 };
+  const auto v16 = randomVolume<std::int16_t>(dims, -1024, 2000, 211);
+  const auto v8 = randomVolume<std::uint8_t>(dims, 0, 256, 212);
+  const auto vf = randomVolume<float>(dims, -1, 1, 213);
+  auto check = [&](const vao::VolumeView& view, const vao::Region& region, vao::Radius radius, int bins,
+                 vao::QueryMode query, double iso) {
+    vao::AmbientOcclusionParameters p;
+    p.method = vao::Method::HistogramCdf;
+    p.radius = radius;
+    p.queryMode = query;
+    p.isoValue = iso;
+    ASSERT_TRUE(vao::volumeThresholds(view, bins, p.thresholds).ok);
+    const size_t n = static_cast<size_t>(region.voxelCount());
+    std::vector<float> cpu(n), gpu(n, -1.0f), cpuVar(n), gpuVar(n, -1.0f);
+    ASSERT_TRUE(vao::computeAmbientOcclusion(view, region, p, { cpu.data(), cpuVar.data() }).ok);
+    const vao::Status status = vao::cuda::computeAmbientOcclusion(view, region, p, { gpu.data(), gpuVar.data() });
+    ASSERT_TRUE(status.ok) << status.message;
+    for (size_t i = 0; i < n; ++i)
+    {
+      ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " bins " << bins;
+      ASSERT_NEAR(gpuVar[i], cpuVar[i], 1e-5 * std::max(1.0f, std::abs(cpuVar[i])));
+    }
+  };
+  const vao::Region inner{ { 5, 3, 7 }, { 50, 30, 20 } };
+  for (int bins : { 2, 9, 64, 256 })
+  {
+    check(viewOf(v16, dims), vao::Region::whole(viewOf(v16, dims)), { 5, 5, 5 }, bins, vao::QueryMode::VoxelValue, 0.0);
+    check(viewOf(v8, dims), inner, { 3, 7, 2 }, bins, vao::QueryMode::VoxelValue, 0.0);
+    check(viewOf(vf, dims), inner, { 10, 10, 10 }, bins, vao::QueryMode::IsoValue, 0.2);
+  }
+  // 41^3 voxels: more than 16-bit counts hold on the CPU; the device counts in int.
+  check(viewOf(v8, dims), vao::Region::whole(viewOf(v8, dims)), { 20, 20, 19 }, 64, vao::QueryMode::VoxelValue, 0.0);
+}

@@ -5,7 +5,10 @@
 #include "TestVolumes.h"
 
 #include "../src/VolumeAccess.h"
+#include "../src/cuda/HistogramPipeline.h"
 #include "../src/cuda/Pipeline.h"
+
+#include "vao/HistogramCdf.h"
 
 #include <gtest/gtest.h>
 
@@ -37,6 +40,14 @@ public:
     return buffer;
   }
 
+  template <class U>
+  Buffer<U> upload(const U* host, Index count)
+  {
+    Buffer<U> buffer;
+    buffer.data.assign(host, host + count);
+    return buffer;
+  }
+
   template <class Kernel>
   void launch(const Kernel& kernel, const char*, double)
   {
@@ -64,6 +75,20 @@ struct Results
   std::vector<double> count, mean, varianceD, minimum, maximum;
 };
 
+/// The block the region reads, as CudaBackend.cu uploads it.
+template <class T>
+std::vector<T> blockOf(const std::vector<T>& v, const vao::Index3& dims, const vao::Region& region,
+  const vao::gpu::RegionGeometry& g)
+{
+  std::vector<T> block;
+  const Index x0 = region.begin[0] - g.ox, y0 = region.begin[1] - g.oy, z0 = region.begin[2] - g.oz;
+  for (Index z = z0; z < z0 + g.sz; ++z)
+    for (Index y = y0; y < y0 + g.sy; ++y)
+      for (Index x = x0; x < x0 + g.sx; ++x)
+        block.push_back(v[(z * dims[1] + y) * dims[0] + x]);
+  return block;
+}
+
 /// The pipeline on the host, set up as CudaBackend.cu sets it up on the device.
 template <class T>
 Results emulate(const std::vector<T>& v, const vao::Index3& dims, const vao::Region& region,
@@ -71,12 +96,7 @@ Results emulate(const std::vector<T>& v, const vao::Index3& dims, const vao::Reg
 {
   using Acc = typename vao::detail::MomentTraits<T>::Accumulator;
   const auto g = vao::gpu::geometryFor(dims, region, radius);
-  std::vector<T> block;
-  const Index x0 = region.begin[0] - g.ox, y0 = region.begin[1] - g.oy, z0 = region.begin[2] - g.oz;
-  for (Index z = z0; z < z0 + g.sz; ++z)
-    for (Index y = y0; y < y0 + g.sy; ++y)
-      for (Index x = x0; x < x0 + g.sx; ++x)
-        block.push_back(v[(z * dims[1] + y) * dims[0] + x]);
+  const std::vector<T> block = blockOf(v, dims, region, g);
   const vao::detail::TypedVolume<T> volume(viewOf(v, dims));
   const Acc shift = vao::detail::MomentTraits<T>::exactInteger ? Acc(0)
                                                                : static_cast<Acc>(vao::detail::sampledMean(volume));
@@ -187,3 +207,49 @@ TEST(GpuPipelineOnHost, EveryEstimatorEqualsTheCpu)
 }
 
 } // namespace
+
+namespace
+{
+
+/// Histogram CDF through the GPU pipeline on the host against the CPU library.
+template <class T>
+void expectHistogramLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, const vao::Region& region,
+  const vao::Radius& radius, int bins, bool iso, double isoValue)
+{
+  const auto view = viewOf(v, dims);
+  vao::AmbientOcclusionParameters p;
+  p.method = vao::Method::HistogramCdf;
+  p.radius = radius;
+  p.queryMode = iso ? vao::QueryMode::IsoValue : vao::QueryMode::VoxelValue;
+  p.isoValue = isoValue;
+  ASSERT_TRUE(vao::volumeThresholds(view, bins, p.thresholds).ok);
+  std::vector<float> cpu(region.voxelCount());
+  ASSERT_TRUE(vao::computeAmbientOcclusion(view, region, p, { cpu.data(), nullptr }).ok);
+  const auto g = vao::gpu::geometryFor(dims, region, radius);
+  const std::vector<T> block = blockOf(v, dims, region, g);
+  std::vector<float> gpu(region.voxelCount(), -1.0f);
+  HostExecutor ex;
+  vao::gpu::runHistogramPasses<T>(ex, block.data(), g, p.thresholds.data(), static_cast<int>(p.thresholds.size()),
+    iso, isoValue, gpu.data());
+  for (size_t i = 0; i < cpu.size(); ++i)
+    ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " bins " << bins;
+}
+
+} // namespace
+
+TEST(GpuPipelineOnHost, HistogramCdfEqualsTheCpu)
+{
+  const vao::Index3 dims = { 19, 13, 11 };
+  const auto i16 = randomVolume<std::int16_t>(dims, -1024, 2000, 301);
+  const auto u8 = randomVolume<std::uint8_t>(dims, 0, 256, 302);
+  const auto f32 = randomVolume<float>(dims, -1, 1, 303);
+  const vao::Region whole{ { 0, 0, 0 }, dims }, inner{ { 3, 2, 4 }, { 11, 8, 5 } };
+  for (int bins : { 2, 7, 64 })
+  {
+    expectHistogramLikeTheCpu(i16, dims, whole, { 2, 2, 2 }, bins, false, 0.0);
+    expectHistogramLikeTheCpu(u8, dims, inner, { 3, 1, 4 }, bins, false, 0.0);
+    expectHistogramLikeTheCpu(f32, dims, inner, { 1, 5, 2 }, bins, true, 0.1);
+    expectHistogramLikeTheCpu(i16, dims, whole, { 20, 20, 20 }, bins, false, 0.0);
+  }
+  expectHistogramLikeTheCpu(u8, dims, whole, { 2, 3, 2 }, 256, false, 0.0);
+}

@@ -6,6 +6,7 @@
 #include "vao/Validation.h"
 
 #include "VolumeAccess.h"
+#include "HistogramPipeline.h"
 #include "Pipeline.h"
 
 #include <cuda_runtime.h>
@@ -134,6 +135,14 @@ public:
     return DeviceBuffer<U>(count);
   }
 
+  template <class U>
+  DeviceBuffer<U> upload(const U* host, Index count)
+  {
+    DeviceBuffer<U> buffer(count);
+    check(cudaMemcpy(buffer.get(), host, count * sizeof(U), cudaMemcpyHostToDevice), "upload");
+    return buffer;
+  }
+
   template <class Kernel>
   void launch(const Kernel& kernel, const char* name, double bytes)
   {
@@ -247,7 +256,30 @@ struct HostOutputs
   float* openness = nullptr;
   float* variance = nullptr;
   BoxStatisticsOutput statistics;
+  const AmbientOcclusionParameters* histogram = nullptr; // Histogram CDF's openness instead
 };
+
+/// Histogram CDF's openness (HistogramPipeline.h) into host.openness.
+template <class T>
+void runHistogram(const VolumeView& view, const Region& region, const AmbientOcclusionParameters& p,
+  float* hostOpenness, const Execution& execution, Timing* timing)
+{
+  const detail::TypedVolume<T> volume(view);
+  const gpu::RegionGeometry g = gpu::geometryFor(view.dims, region, p.radius);
+  CudaExecutor ex(timing, execution);
+  DeviceBuffer<T> input(g.block());
+  upload(volume, region, g, input.get());
+  ex.progress(0.1);
+  DeviceBuffer<float> openness(g.region());
+  gpu::runHistogramPasses<T>(ex, input.get(), g, p.thresholds.data(), static_cast<int>(p.thresholds.size()),
+    p.queryMode == QueryMode::IsoValue, p.isoValue, openness.get());
+  if (timing)
+  {
+    ex.finish();
+  }
+  check(cudaMemcpy(hostOpenness, openness.get(), g.region() * sizeof(float), cudaMemcpyDeviceToHost), "download");
+  ex.progress(1.0);
+}
 
 template <class T>
 void run(const VolumeView& view, const Region& region, const Radius& radius, bool withExtrema,
@@ -296,7 +328,18 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   const gpu::EstimatorSetting& estimator, const HostOutputs& host, const Execution& execution, Timing* timing)
 {
   ValueScan scan;
-  const Status status = validateMomentRequest(view, region, radius, scan);
+  Status status;
+  if (host.histogram)
+  {
+    // Counts, not moments: no magnitude limit, only finite values.
+    status = validate(view, region, radius);
+    if (status.ok && needsValueScan(view.type))
+      status = finiteStatus(scanValues(view));
+  }
+  else
+  {
+    status = validateMomentRequest(view, region, radius, scan);
+  }
   if (!status.ok)
   {
     return status;
@@ -314,7 +357,10 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   try
   {
     detail::dispatchScalarType(view.type, [&](auto tag) {
-      run<decltype(tag)>(view, region, radius, withExtrema, estimator, scan, host, execution, timing);
+      if (host.histogram)
+        runHistogram<decltype(tag)>(view, region, *host.histogram, host.openness, execution, timing);
+      else
+        run<decltype(tag)>(view, region, radius, withExtrema, estimator, scan, host, execution, timing);
     });
     check(cudaDeviceSynchronize(), "synchronize");
   }
@@ -380,15 +426,32 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& p, const AmbientOcclusionOutput& output,
   const Execution& execution, Timing* timing)
 {
-  if (!isSeparableMethod(p.method))
+  if (!isSeparableMethod(p.method) && p.method != Method::HistogramCdf)
   {
-    return Status::device(p.method == Method::HistogramCdf
-        ? "Histogram CDF runs on the CPU only"
-        : "the exact references (Exact Box, Exact Sphere) run on the CPU only");
+    return Status::device("the exact references (Exact Box, Exact Sphere) run on the CPU only");
   }
   if (p.queryMode == QueryMode::SmoothedValue)
   {
     return Status::device("the smoothed query runs on the CPU only");
+  }
+  if (p.method == Method::HistogramCdf)
+  {
+    Status status = checkHistogramThresholds(p.thresholds);
+    if (status.ok && p.queryMode == QueryMode::IsoValue)
+      status = checkFiniteParameter(p.isoValue, "the iso value");
+    HostOutputs host;
+    host.openness = output.openness;
+    host.histogram = &p;
+    const gpu::EstimatorSetting none{ Method::GaussianCdf, QueryMode::VoxelValue, 0.0, ErfMode::Exact };
+    if (status.ok && output.openness)
+      status = runChecked(volume, region, p.radius, false, none, host, execution, timing);
+    if (status.ok && output.variance)
+    {
+      HostOutputs variance; // the box variance comes from the moments, as on the CPU
+      variance.variance = output.variance;
+      status = runChecked(volume, region, p.radius, false, none, variance, execution, timing);
+    }
+    return status;
   }
   if (p.queryMode == QueryMode::IsoValue)
   {

@@ -114,12 +114,13 @@ struct MomentSource
   }
 };
 
-/// Box sums of both moments along one axis: one thread per (lane, segment of outputs),
-/// a running window moved by one addition and one subtraction per output.
-template <class TIn, class Acc, bool FromInput>
-struct MomentKernel
+/// Box sums of two channels along one axis (the moments, or Histogram CDF's indicators):
+/// one thread per (lane, segment of outputs), a running window moved by one addition and
+/// one subtraction per output. Source::load(index, v1, v2) gives a voxel's two values.
+template <class Source, class Acc>
+struct SumKernel
 {
-  MomentSource<TIn, Acc, FromInput> source;
+  Source source;
   Acc* out1;
   Acc* out2;
   AxisPass pass;
@@ -162,6 +163,9 @@ struct MomentKernel
     }
   }
 };
+
+template <class TIn, class Acc, bool FromInput>
+using MomentKernel = SumKernel<MomentSource<TIn, Acc, FromInput>, Acc>;
 
 /// The two van Herk steps along one axis, one thread per (lane, block of w = 2r + 1
 /// voxels). Suffix (step 1): suffix minimum and maximum of every block into suf*. Output
