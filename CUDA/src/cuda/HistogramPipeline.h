@@ -97,22 +97,7 @@ struct GatherKernel
 
   VAO_HD void operator()(Index thread) const
   {
-    const Index lanes = g.rx * g.ry;
-    const Index lane = thread % lanes;
-    const Index first = (thread / lanes) * segment;
-    const Index last = lower(first + segment, g.rz);
-    const Index r = g.radius[2];
-    const Index lo = greater(Index(0), g.oz + first - r), hi = lower(g.sz - 1, g.oz + first + r);
-    int s1 = 0, s2 = 0;
-    for (Index j = lo; j <= hi; ++j)
-    {
-      s1 += sum1[j * lanes + lane];
-      s2 += sum2[j * lanes + lane];
-    }
-    for (Index o = first; o < last; ++o)
-    {
-      const Index z = g.oz + o;
-      const Index index = o * lanes + lane;
+    zRunningSums(sum1, sum2, g, segment, thread, [&](Index index, Index, Index, Index, int s1, int s2) {
       const int u = upper[index];
       if (u - 1 == k)
         below[index] = s1;
@@ -122,17 +107,7 @@ struct GatherKernel
         atOrBelow[index] = s1;
       else if (u == k + 1)
         atOrBelow[index] = s2;
-      if (z + r + 1 <= g.sz - 1)
-      {
-        s1 += sum1[(z + r + 1) * lanes + lane];
-        s2 += sum2[(z + r + 1) * lanes + lane];
-      }
-      if (z - r >= 0)
-      {
-        s1 -= sum1[(z - r) * lanes + lane];
-        s2 -= sum2[(z - r) * lanes + lane];
-      }
-    }
+    });
   }
 };
 

@@ -309,6 +309,43 @@ struct EstimatorSetting
   double roundingVariance = 0.0; // of the moment sums (MomentScale)
 };
 
+/// Running sums along z of two x-y box sums ([sz][ry][rx]) for one thread of a z pass:
+/// one (x, y) column of the region and a segment of its slices; visit(index, z, x, y, s1,
+/// s2) gets each voxel's box sums (index in the region, x fastest; z in the block).
+template <class Acc, class Visit>
+VAO_HD void zRunningSums(const Acc* sum1, const Acc* sum2, const RegionGeometry& g, Index segment, Index thread,
+  Visit&& visit)
+{
+  const Index lanes = g.rx * g.ry;
+  const Index lane = thread % lanes;
+  const Index x = lane % g.rx, y = lane / g.rx;
+  const Index first = (thread / lanes) * segment;
+  const Index last = lower(first + segment, g.rz);
+  const Index r = g.radius[2];
+  const Index lo = greater(Index(0), g.oz + first - r), hi = lower(g.sz - 1, g.oz + first + r);
+  Acc s1 = 0, s2 = 0;
+  for (Index j = lo; j <= hi; ++j)
+  {
+    s1 += sum1[j * lanes + lane];
+    s2 += sum2[j * lanes + lane];
+  }
+  for (Index k = first; k < last; ++k)
+  {
+    const Index z = g.oz + k;
+    visit(k * lanes + lane, z, x, y, s1, s2);
+    if (z + r + 1 <= g.sz - 1)
+    {
+      s1 += sum1[(z + r + 1) * lanes + lane];
+      s2 += sum2[(z + r + 1) * lanes + lane];
+    }
+    if (z - r >= 0)
+    {
+      s1 -= sum1[(z - r) * lanes + lane];
+      s2 -= sum2[(z - r) * lanes + lane];
+    }
+  }
+}
+
 /// The z pass fused with the estimator: one thread per (x, y) column of the region and
 /// segment of slices; running sums of both moments along z, then the formulas of
 /// Estimators.h on each voxel's statistics.
@@ -330,38 +367,12 @@ struct FinalKernel
 
   VAO_HD void operator()(Index thread) const
   {
-    const Index lanes = g.rx * g.ry;
-    const Index lane = thread % lanes;
-    const Index x = lane % g.rx, y = lane / g.rx;
-    const Index first = (thread / lanes) * segment;
-    const Index last = lower(first + segment, g.rz);
     const Index r = g.radius[2];
-    const Index countXY =
-      clippedWindowCount(g.ox + x, g.radius[0], g.sx) * clippedWindowCount(g.oy + y, g.radius[1], g.sy);
-    const Index lo = greater(Index(0), g.oz + first - r), hi = lower(g.sz - 1, g.oz + first + r);
-    Acc s1 = 0, s2 = 0;
-    for (Index j = lo; j <= hi; ++j)
-    {
-      s1 += sum1[j * lanes + lane];
-      s2 += sum2[j * lanes + lane];
-    }
-    for (Index k = first; k < last; ++k)
-    {
-      const Index z = g.oz + k;
-      const Index index = k * lanes + lane; // in the region, x fastest
-      const long long count = countXY * clippedWindowCount(z, r, g.sz);
+    zRunningSums(sum1, sum2, g, segment, thread, [&](Index index, Index z, Index x, Index y, Acc s1, Acc s2) {
+      const long long count = clippedWindowCount(g.ox + x, g.radius[0], g.sx) *
+        clippedWindowCount(g.oy + y, g.radius[1], g.sy) * clippedWindowCount(z, r, g.sz);
       this->write(index, z, x, y, count, s1, s2);
-      if (z + r + 1 <= g.sz - 1)
-      {
-        s1 += sum1[(z + r + 1) * lanes + lane];
-        s2 += sum2[(z + r + 1) * lanes + lane];
-      }
-      if (z - r >= 0)
-      {
-        s1 -= sum1[(z - r) * lanes + lane];
-        s2 -= sum2[(z - r) * lanes + lane];
-      }
-    }
+    });
   }
 
   VAO_HD void write(Index index, Index z, Index x, Index y, long long count, Acc s1, Acc s2) const
