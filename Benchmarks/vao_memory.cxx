@@ -88,6 +88,7 @@ struct Case
 };
 
 const Case kCases[] = {
+  { "Histogram CDF", "AmbientOcclusion" },
   { "Gaussian CDF", "AmbientOcclusion" },
   { "CDF Reconstruction", "AmbientOcclusion" },
   { "Chebyshev", "AmbientOcclusion" },
@@ -100,7 +101,7 @@ const Case kCases[] = {
   { "Exact Box", "AmbientOcclusion" },   // only with --exact (minutes: O(R^3))
   { "Exact Sphere", "AmbientOcclusion" }, // only with --exact
 };
-constexpr int kFirstExactCase = 9;
+constexpr int kFirstExactCase = 10;
 
 /// The filter of case c on `input`, ready to update.
 vtkSmartPointer<vtkAlgorithm> MakeFilter(int c, vtkImageData* input, double radius, int threads)
@@ -157,6 +158,7 @@ vtkSmartPointer<vtkAlgorithm> MakeFilter(int c, vtkImageData* input, double radi
       : name == "Chebyshev"                  ? vtkVolumetricAmbientOcclusion::CHEBYSHEV
       : name == "Exact Box"                  ? vtkVolumetricAmbientOcclusion::EXACT_BOX
       : name == "Exact Sphere"               ? vtkVolumetricAmbientOcclusion::EXACT_SPHERE
+      : name == "Histogram CDF"              ? vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF
                                              : vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF);
   ao->SetComputeVariance(name == "Gaussian CDF + variance");
   return ao;

@@ -51,13 +51,14 @@ std::int64_t tileStateBytes(std::int64_t tile, const Radius& r, int lanes, int l
 
 /// The tile's side: 64 (the fastest measured on 256^2 slices at R = 5 and 10; larger tiles
 /// leave the L2 cache, smaller ones recount more of their border), smaller when the
-/// workers' states would exceed a fifth of the input, down to 16.
+/// workers' states would exceed an eighth of the input (the rest of the 25% the filter
+/// may add goes to buffers that do not shrink with the tile), down to 16.
 std::int64_t tileSize(std::int64_t inputBytes, const Radius& r, int lanes, int laneBytes, int threads)
 {
   std::int64_t tile = 64;
-  while (tile > 16 && threads * tileStateBytes(tile, r, lanes, laneBytes) > inputBytes / 5)
+  while (tile > 16 && threads * tileStateBytes(tile, r, lanes, laneBytes) > inputBytes / 8)
   {
-    tile -= 16;
+    tile -= 8;
   }
   return tile;
 }
