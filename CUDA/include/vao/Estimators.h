@@ -248,15 +248,29 @@ VAO_HD double opennessFromStats(
 }
 
 /// Mean and variance of a box of `count` voxels from exact integer sums of v and v^2.
-/// The numerator count * sumSquares - sum^2 is exact in 128 bits, so the variance is
-/// correctly rounded and does not depend on how the sums were formed: a distributed or
-/// streamed run gives the serial bits.
+/// The numerator count * sumSquares - sum^2 is exact (in 64 bits when it fits, as it does
+/// for 16-bit data in boxes of up to 65536 voxels, else in 128), and its conversion to
+/// double is correctly rounded either way, so the variance does not depend on how the sums
+/// were formed: a distributed or streamed run gives the serial bits.
 VAO_HD void meanVarianceFromExactSums(
   long long sum, long long sumSquares, long long count, double& mean, double& variance)
 {
-  const __int128 numerator = static_cast<__int128>(count) * sumSquares - static_cast<__int128>(sum) * sum;
   const double n = static_cast<double>(count);
   mean = static_cast<double>(sum) / n;
+  long long a = 0, b = 0;
+#if defined(__CUDA_ARCH__)
+  const bool fits = false;
+#else
+  const bool fits = !__builtin_mul_overflow(count, sumSquares, &a) && !__builtin_mul_overflow(sum, sum, &b);
+#endif
+  if (fits)
+  {
+    // a - b >= 0 up to rounding-free integer arithmetic (Cauchy-Schwarz), so no overflow.
+    const long long numerator = a - b;
+    variance = numerator > 0 ? static_cast<double>(numerator) / (n * n) : 0.0;
+    return;
+  }
+  const __int128 numerator = static_cast<__int128>(count) * sumSquares - static_cast<__int128>(sum) * sum;
   variance = numerator > 0 ? static_cast<double>(numerator) / (n * n) : 0.0;
 }
 
