@@ -98,7 +98,8 @@ VAO_HD double flatOpenness(double query, double mean, double roundingVariance = 
 {
   const double scale = mean > 1.0 ? mean : (mean < -1.0 ? -mean : 1.0);
   const double relative = kFlatSpread * scale;
-  const double rounding = sqrt(roundingVariance * kSumRoundingUlps * kDoubleUlp);
+  // No square root for exact sums (no rounding): flat boxes are most of many volumes.
+  const double rounding = roundingVariance > 0.0 ? sqrt(roundingVariance * kSumRoundingUlps * kDoubleUlp) : 0.0;
   return query >= mean - (rounding > relative ? rounding : relative) ? 1.0 : 0.0;
 }
 
