@@ -11,6 +11,7 @@
 // invertible, so they take three van Herk passes (x and y per slice, then z per row).
 #pragma once
 
+#include "CpuDispatch.h"
 #include "Parallel.h"
 #include "SlidingExtremum.h"
 #include "VolumeAccess.h"
@@ -56,6 +57,23 @@ struct BoxGeometry
   }
 };
 
+/// One row of the y pass: plane += run (when plane is not null), then the running column
+/// sums move on: run = (run + entering) - leaving, in that order (the rounding of double
+/// sums is that of the scalar code it replaced). Compiled for AVX2 too (CpuDispatch.h).
+template <class Acc>
+struct SlideColumns
+{
+  static VAO_ALWAYS_INLINE void run(Acc* __restrict plane, Acc* __restrict run, const Acc* __restrict entering,
+    const Acc* __restrict leaving, std::int64_t n)
+  {
+    if (plane)
+      for (std::int64_t i = 0; i < n; ++i)
+        plane[i] += run[i];
+    for (std::int64_t i = 0; i < n; ++i)
+      run[i] = (run[i] + entering[i]) - leaving[i];
+  }
+};
+
 /// Box sums of (v - shift) and (v - shift)^2 for one slice of the region at a time.
 template <class T>
 class MomentPlanes
@@ -75,6 +93,7 @@ public:
     , XBox2(geometry.ys.size() * geometry.region.size[0])
     , Run1(geometry.region.size[0])
     , Run2(geometry.region.size[0])
+    , Zeros(geometry.region.size[0], Acc(0))
   {
   }
 
@@ -160,45 +179,21 @@ private:
     const std::int64_t ny = this->Geo.dims[1];
     const std::int64_t y0 = this->Geo.region.begin[1];
     const std::int64_t yLo = this->Geo.ys.lo;
+    const Acc* zeros = this->Zeros.data();
     std::fill(run, run + nx, Acc(0));
     for (std::int64_t y = std::max<std::int64_t>(0, y0 - r); y <= std::min(ny - 1, y0 + r); ++y)
     {
-      const Acc* src = xbox + (y - yLo) * nx;
-      for (std::int64_t i = 0; i < nx; ++i)
-      {
-        run[i] += src[i];
-      }
+      runRows<SlideColumns<Acc>>(this->Avx2, static_cast<Acc*>(nullptr), run, xbox + (y - yLo) * nx, zeros, nx);
     }
     for (std::int64_t row = 0; row < this->Geo.region.size[1]; ++row)
     {
-      Acc* dst = plane + row * nx;
-      for (std::int64_t i = 0; i < nx; ++i)
-      {
-        dst[i] += run[i];
-      }
-      if (row + 1 == this->Geo.region.size[1])
-      {
-        break; // no next row: its window's entering row may lie past the rows read
-      }
+      // The last row has no next one: its window's entering row may lie past the rows read.
       const std::int64_t y = y0 + row;
-      const std::int64_t entering = y + r + 1;
-      const std::int64_t leaving = y - r;
-      if (entering < ny)
-      {
-        const Acc* src = xbox + (entering - yLo) * nx;
-        for (std::int64_t i = 0; i < nx; ++i)
-        {
-          run[i] += src[i];
-        }
-      }
-      if (leaving >= 0)
-      {
-        const Acc* src = xbox + (leaving - yLo) * nx;
-        for (std::int64_t i = 0; i < nx; ++i)
-        {
-          run[i] -= src[i];
-        }
-      }
+      const bool last = row + 1 == this->Geo.region.size[1];
+      const std::int64_t entering = y + r + 1, leaving = y - r;
+      const Acc* in = !last && entering < ny ? xbox + (entering - yLo) * nx : zeros;
+      const Acc* out = !last && leaving >= 0 ? xbox + (leaving - yLo) * nx : zeros;
+      runRows<SlideColumns<Acc>>(this->Avx2, plane + row * nx, run, in, out, nx);
     }
   }
 
@@ -209,6 +204,8 @@ private:
   std::vector<Acc> Row1, Row2;
   std::vector<Acc> XBox1, XBox2;
   std::vector<Acc> Run1, Run2;
+  std::vector<Acc> Zeros; // a row outside the volume
+  bool Avx2 = cpuHasAvx2();
 };
 
 /// Per-slice view handed to the consumer of the moments: everything needed to turn the
