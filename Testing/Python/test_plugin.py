@@ -16,6 +16,23 @@ plugin, shared, out_dir = sys.argv[1:4]
 LoadPlugin(plugin, ns=globals())
 check("VolumetricAmbientOcclusion" in globals(), "the plugin defines VolumetricAmbientOcclusion")
 
+# One version everywhere a user looks: the plugin (Manage Plugins), the CMake package,
+# CITATION.cff and the newest CHANGELOG entry.
+import re  # noqa: E402
+root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+plugins = servermanager.vtkPVPluginsInformation()
+servermanager.ActiveConnection.Session.GatherInformation(servermanager.vtkPVSession.CLIENT, plugins, 0)
+plugin_version = [plugins.GetPluginVersion(i) for i in range(plugins.GetNumberOfPlugins())
+                  if plugins.GetPluginName(i) == "VolumetricAO"]
+config = os.path.join(os.path.dirname(plugin), "..", "..", "..", "cmake", "VolumetricAO",
+                      "VolumetricAOConfigVersion.cmake")
+package_version = re.search(r'set\(PACKAGE_VERSION "([0-9.]+)"\)', open(config).read()).group(1)
+citation_version = re.search(r"^version: *([0-9.]+)", open(os.path.join(root, "CITATION.cff")).read(), re.M).group(1)
+changelog_version = re.search(r"^## ([0-9.]+)", open(os.path.join(root, "CHANGELOG.md")).read(), re.M).group(1)
+check(plugin_version == [package_version] and package_version == citation_version == changelog_version,
+      "one version: plugin %s, CMake package %s, CITATION.cff %s, CHANGELOG %s"
+      % (plugin_version, package_version, citation_version, changelog_version))
+
 wavelet = Wavelet(WholeExtent=[-12, 12, -10, 10, -8, 8])
 ao = VolumetricAmbientOcclusion(Input=wavelet)
 
