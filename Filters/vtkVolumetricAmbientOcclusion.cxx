@@ -18,6 +18,7 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkIntArray.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
@@ -385,6 +386,12 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     backend->SetName("AmbientOcclusionBackend");
     backend->InsertNextValue(this->LastBackend);
     output->GetFieldData()->AddArray(backend);
+    // The CPU threads this process used (or would have used, on the GPU backend): under
+    // MPI the cores are shared among the node's ranks.
+    vtkNew<vtkIntArray> threads;
+    threads->SetName("AmbientOcclusionThreads");
+    threads->InsertNextValue(vao::threadCount(this->NumberOfThreads));
+    output->GetFieldData()->AddArray(threads);
     return 1;
   });
 }

@@ -167,6 +167,12 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
 Status computeBoxStatistics(const VolumeView& volume, const Region& region, const Radius& radius,
   const BoxStatisticsOutput& output, const Execution& execution = {});
 
+/// The CPU threads a call with Execution::threads = `requested` uses: `requested` when
+/// above 0, else the cores this process may run on divided by the MPI ranks on its node
+/// (when a launcher says how many: OMPI_COMM_WORLD_LOCAL_SIZE, MPI_LOCALNRANKS,
+/// MV2_COMM_WORLD_LOCAL_SIZE), at least 1.
+int threadCount(int requested);
+
 /// Number of voxels that are NaN or infinite (always 0 for integer types); the index of the
 /// first one goes to firstIndex when not null. Runs on every core.
 std::int64_t countNonFinite(const VolumeView& volume, std::int64_t* firstIndex = nullptr);

@@ -288,4 +288,10 @@ bool parallelFor(std::int64_t n, int chunks, int threads, const Execution& execu
 }
 
 } // namespace detail
+
+int threadCount(int requested)
+{
+  return detail::resolveThreadCount(requested);
+}
+
 } // namespace vao
