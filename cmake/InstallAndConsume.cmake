@@ -4,6 +4,8 @@
 #   3. configure Examples/Consumer against that prefix only, build it, run it
 #   4. with ParaView: load the installed plugin in pvpython (its RPATH must find the
 #      installed module library)
+#   5. with the Python package: Testing/Python/test_package.py against the installed
+#      package, in python3 and in pvpython
 # Any failure stops the script with FATAL_ERROR, which fails the test.
 cmake_minimum_required(VERSION 3.16)
 
@@ -113,6 +115,18 @@ if info is None:
 print('installed plugin OK, AmbientOcclusion range', info.GetRange())
 ")
   vao_run("pvpython with the installed plugin" "${VAO_PVPYTHON}" "${script}")
+endif()
+
+# 5. The installed Python package, in both interpreters.
+if(VAO_PYTHON_DESTINATION)
+  vao_expect("${VAO_PYTHON_DESTINATION}/volumetricao/__init__.py")
+  find_program(VAO_PYTHON3 python3 PATHS /usr/bin NO_DEFAULT_PATH)
+  foreach(interpreter IN ITEMS "${VAO_PYTHON3}" "${VAO_PVPYTHON}")
+    if(interpreter)
+      vao_run("the installed Python package in ${interpreter}" "${interpreter}" "${VAO_PACKAGE_TEST}"
+        "${VAO_INSTALL_PREFIX}/${VAO_PYTHON_DESTINATION}" "${VAO_VERSION}")
+    endif()
+  endforeach()
 endif()
 
 message(STATUS "InstallAndConsume: OK")
