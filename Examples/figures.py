@@ -185,7 +185,7 @@ def accuracy(source, array, tag, spacing):
         ao = VolumetricAmbientOcclusion(Input=source, Method=method, Radius=10)
         ao.Scalars = ["POINTS", array]
         shaded = AmbientOcclusionShading(Input=ao, **SHADING_ARGS)
-        shaded.Scalars = array
+        shaded.Scalars = ["POINTS", array]
         panels.append(render_rgba(shaded, method + ", R = 10", os.path.join(out_dir, "_panel%d.png" % i),
                                   bounds, spacing))
         print("  accuracy %-20s %.1f s" % (method, time.time() - t0))
@@ -213,7 +213,7 @@ def ruiz(source, array, tag, spacing):
             shaded = AmbientOcclusionShading(Input=ao, **shading_args)
             if method == "Gaussian CDF":
                 gaussian = ao
-        shaded.Scalars = array
+        shaded.Scalars = ["POINTS", array]
         panels.append(render_rgba(shaded, text if method is None else text + ", R = 10",
                                   os.path.join(out_dir, "_panel%d.png" % i), bounds, spacing))
         print("  ruiz %-20s %.1f s" % (text, time.time() - t0))
@@ -227,7 +227,7 @@ def ruiz(source, array, tag, spacing):
         # tissue and ~470 HU at bone: s2max = 600^2 fades the first and keeps the second.
         shaded = AmbientOcclusionShading(Input=gaussian, ModulateOpacity=modulate, VarianceMax=600.0 ** 2,
                                          **dict(shading_args, OpacityRamp=[-600.0, 1500.0]))
-        shaded.Scalars = array
+        shaded.Scalars = ["POINTS", array]
         panels.append(render_rgba(shaded, "Gaussian CDF, opacity %s" % ("x variance" if modulate else "as is"),
                                   os.path.join(out_dir, "_panel%d.png" % i), bounds, spacing))
     combine(panels, os.path.join(out_dir, "ruiz_opacity_modulation_%s.png" % tag))
@@ -271,7 +271,7 @@ def penner(source, array, tag):
                    ComputeScalars=0)
     iso = IsosurfaceAmbientOcclusion(Input=bone, Volume=source, ComputeShadows=1,
                                      LightDirection=[0.3, -1.0, 1.0])
-    iso.Scalars = array
+    iso.Scalars = ["POINTS", array]
     # Ambient light dimmed by AO plus direct light dimmed by the shadow (as the C++ test).
     shade = Calculator(Input=iso, ResultArrayName="Shade", Function="AmbientOcclusion*(0.5+0.5*Shadow)")
     bounds = bounds_of(bone)

@@ -140,6 +140,17 @@ std::string vtkAmbientOcclusionShading::CheckInput(vtkPointData* pd, vtkDataArra
 }
 
 //------------------------------------------------------------------------------
+void vtkAmbientOcclusionShading::SetScalarsArray(int, int, int, int association, const char* name)
+{
+  if (association != vtkDataObject::FIELD_ASSOCIATION_POINTS)
+  {
+    vtkErrorMacro(<< "Scalars must be a point array (got association " << association << ").");
+    return;
+  }
+  this->SetScalarsArrayName(name ? name : "");
+}
+
+//------------------------------------------------------------------------------
 void vtkAmbientOcclusionShading::ColourRange(vtkDataArray* scalars, double range[2])
 {
   range[0] = this->ScalarRange[0];

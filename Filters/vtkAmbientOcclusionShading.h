@@ -55,6 +55,9 @@ public:
   vtkGetCharFromStdStringMacro(AmbientOcclusionArrayName);
   vtkSetStdStringFromCharMacro(ScalarsArrayName);
   vtkGetCharFromStdStringMacro(ScalarsArrayName);
+  /// ScalarsArrayName in the form of SetInputArrayToProcess (ParaView's `Scalars =
+  /// ['POINTS', name]`); the association must be points.
+  void SetScalarsArray(int idx, int port, int connection, int association, const char* name);
   ///@}
 
   ///@{

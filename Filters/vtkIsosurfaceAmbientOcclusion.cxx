@@ -77,6 +77,17 @@ vtkMultiProcessController* vtkIsosurfaceAmbientOcclusion::GetController() const
 }
 
 //------------------------------------------------------------------------------
+void vtkIsosurfaceAmbientOcclusion::SetVolumeScalars(int, int, int, int association, const char* name)
+{
+  if (association != vtkDataObject::FIELD_ASSOCIATION_POINTS)
+  {
+    vtkErrorMacro(<< "Scalars must be a point array of the volume (got association " << association << ").");
+    return;
+  }
+  this->SetVolumeScalars(name);
+}
+
+//------------------------------------------------------------------------------
 void vtkIsosurfaceAmbientOcclusion::SetVolumeScalars(const char* name)
 {
   if (name && *name)

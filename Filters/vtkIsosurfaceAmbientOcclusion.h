@@ -65,6 +65,10 @@ public:
   /// The volume's point array (default: its active scalars); the same as
   /// SetInputArrayToProcess(0, 1, 0, FIELD_ASSOCIATION_POINTS, name).
   void SetVolumeScalars(const char* name);
+  /// The same in the form of SetInputArrayToProcess (ParaView's `Scalars = ['POINTS',
+  /// name]`): the index, port and connection are those of the volume's array whatever
+  /// they say; the association must be points.
+  void SetVolumeScalars(int idx, int port, int connection, int association, const char* name);
 
   ///@{
   /// Query value: the volume half a voxel inside the surface (default, the paper) or IsoValue.

@@ -27,6 +27,22 @@ try:
     if not (0.0 <= lo < hi <= 1.0):
         raise RuntimeError('AmbientOcclusion range [%g, %g] is not inside [0, 1]' % (lo, hi))
 
+    # The panel's layout: property groups, sliders (range domains with both ends), and
+    # advanced properties hidden from the default view.
+    groups = [vao.SMProxy.GetPropertyGroup(i).GetXMLLabel() for i in range(vao.SMProxy.GetNumberOfPropertyGroups())]
+    lines.append('VolumetricAmbientOcclusion groups %s' % groups)
+    for label in ('Input', 'Method', 'Neighbourhood', 'Query', 'Output', 'Performance'):
+        if label not in groups:
+            raise RuntimeError('no property group %s in the panel (%s)' % (label, groups))
+    for name in ('Radius', 'QuerySmoothing'):
+        domain = vao.GetProperty(name).SMProperty.FindDomain('vtkSMDoubleRangeDomain')
+        if not (domain and domain.GetMinimumExists(0) and domain.GetMaximumExists(0)):
+            raise RuntimeError('%s has no slider range' % name)
+        lines.append('%s slider %g..%g' % (name, domain.GetMinimum(0), domain.GetMaximum(0)))
+    for name in ('Backend', 'NumberOfThreads', 'Component'):
+        if vao.GetProperty(name).SMProperty.GetPanelVisibility() != 'advanced':
+            raise RuntimeError('%s is not an advanced property' % name)
+
     view = GetActiveViewOrCreate('RenderView')
     for proxy in GetSources().values():
         Hide(proxy, view)

@@ -13,6 +13,6 @@ sweep.Scalars = ["POINTS", "v"]
 SaveData(prefix + "_sweep.pvti", proxy=sweep)
 surface = Contour(Input=XMLImageDataReader(FileName=[source_path]), ContourBy=["POINTS", "v"], Isosurfaces=[0.5])
 shaded = IsosurfaceAmbientOcclusion(Input=surface, Volume=XMLImageDataReader(FileName=[source_path]))
-shaded.Scalars = "v"
+shaded.Scalars = ["POINTS", "v"]
 SaveData(prefix + "_iso.pvtp", proxy=shaded)
 print("finished", flush=True)

@@ -35,7 +35,7 @@ current = OcclusionSweeping(Input=extent_logger(current, target + ".sweeping"), 
                             ConvergenceTolerance=1e-4)
 current.Scalars = ["POINTS", "MetaImage"]
 current = AmbientOcclusionShading(Input=current, AmbientOcclusionArray="GaussianCDF")
-current.Scalars = "MetaImage"
+current.Scalars = ["POINTS", "MetaImage"]
 SaveData(target, proxy=current, DataMode="Binary")
 
 # A local filter asked directly for the writer's pieces (ParaView's decomposition of the

@@ -21,7 +21,7 @@ pieces = XMLImageDataReader(FileName=[source_path])
 volume = extent_logger(XMLImageDataReader(FileName=[source_path]), target + ".volume")
 bone = Contour(Input=pieces, ContourBy=["POINTS", "MetaImage"], Isosurfaces=[400.0], ComputeNormals=0)
 shaded = IsosurfaceAmbientOcclusion(Input=bone, Volume=volume, ComputeShadows=1, LightDirection=[0.0, -1.0, 1.0])
-shaded.Scalars = "MetaImage"
+shaded.Scalars = ["POINTS", "MetaImage"]
 SaveData(target, proxy=shaded, DataMode="Binary")
 
 # The pyramid (Variance Occlusion Map), distributed: each rank computes the level voxels

@@ -222,4 +222,46 @@ SaveData(vti, proxy=final, DataMode="Binary")
 back = read_image(vti)
 for name in ["AmbientOcclusion", "Variance", "MetaImage"]:
     check(np.array_equal(array_of(back, name), array_of(reference, name)), "%s survives the .vti round trip" % name)
+# One vocabulary: every proxy that reads a volume array takes Scalars = ['POINTS', name];
+# a pvpython trace of each filter replays in a fresh session and gives the same arrays.
+ResetSession()
+LoadPlugin(plugin, ns=globals())
+from paraview import smtrace  # noqa: E402
+smtrace.start_trace()
+traced_source = Wavelet(WholeExtent=[-10, 10, -10, 10, -10, 10])
+traced_ao = VolumetricAmbientOcclusion(Input=traced_source, Radius=3, QueryMode="Smoothed Voxel Value")
+traced_ao.Scalars = ["POINTS", "RTData"]
+traced_sweep = OcclusionSweeping(Input=traced_ao, IsoValue=150.0)
+traced_sweep.Scalars = ["POINTS", "RTData"]
+traced_map = VarianceOcclusionMap(Input=traced_ao, NumberOfLevels=3)
+traced_map.Scalars = ["POINTS", "RTData"]
+traced_contour = Contour(Input=traced_source, ContourBy=["POINTS", "RTData"], Isosurfaces=[150.0], ComputeNormals=1)
+traced_iso = IsosurfaceAmbientOcclusion(Input=traced_contour, Volume=traced_source, NumberOfLevels=3)
+traced_iso.Scalars = ["POINTS", "RTData"]
+traced_shading = AmbientOcclusionShading(Input=traced_ao)
+traced_shading.Scalars = ["POINTS", "RTData"]
+for proxy in (traced_ao, traced_sweep, traced_map, traced_iso, traced_shading):
+    proxy.UpdatePipeline()
+trace = smtrace.stop_trace()
+for proxy, name in ((traced_ao, "VolumetricAmbientOcclusion"), (traced_sweep, "OcclusionSweeping"),
+                    (traced_map, "VarianceOcclusionMap"), (traced_iso, "IsosurfaceAmbientOcclusion"),
+                    (traced_shading, "AmbientOcclusionShading")):
+    check(list(proxy.Scalars) == ["POINTS", "RTData"], "%s: Scalars is ['POINTS', name]" % name)
+    check(name in trace, "the trace creates %s" % name)
+expected = {name: array_of(servermanager.Fetch(traced_ao), name) for name in ("AmbientOcclusion",)}
+expected_rgba = array_of(servermanager.Fetch(traced_shading), "ShadedRGBA")
+expected_shadow = array_of(servermanager.Fetch(traced_iso), "AmbientOcclusion")
+ResetSession()
+LoadPlugin(plugin, ns=globals())
+replay = {}
+exec(trace, replay)
+replayed = {proxy.GetXMLName(): proxy for proxy in GetSources().values()}
+check(set(["VolumetricAmbientOcclusion", "OcclusionSweeping", "VarianceOcclusionMap", "IsosurfaceAmbientOcclusion",
+           "AmbientOcclusionShading"]) <= set(replayed), "the replayed trace created every filter (%s)" % sorted(replayed))
+check(np.array_equal(array_of(servermanager.Fetch(replayed["VolumetricAmbientOcclusion"]), "AmbientOcclusion"),
+                     expected["AmbientOcclusion"]), "the replayed Volumetric AO equals the traced one")
+check(np.array_equal(array_of(servermanager.Fetch(replayed["AmbientOcclusionShading"]), "ShadedRGBA"), expected_rgba),
+      "the replayed shading equals the traced one")
+check(np.array_equal(array_of(servermanager.Fetch(replayed["IsosurfaceAmbientOcclusion"]), "AmbientOcclusion"),
+                     expected_shadow), "the replayed isosurface AO equals the traced one")
 print("all plugin checks passed")
