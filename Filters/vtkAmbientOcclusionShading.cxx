@@ -5,6 +5,7 @@
 
 #include "vtkAmbientOcclusionCollectives.h"
 
+#include "vao/AmbientOcclusion.h"
 #include "vao/Shading.h"
 
 #include "vtkColorTransferFunction.h"
@@ -107,6 +108,8 @@ std::string vtkAmbientOcclusionShading::CheckInput(vtkPointData* pd, vtkDataArra
     why << "Gamma must be a finite, positive number (got " << this->Gamma << ").";
   else if (!std::isfinite(this->VarianceMax))
     why << "VarianceMax must be finite (0 or less: automatic).";
+  else if (this->NumberOfThreads < 0)
+    why << vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
   else if (this->ColorPreset < GRAYSCALE || this->ColorPreset > COOL_TO_WARM)
     why << "Unknown ColorPreset " << this->ColorPreset << " (0 Grayscale, 1 Bone, 2 Cool to Warm).";
   else if (!ao || ao->GetNumberOfComponents() != 1)
@@ -186,35 +189,39 @@ bool vtkAmbientOcclusionShading::ShadePoints(
   const double varianceMax =
     this->VarianceMax > 0.0 ? this->VarianceMax : std::pow((range[1] - range[0]) / 20.0, 2.0);
   const vtkIdType n = shaded->GetNumberOfTuples();
-  unsigned char* out = shaded->GetPointer(0);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    if (i % 65536 == 0)
-    {
-      this->UpdateProgress(static_cast<double>(i) / n);
-      if (this->GetAbortExecute())
+  const int components = volume ? 4 : 3;
+  unsigned char* const pixels = shaded->GetPointer(0);
+  // Points in chunks on the library's workers. Each chunk evaluates its own copies of the
+  // transfer functions: their evaluation may build tables lazily, which is not
+  // thread-safe on one shared object. Progress and abort are polled on this thread.
+  const bool finished = vao::parallelRanges(n, vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads),
+    [&](std::int64_t begin, std::int64_t end) {
+      vtkSmartPointer<vtkScalarsToColors> chunkColors = vtk::TakeSmartPointer(colors->NewInstance());
+      chunkColors->DeepCopy(colors);
+      vtkSmartPointer<vtkPiecewiseFunction> chunkOpacity = vtk::TakeSmartPointer(opacity->NewInstance());
+      chunkOpacity->DeepCopy(opacity);
+      unsigned char* out = pixels + begin * components;
+      for (std::int64_t i = begin; i < end; ++i)
       {
-        return false;
+        double rgb[3] = { 1.0, 1.0, 1.0 };
+        const double v = scalars ? scalars->GetComponent(i, 0) : 0.0;
+        if (scalars)
+        {
+          chunkColors->GetColor(v, rgb);
+        }
+        const double o = ao->GetComponent(i, 0) * (shadow ? shadow->GetComponent(i, 0) : 1.0);
+        for (int c = 0; c < 3; ++c)
+        {
+          *out++ = vao::toByte(vao::ambientLighting(this->AmbientIntensity, o, rgb[c], this->Gamma));
+        }
+        if (volume)
+        {
+          const double m = variance ? vao::varianceModulation(variance->GetComponent(i, 0), varianceMax) : 1.0;
+          *out++ = vao::toByte(chunkOpacity->GetValue(v) * m);
+        }
       }
-    }
-    double rgb[3] = { 1.0, 1.0, 1.0 };
-    const double v = scalars ? scalars->GetComponent(i, 0) : 0.0;
-    if (scalars)
-    {
-      colors->GetColor(v, rgb);
-    }
-    const double o = ao->GetComponent(i, 0) * (shadow ? shadow->GetComponent(i, 0) : 1.0);
-    for (int c = 0; c < 3; ++c)
-    {
-      *out++ = vao::toByte(vao::ambientLighting(this->AmbientIntensity, o, rgb[c], this->Gamma));
-    }
-    if (volume)
-    {
-      const double m = variance ? vao::varianceModulation(variance->GetComponent(i, 0), varianceMax) : 1.0;
-      *out++ = vao::toByte(opacity->GetValue(v) * m);
-    }
-  }
-  return true;
+    });
+  return finished;
 }
 
 //------------------------------------------------------------------------------

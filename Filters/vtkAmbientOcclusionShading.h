@@ -100,6 +100,13 @@ public:
   /// The processes of a distributed run (default: the global controller): the automatic
   /// ScalarRange is the range over all of them, so every piece is coloured alike. Every
   /// process must execute the filter; nullptr: each piece's own range.
+  ///@{
+  /// Threads of this process (0, the default: the cores it may use, divided by the MPI
+  /// ranks on its node). Negative values are an error.
+  vtkSetMacro(NumberOfThreads, int);
+  vtkGetMacro(NumberOfThreads, int);
+  ///@}
+
   void SetController(vtkMultiProcessController* controller);
   vtkMultiProcessController* GetController() const;
   ///@}
@@ -115,6 +122,7 @@ protected:
   std::string ScalarsArrayName;
   double AmbientIntensity = 1.0;
   double Gamma = 1.0;
+  int NumberOfThreads = 0;
   vtkTypeBool ModulateOpacity = false;
   double VarianceMax = 0.0;
   int ColorPreset = GRAYSCALE;

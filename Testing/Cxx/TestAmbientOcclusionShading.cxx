@@ -149,6 +149,42 @@ TEST(AmbientOcclusionShadingFilter, RejectsBadInputWithAClearError)
   auto nanVariance = SmallVolume();
   nanVariance->GetPointData()->GetArray("Variance")->SetComponent(2, 0, nan);
   check(nanVariance, [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); }, "Array 'Variance' has 1 NaN");
+  check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetNumberOfThreads(-2); }, "NumberOfThreads");
+}
+
+TEST(AmbientOcclusionShadingFilter, AnyNumberOfThreadsGivesTheSameColours)
+{
+  // A volume large enough for many chunks, shaded on 1, 2 and 5 threads.
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(61, 47, 33);
+  const vtkIdType n = image->GetNumberOfPoints();
+  std::vector<float> density(n), ao(n), variance(n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    density[i] = static_cast<float>((i * 7919) % 2600) - 1000.0f;
+    ao[i] = static_cast<float>((i * 104729) % 1000) / 999.0f;
+    variance[i] = static_cast<float>((i * 31) % 5000);
+  }
+  image->GetPointData()->SetScalars(Array("Density", density));
+  image->GetPointData()->AddArray(Array("AmbientOcclusion", ao));
+  image->GetPointData()->AddArray(Array("Variance", variance));
+  std::vector<std::vector<unsigned char>> results;
+  for (int threads : { 1, 2, 5 })
+  {
+    vtkNew<vtkAmbientOcclusionShading> shading;
+    shading->SetInputData(image);
+    shading->SetColorPreset(vtkAmbientOcclusionShading::BONE);
+    shading->ModulateOpacityOn();
+    shading->SetNumberOfThreads(threads);
+    shading->Update();
+    vtkDataArray* rgba = vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGBA");
+    ASSERT_NE(rgba, nullptr);
+    ASSERT_EQ(rgba->GetNumberOfTuples(), n);
+    const auto* bytes = static_cast<const unsigned char*>(rgba->GetVoidPointer(0));
+    results.emplace_back(bytes, bytes + 4 * n);
+  }
+  EXPECT_EQ(results[0], results[1]);
+  EXPECT_EQ(results[0], results[2]);
 }
 
 } // namespace

@@ -200,7 +200,7 @@ volume_ao = VolumetricAmbientOcclusion(Input=ct, Radius=5, ComputeVariance=1)
 volume_ao.Scalars = ["POINTS", "MetaImage"]
 lit_volume = AmbientOcclusionShading(Input=volume_ao, ModulateOpacity=1)
 for name in ["AmbientOcclusionArray", "Scalars", "ColorPreset", "ScalarRange", "OpacityRamp", "AmbientIntensity",
-             "Gamma", "ModulateOpacity", "VarianceMax"]:
+             "Gamma", "ModulateOpacity", "VarianceMax", "NumberOfThreads"]:
     prop = lit_volume.GetProperty(name)
     check(prop is not None and len(prop.SMProperty.GetDocumentation().GetDescription().strip()) > 20,
           "AmbientOcclusionShading property %s exists and is documented" % name)

@@ -173,6 +173,13 @@ Status computeBoxStatistics(const VolumeView& volume, const Region& region, cons
 /// MV2_COMM_WORLD_LOCAL_SIZE), at least 1.
 int threadCount(int requested);
 
+/// The library's worker pool for a caller's own loop (the VTK filters' per-point work):
+/// body(begin, end) over chunks of [0, n) on threadCount(execution.threads) threads,
+/// progress and cancellation polled on the calling thread between chunks. Returns false
+/// when cancelled. body must be safe to run on several threads at once.
+bool parallelRanges(std::int64_t n, const Execution& execution,
+  const std::function<void(std::int64_t begin, std::int64_t end)>& body);
+
 /// Number of voxels that are NaN or infinite (always 0 for integer types); the index of the
 /// first one goes to firstIndex when not null. Runs on every core.
 std::int64_t countNonFinite(const VolumeView& volume, std::int64_t* firstIndex = nullptr);

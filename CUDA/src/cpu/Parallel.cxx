@@ -294,4 +294,17 @@ int threadCount(int requested)
   return detail::resolveThreadCount(requested);
 }
 
+bool parallelRanges(std::int64_t n, const Execution& execution,
+  const std::function<void(std::int64_t begin, std::int64_t end)>& body)
+{
+  const int threads = detail::resolveThreadCount(execution.threads);
+  // Enough chunks for progress to move and for uneven chunks to even out.
+  const std::int64_t chunks = std::max<std::int64_t>(1, std::min<std::int64_t>(n, 16 * threads));
+  return detail::parallelFor(n, static_cast<int>(chunks), threads, execution,
+    [&](std::int64_t begin, std::int64_t end, detail::ChunkProgress& progress) {
+      body(begin, end);
+      progress.advance(end - begin);
+    });
+}
+
 } // namespace vao

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# The project against Debian 13 (trixie): ParaView 5.13, VTK 9.3/9.4. Builds a Debian 13
+# root with debootstrap from Debian's own mirror (once; reused afterwards), copies this
+# checkout and ../shared into it, and runs the two set-up commands of the README there:
+# `bash .ci/setup.sh test` (which installs the packages, builds and runs every test).
+# Needs root. Takes about half an hour the first time (downloads), minutes afterwards.
+#
+#   bash Testing/compat/debian13.sh [ROOT_DIR]      (default /var/tmp/vao-debian13)
+set -euo pipefail
+repo="$(cd "$(dirname "$0")/../.." && pwd)"
+shared="$(cd "$repo/../shared" && pwd)"
+root="${1:-/var/tmp/vao-debian13}"
+mirror="http://deb.debian.org/debian"
+
+if [ "$(id -u)" -ne 0 ]; then
+  echo "debian13.sh: needs root (debootstrap, chroot)" >&2
+  exit 2
+fi
+command -v debootstrap >/dev/null || { apt-get update -qq && apt-get install -y -qq debootstrap; }
+
+if [ ! -x "$root/usr/bin/apt-get" ]; then
+  echo "== debootstrap trixie into $root"
+  debootstrap --variant=minbase trixie "$root" "$mirror"
+fi
+
+mounted=()
+cleanup() {
+  for ((i = ${#mounted[@]} - 1; i >= 0; i--)); do umount -l "${mounted[i]}" 2>/dev/null || true; done
+}
+trap cleanup EXIT
+for fs in proc sys dev dev/pts; do
+  mkdir -p "$root/$fs"
+  if ! mountpoint -q "$root/$fs"; then
+    mount --bind "/$fs" "$root/$fs"
+    mounted+=("$root/$fs")
+  fi
+done
+cp /etc/resolv.conf "$root/etc/resolv.conf"
+
+echo "== copying the checkout and ../shared (build trees left out)"
+mkdir -p "$root/work/main" "$root/work/shared"
+tar -C "$repo" --exclude='./build*' --exclude='./vao-output' -cf - . | tar -C "$root/work/main" -xf -
+tar -C "$shared" -cf - . | tar -C "$root/work/shared" -xf -
+
+echo "== inside Debian 13: bash .ci/setup.sh test"
+chroot "$root" /usr/bin/env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
+  LANG=C.UTF-8 bash -c 'apt-get update -qq && apt-get install -y -qq --no-install-recommends ca-certificates sudo > /dev/null &&
+    cd /work/main && grep -h VERSION_CODENAME /etc/os-release && bash .ci/setup.sh test'
