@@ -15,13 +15,18 @@ job="${1:-demo}"
 shift || true
 
 # Verified from a bare Debian 12 (see ../shared/ARCHITECTURE.md), plus scipy for the
-# benchmark's peer.
-packages=(cmake g++ ninja-build paraview-dev paraview python3-paraview qtbase5-dev qttools5-dev
-  libqt5svg5-dev libqt5opengl5-dev qtxmlpatterns5-dev-tools libqt5x11extras5-dev
+# benchmark's peer and python3-dev for the Python package.
+qt_packages=(qtbase5-dev qttools5-dev libqt5svg5-dev libqt5opengl5-dev qtxmlpatterns5-dev-tools
+  libqt5x11extras5-dev)
+# Debian 13's ParaView 5.13 is built with Qt 6 (Testing/compat/debian13.sh runs this there).
+if grep -qs '^VERSION_CODENAME=trixie' /etc/os-release; then
+  qt_packages=(qt6-base-dev qt6-tools-dev qt6-svg-dev qt6-5compat-dev libqt6opengl6-dev)
+fi
+packages=(cmake g++ ninja-build paraview-dev paraview python3-paraview "${qt_packages[@]}"
   libhdf5-openmpi-dev libutfcpp-dev libgl2ps-dev libglew-dev libgdal-dev libnetcdf-dev
   libavcodec-dev libavformat-dev libswscale-dev libtheora-dev libdouble-conversion-dev
   liblz4-dev libexpat1-dev libeigen3-dev libboost-dev libfreetype-dev mpi-default-dev
-  python3-mpi4py libgtest-dev xvfb xauth python3-numpy python3-scipy)
+  python3-mpi4py libgtest-dev xvfb xauth python3-numpy python3-scipy python3-dev)
 # libFuzzer comes with clang (GCC's sanitizers come with g++).
 [ "$job" = fuzz ] && packages+=(clang-16 libclang-rt-16-dev)
 

@@ -43,6 +43,13 @@ tar -C "$repo" --exclude='./build*' --exclude='./vao-output' -cf - . | tar -C "$
 tar -C "$shared" -cf - . | tar -C "$root/work/shared" -xf -
 
 echo "== inside Debian 13: bash .ci/setup.sh test"
+# Debian 13's ParaView CMake files (VTKPython-targets.cmake, ParaViewPython-targets.cmake)
+# name the wrapped modules <module>.so, but python3-paraview ships them as
+# <module>.cpython-3XX-<arch>.so: find_package(ParaView) stops on the missing files. The
+# links below give CMake the names it checks (a packaging slip, not the project's).
 chroot "$root" /usr/bin/env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
-  LANG=C.UTF-8 bash -c 'apt-get update -qq && apt-get install -y -qq --no-install-recommends ca-certificates sudo > /dev/null &&
+  LANG=C.UTF-8 bash -c 'set -e
+    apt-get update -qq && apt-get install -y -qq --no-install-recommends ca-certificates sudo paraview-dev python3-paraview > /dev/null
+    find /usr/lib/python3/dist-packages/vtkmodules /usr/lib/python3/dist-packages/paraview -name "*.cpython-3*-*.so" |
+      while read -r f; do b="${f%%.cpython-*}.so"; [ -e "$b" ] || ln -s "$(basename "$f")" "$b"; done
     cd /work/main && grep -h VERSION_CODENAME /etc/os-release && bash .ci/setup.sh test'
