@@ -178,3 +178,24 @@ TEST(SmoothedQuery, RefusesABadSigma)
     EXPECT_NE(status.message.find("QuerySmoothing"), std::string::npos) << status.message;
   }
 }
+
+TEST(SmoothedQuery, RefusesValuesWhoseDifferencesOverflow)
+{
+  // Differences of +-1e305 overflow double: a clear failure, not NaN openness.
+  const vao::Index3 dims = { 6, 6, 6 };
+  std::vector<double> v(216, 1.0);
+  v[10] = 1e305;
+  v[20] = -1e305;
+  const auto view = viewOf(v, dims);
+  std::vector<float> out(216);
+  vao::AmbientOcclusionParameters p;
+  p.method = vao::Method::ExactBox;
+  p.radius = { 1, 1, 1 };
+  p.queryMode = vao::QueryMode::SmoothedValue;
+  const vao::Status status = vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { out.data(), nullptr });
+  EXPECT_FALSE(status.ok);
+  EXPECT_NE(status.message.find("rescale"), std::string::npos) << status.message;
+  // Without the smoothed query the exact count handles them.
+  p.queryMode = vao::QueryMode::VoxelValue;
+  EXPECT_TRUE(vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { out.data(), nullptr }).ok);
+}

@@ -25,6 +25,8 @@ const char* scalarTypeName(ScalarType type)
 namespace
 {
 
+constexpr double kLargestSmoothedMagnitude = 1e300;
+
 /// The openness (from the streamed moments) and the variance of the box, as asked.
 template <class T>
 Status separableOpenness(const VolumeView& view, const Region& region,
@@ -88,6 +90,13 @@ Status ambientOcclusion(const VolumeView& volume, const Region& region,
     status = validate(volume, region, parameters.radius);
     if (status.ok && !scalarTypeIsIntegral(volume.type))
       status = finiteStatus(scan = scanValues(volume));
+  }
+  if (status.ok && parameters.queryMode == QueryMode::SmoothedValue &&
+    std::max(std::abs(scan.minimum), std::abs(scan.maximum)) > kLargestSmoothedMagnitude)
+  {
+    // The smoothed query sums differences of values: beyond this they overflow double.
+    status = Status::failure("the smoothed query needs values within +-1e300 (their differences would overflow "
+                             "double precision): rescale the data (e.g. with the Calculator) first");
   }
   if (!status.ok)
   {

@@ -4,13 +4,15 @@
 // - a call succeeds, or fails with a message (never a crash, a hang, or an exception);
 // - on success every openness and occlusion lies in [0, 1], and on every box that holds
 //   one value only, every method gives the exact answer (q >= that value), the brute-force
-//   count of METHODS.md computed here;
+//   count of METHODS.md computed here (not for Histogram CDF, which interpolates between
+//   thresholds by definition, nor for the smoothed query, which is not the box's value);
 // - the box statistics are ordered: minimum <= mean <= maximum, variance >= 0.
 // Used by the seeded test that runs in CI (test_fuzz_seeded.cxx) and by the libFuzzer
 // target (fuzz_entry_points.cxx, `bash .ci/setup.sh fuzz`).
 #pragma once
 
 #include "vao/AmbientOcclusion.h"
+#include "vao/HistogramCdf.h"
 #include "vao/OcclusionSweeping.h"
 #include "vao/VarianceOcclusionMap.h"
 
@@ -163,14 +165,20 @@ inline double flatValue(const FuzzVolume& v, std::int64_t x, std::int64_t y, std
 inline void fuzzAmbientOcclusion(ByteReader& in, const FuzzVolume& v)
 {
   vao::AmbientOcclusionParameters p;
-  p.method = static_cast<vao::Method>(in.below(5));
+  p.method = static_cast<vao::Method>(in.below(6));
   p.radius = { in.below(7), in.below(7), in.below(7) };
   p.erfMode = in.flag() ? vao::ErfMode::Winitzki : vao::ErfMode::Exact;
-  p.queryMode = in.below(4) == 0 ? vao::QueryMode::IsoValue : vao::QueryMode::VoxelValue;
+  const int query = in.below(5);
+  p.queryMode = query == 0 ? vao::QueryMode::IsoValue
+                           : (query == 1 ? vao::QueryMode::SmoothedValue : vao::QueryMode::VoxelValue);
   p.isoValue = in.below(8) == 0 ? std::numeric_limits<double>::quiet_NaN() : static_cast<double>(in.bits(1));
+  p.querySmoothing = in.below(24) / 8.0; // 0 (refused) to 2.875 voxels
+  if (p.method == vao::Method::HistogramCdf && !vao::volumeThresholds(v.view, 2 + in.below(300), p.thresholds).ok)
+    p.thresholds = { static_cast<double>(in.bits(1)), static_cast<double>(in.bits(1)) }; // maybe not ascending
   const std::size_t n = v.values.size();
   const std::int64_t box = (2 * p.radius.x + 1) * (2 * p.radius.y + 1) * (2 * p.radius.z + 1);
-  if (!vao::isSeparableMethod(p.method) && static_cast<std::int64_t>(n) * box > 20000000)
+  const bool exact = p.method == vao::Method::ExactBox || p.method == vao::Method::ExactSphere;
+  if (exact && static_cast<std::int64_t>(n) * box > 20000000)
     p.method = vao::Method::GaussianCdf; // the O(R^3) references: small cases only (speed)
   std::vector<float> open(n, -1.0f), variance(n, -1.0f);
   const vao::Status s = vao::computeAmbientOcclusion(v.view, vao::Region::whole(v.view), p,
@@ -178,6 +186,14 @@ inline void fuzzAmbientOcclusion(ByteReader& in, const FuzzVolume& v)
   if (!s.ok)
   {
     check(!s.message.empty(), "a failed Volumetric AO call says why");
+    return;
+  }
+  if (p.queryMode == vao::QueryMode::SmoothedValue || p.method == vao::Method::HistogramCdf)
+  {
+    // No flat rule here: the smoothed query is not the box's value, and Histogram CDF
+    // interpolates between thresholds by definition (METHODS.md 8).
+    for (std::size_t i = 0; i < n; ++i)
+      check(open[i] >= 0.0f && open[i] <= 1.0f, "openness in [0, 1] at voxel " + std::to_string(i));
     return;
   }
   const vao::Index3& d = v.dims;
