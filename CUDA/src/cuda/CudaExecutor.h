@@ -1,0 +1,224 @@
+// The CUDA side of the GPU pipeline's executor (only CudaBackend.cu includes it): errors
+// as exceptions, device buffers, the kernel launcher and the slice transpose, and
+// CudaExecutor, which runs Pipeline.h's passes on the device with optional timing.
+#pragma once
+
+#include "Pipeline.h"
+
+#include "vao/Cuda.h"
+
+#include <cuda_runtime.h>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace vao
+{
+namespace cuda
+{
+namespace
+{
+
+using gpu::Index;
+
+struct CudaFailure : std::runtime_error
+{
+  using std::runtime_error::runtime_error;
+};
+
+/// The user aborted between two stages: unwinds like a failure, reported as cancelled.
+struct Cancelled
+{
+};
+
+void check(cudaError_t error, const char* what)
+{
+  if (error != cudaSuccess)
+  {
+    throw CudaFailure(std::string("CUDA ") + what + ": " + cudaGetErrorString(error));
+  }
+}
+
+/// A device allocation, freed on every exit path.
+template <class T>
+class DeviceBuffer
+{
+public:
+  explicit DeviceBuffer(Index count)
+  {
+    if (count > 0)
+    {
+      check(cudaMalloc(&this->Data, static_cast<size_t>(count) * sizeof(T)), "allocation");
+    }
+  }
+  ~DeviceBuffer() { cudaFree(this->Data); }
+  DeviceBuffer(DeviceBuffer&& other) noexcept : Data(other.Data) { other.Data = nullptr; }
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  T* get() const { return this->Data; }
+
+private:
+  T* Data = nullptr;
+};
+
+constexpr int kThreads = 256;
+
+template <class Kernel>
+__global__ void runKernel(Kernel kernel, Index threads)
+{
+  const Index thread = static_cast<Index>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (thread < threads)
+  {
+    kernel(thread);
+  }
+}
+
+/// out[z][x][y] = in[z][y][x] for every slice, through a padded shared-memory tile.
+template <class T>
+__global__ void transposeSlices(const T* in, T* out, Index nx, Index ny)
+{
+  __shared__ T tile[32][33];
+  const Index z = blockIdx.z;
+  const Index x0 = static_cast<Index>(blockIdx.x) * 32, y0 = static_cast<Index>(blockIdx.y) * 32;
+  for (int j = threadIdx.y; j < 32; j += blockDim.y)
+  {
+    const Index x = x0 + threadIdx.x, y = y0 + j;
+    if (x < nx && y < ny)
+    {
+      tile[j][threadIdx.x] = in[(z * ny + y) * nx + x];
+    }
+  }
+  __syncthreads();
+  for (int j = threadIdx.y; j < 32; j += blockDim.y)
+  {
+    const Index y = y0 + threadIdx.x, x = x0 + j;
+    if (x < nx && y < ny)
+    {
+      out[(z * nx + x) * ny + y] = tile[threadIdx.x][j];
+    }
+  }
+}
+
+/// Runs the pipeline's kernels on the device. When asked for timings, each pass gets a
+/// pair of CUDA events; they are read once at the end (finish), so timing adds no waits
+/// between passes.
+class CudaExecutor
+{
+public:
+  CudaExecutor(Timing* timing, const Execution& execution)
+    : Report(timing)
+    , Exec(execution)
+  {
+  }
+  ~CudaExecutor()
+  {
+    for (const Pass& pass : this->Passes)
+    {
+      if (pass.start)
+        cudaEventDestroy(pass.start);
+      if (pass.stop)
+        cudaEventDestroy(pass.stop);
+    }
+  }
+  CudaExecutor(const CudaExecutor&) = delete;
+  CudaExecutor& operator=(const CudaExecutor&) = delete;
+
+  template <class U>
+  DeviceBuffer<U> allocate(Index count)
+  {
+    return DeviceBuffer<U>(count);
+  }
+
+  template <class U>
+  DeviceBuffer<U> upload(const U* host, Index count)
+  {
+    DeviceBuffer<U> buffer(count);
+    check(cudaMemcpy(buffer.get(), host, count * sizeof(U), cudaMemcpyHostToDevice), "upload");
+    return buffer;
+  }
+
+  template <class Kernel>
+  void launch(const Kernel& kernel, const char* name, double bytes)
+  {
+    const Index threads = kernel.threads();
+    this->begin();
+    if (threads > 0)
+    {
+      runKernel<<<static_cast<unsigned>((threads + kThreads - 1) / kThreads), kThreads>>>(kernel, threads);
+    }
+    this->end(name, bytes);
+  }
+
+  template <class U>
+  void transpose(const U* in, U* out, Index nx, Index ny, Index nz, const char* name)
+  {
+    this->begin();
+    const dim3 grid(static_cast<unsigned>((nx + 31) / 32), static_cast<unsigned>((ny + 31) / 32),
+      static_cast<unsigned>(nz));
+    transposeSlices<U><<<grid, dim3(32, 8)>>>(in, out, nx, ny);
+    this->end(name, 2.0 * nx * ny * nz * sizeof(U));
+  }
+
+  /// Between stages only: a running kernel is not interrupted.
+  void progress(double fraction)
+  {
+    if (this->Exec.progress)
+      this->Exec.progress(fraction);
+    if (this->Exec.abortRequested && this->Exec.abortRequested())
+      throw Cancelled{};
+  }
+
+  /// Waits for the passes and reports their times.
+  void finish()
+  {
+    check(cudaDeviceSynchronize(), "passes");
+    for (const Pass& pass : this->Passes)
+    {
+      float ms = 0.0f;
+      check(cudaEventElapsedTime(&ms, pass.start, pass.stop), "event time");
+      this->Report->passes.push_back({ pass.name, ms, pass.bytes });
+      this->Report->kernelMilliseconds += ms;
+    }
+  }
+
+private:
+  struct Pass
+  {
+    const char* name;
+    double bytes;
+    cudaEvent_t start;
+    cudaEvent_t stop;
+  };
+
+  void begin()
+  {
+    if (!this->Report)
+      return;
+    this->Passes.push_back({ nullptr, 0.0, nullptr, nullptr }); // destroyed with the executor
+    Pass& pass = this->Passes.back();
+    check(cudaEventCreate(&pass.start), "event");
+    check(cudaEventCreate(&pass.stop), "event");
+    check(cudaEventRecord(pass.start), "event record");
+  }
+  /// Ends a pass: checks its launch and records its stop event.
+  void end(const char* name, double bytes)
+  {
+    check(cudaGetLastError(), name);
+    if (!this->Report)
+      return;
+    Pass& pass = this->Passes.back();
+    pass.name = name;
+    pass.bytes = bytes;
+    check(cudaEventRecord(pass.stop), "event record");
+  }
+
+  Timing* Report;
+  const Execution& Exec;
+  std::vector<Pass> Passes;
+};
+
+/// Copies the block the region reads into device memory, contiguous.
+} // namespace
+} // namespace cuda
+} // namespace vao
