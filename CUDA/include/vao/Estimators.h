@@ -218,20 +218,6 @@ VAO_HD double opennessHistogramCdfAt(double q, const double* thresholds, int n, 
   return clamp01(fLower + a * (fUpper - fLower));
 }
 
-/// The same from the box's counts per bin: histogram[b] voxels with thresholdIndex(v) = b.
-template <class Count>
-VAO_HD double opennessHistogramCdf(double q, const double* thresholds, int n, double count, const Count* histogram)
-{
-  const int upper = thresholdIndex(q, thresholds, n);
-  double below = 0.0;
-  for (int b = 0; b < upper && b < n; ++b)
-  {
-    below += static_cast<double>(histogram[b]);
-  }
-  return opennessHistogramCdfAt(
-    q, thresholds, n, upper, count, below, upper < n ? static_cast<double>(histogram[upper]) : 0.0);
-}
-
 /// Dispatch for the separable methods (the exact references count voxels instead).
 VAO_HD double opennessFromStats(
   Method method, double query, const NeighbourhoodStats& s, ErfMode erfMode)

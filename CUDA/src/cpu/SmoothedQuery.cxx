@@ -32,7 +32,7 @@ struct AxisWeights
 
   AxisWeights(std::int64_t begin, std::int64_t count, std::int64_t n, double sigma)
   {
-    half = std::min<std::int64_t>(static_cast<std::int64_t>(std::ceil(3.0 * sigma)), n - 1);
+    half = std::min<std::int64_t>(querySmoothingHalfWidth(sigma), n - 1);
     const std::int64_t taps = 2 * half + 1;
     first.resize(count);
     size.resize(count);
