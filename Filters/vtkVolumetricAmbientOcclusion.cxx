@@ -324,10 +324,13 @@ int vtkVolumetricAmbientOcclusion::RequestData(
       vtkErrorMacro(<< error);
       ok = false;
     }
-    if (ok && this->Method == HISTOGRAM_CDF)
+    vao::ValueScan scan;
+    if (ok && this->Method == HISTOGRAM_CDF && !this->HistogramThresholds)
     {
-      // Before the thresholds, which count finite values only: the kernel's own message.
-      const vao::Status finite = vao::checkFiniteValues(scalars.view);
+      // One pass for the thresholds' value range and, before them (they count finite
+      // values only), the kernel's own message for NaN and infinite voxels.
+      scan = vao::scanValues(scalars.view);
+      const vao::Status finite = vao::finiteStatus(scan);
       if (!finite.ok)
       {
         vtkErrorMacro(<< vtkAmbientOcclusionArrayInput::KernelError(finite, scalars, "Ambient occlusion failed"));
@@ -336,7 +339,7 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     }
     std::vector<double> thresholds;
     if (this->Method == HISTOGRAM_CDF && (ok || this->IsDistributed()) &&
-      !this->Thresholds(input, ok ? &scalars.view : nullptr, outExt, whole, !ok && !emptyPiece, thresholds))
+      !this->Thresholds(input, ok ? &scalars.view : nullptr, scan, outExt, whole, !ok && !emptyPiece, thresholds))
     {
       return 1;
     }

@@ -55,6 +55,7 @@ struct AmbientOcclusionOutput;
 struct AmbientOcclusionParameters;
 struct Region;
 struct Status;
+struct ValueScan;
 struct VolumeView;
 }
 
@@ -246,8 +247,8 @@ private:
   bool IsDistributed() const;
   /// Histogram CDF's thresholds for this run: the given ones, or the whole data set's
   /// (collective in a distributed run; see RequestData).
-  bool Thresholds(vtkImageData* input, const vao::VolumeView* volume, const int outExt[6], const int whole[6],
-    bool failed, std::vector<double>& thresholds);
+  bool Thresholds(vtkImageData* input, const vao::VolumeView* volume, const vao::ValueScan& scan,
+    const int outExt[6], const int whole[6], bool failed, std::vector<double>& thresholds);
   /// The input covers the requested extent `outExt`.
   bool CheckInputCovers(vtkImageData* input, const int outExt[6]);
   /// The radius in voxels for the input's spacing; false when it is 0 on every axis or

@@ -48,7 +48,7 @@ vtkSmartPointer<vtkDoubleArray> vtkVolumetricAmbientOcclusion::ComputeHistogramT
   {
     const int port = this->GetInputConnection(0, 0)->GetIndex();
     vtkAmbientOcclusionArrayInput::ScalarVolume scalars; // the slab being read
-    vtkAmbientOcclusionThresholds::ComputeInSlabs(producer, port, slabs, this->NumberOfBins,
+    const bool read = vtkAmbientOcclusionThresholds::ComputeInSlabs(producer, port, slabs, this->NumberOfBins,
       [&](vtkImageData* image, vao::VolumeView& view, std::string& why) {
         if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
               this, this->GetInputArrayToProcess(0, image), image, this->Component, scalars, why))
@@ -57,6 +57,8 @@ vtkSmartPointer<vtkDoubleArray> vtkVolumetricAmbientOcclusion::ComputeHistogramT
         return true;
       },
       thresholds, error);
+    if (!read && error.empty())
+      error = "the input could not be read in slabs";
   }
   if (!error.empty())
   {
@@ -72,7 +74,7 @@ vtkSmartPointer<vtkDoubleArray> vtkVolumetricAmbientOcclusion::ComputeHistogramT
 
 //------------------------------------------------------------------------------
 bool vtkVolumetricAmbientOcclusion::Thresholds(vtkImageData* input, const vao::VolumeView* volume,
-  const int outExt[6], const int whole[6], bool failed, std::vector<double>& thresholds)
+  const vao::ValueScan& scan, const int outExt[6], const int whole[6], bool failed, std::vector<double>& thresholds)
 {
   std::string error;
   if (this->HistogramThresholds)
@@ -89,7 +91,7 @@ bool vtkVolumetricAmbientOcclusion::Thresholds(vtkImageData* input, const vao::V
     // set); one process counts its input, which is the whole extent.
     const bool distributed = this->IsDistributed();
     const bool computed = vtkAmbientOcclusionThresholds::Compute(distributed ? this->Controller.Get() : nullptr,
-      volume, volume ? input->GetExtent() : outExt, distributed || !volume ? outExt : input->GetExtent(), whole,
+      volume, scan, volume ? input->GetExtent() : outExt, distributed || !volume ? outExt : input->GetExtent(), whole,
       this->NumberOfBins, failed, thresholds, error);
     if (!computed && error.empty())
       return false; // aborted, or this process failed and said why before
