@@ -48,17 +48,10 @@ struct BinKernel
   }
 };
 
-/// The query of region voxel `index` (x fastest): its value in the block, or the iso value.
+/// What the first and the last kernel read of the query: the uploaded block, the region
+/// in it, the iso value (when iso) and the n thresholds in device memory.
 template <class T>
-VAO_HD double regionQuery(const T* input, const RegionGeometry& g, bool iso, double isoValue, Index index)
-{
-  const Index x = index % g.rx, y = (index / g.rx) % g.ry, z = index / (g.rx * g.ry);
-  return iso ? isoValue : static_cast<double>(input[((g.oz + z) * g.sy + g.oy + y) * g.sx + g.ox + x]);
-}
-
-/// upper[i] = thresholdIndex of region voxel i's query; below and atOrBelow start at 0.
-template <class T>
-struct UpperKernel
+struct HistogramQuerySource
 {
   const T* input;
   RegionGeometry g;
@@ -66,14 +59,28 @@ struct UpperKernel
   double isoValue;
   const double* thresholds;
   int n;
+
+  /// The query of region voxel `index` (x fastest): its value in the block, or the iso value.
+  VAO_HD double at(Index index) const
+  {
+    const Index x = index % g.rx, y = (index / g.rx) % g.ry, z = index / (g.rx * g.ry);
+    return iso ? isoValue : static_cast<double>(input[((g.oz + z) * g.sy + g.oy + y) * g.sx + g.ox + x]);
+  }
+};
+
+/// upper[i] = thresholdIndex of region voxel i's query; below and atOrBelow start at 0.
+template <class T>
+struct UpperKernel
+{
+  HistogramQuerySource<T> query;
   int* upper;
   int* below;
   int* atOrBelow;
 
-  VAO_HD Index threads() const { return g.region(); }
+  VAO_HD Index threads() const { return query.g.region(); }
   VAO_HD void operator()(Index i) const
   {
-    upper[i] = thresholdIndex(regionQuery(input, g, iso, isoValue, i), thresholds, n);
+    upper[i] = thresholdIndex(query.at(i), query.thresholds, query.n);
     below[i] = 0;
     atOrBelow[i] = 0;
   }
@@ -115,28 +122,24 @@ struct GatherKernel
 template <class T>
 struct HistogramOpennessKernel
 {
-  const T* input;
-  RegionGeometry g;
-  bool iso;
-  double isoValue;
-  const double* thresholds;
-  int n;
+  HistogramQuerySource<T> query;
   const int* upper;
   const int* below;
   const int* atOrBelow;
   float* openness;
 
-  VAO_HD Index threads() const { return g.region(); }
+  VAO_HD Index threads() const { return query.g.region(); }
   VAO_HD void operator()(Index i) const
   {
+    const RegionGeometry& g = query.g;
     const Index x = i % g.rx, y = (i / g.rx) % g.ry, z = i / (g.rx * g.ry);
     const double count = static_cast<double>(clippedWindowCount(g.ox + x, g.radius[0], g.sx)) *
       static_cast<double>(clippedWindowCount(g.oy + y, g.radius[1], g.sy)) *
       static_cast<double>(clippedWindowCount(g.oz + z, g.radius[2], g.sz));
     const int u = upper[i];
-    const double at = u < n ? static_cast<double>(atOrBelow[i] - below[i]) : 0.0;
+    const double at = u < query.n ? static_cast<double>(atOrBelow[i] - below[i]) : 0.0;
     openness[i] = static_cast<float>(opennessHistogramCdfAt(
-      regionQuery(input, g, iso, isoValue, i), thresholds, n, u, count, static_cast<double>(below[i]), at));
+      query.at(i), query.thresholds, query.n, u, count, static_cast<double>(below[i]), at));
   }
 };
 
@@ -158,7 +161,8 @@ void runHistogramPasses(Executor& ex, const T* input, const RegionGeometry& g, c
   ex.transpose(bins.get(), transposed.get(), g.sx, g.sy, g.sz, "transpose bins");
   auto upper = ex.template allocate<int>(g.region()), below = ex.template allocate<int>(g.region()),
        atOrBelow = ex.template allocate<int>(g.region());
-  ex.launch(UpperKernel<T>{ input, g, iso, isoValue, thresholds.get(), n, upper.get(), below.get(), atOrBelow.get() },
+  const HistogramQuerySource<T> query{ input, g, iso, isoValue, thresholds.get(), n };
+  ex.launch(UpperKernel<T>{ query, upper.get(), below.get(), atOrBelow.get() },
     "query bins", g.region() * (sizeof(T) + 3.0 * sizeof(int)));
 
   auto a1 = ex.template allocate<int>(g.afterX()), a2 = ex.template allocate<int>(g.afterX());
@@ -178,8 +182,7 @@ void runHistogramPasses(Executor& ex, const T* input, const RegionGeometry& g, c
       "indicators z", 2.0 * g.afterY() * sizeof(int) + 3.0 * g.region() * sizeof(int));
     ex.progress(0.1 + 0.8 * lower(1.0, (k + 2.0) / n));
   }
-  ex.launch(HistogramOpennessKernel<T>{ input, g, iso, isoValue, thresholds.get(), n, upper.get(), below.get(),
-              atOrBelow.get(), openness },
+  ex.launch(HistogramOpennessKernel<T>{ query, upper.get(), below.get(), atOrBelow.get(), openness },
     "openness", g.region() * (sizeof(T) + 3.0 * sizeof(int) + sizeof(float)));
 }
 
