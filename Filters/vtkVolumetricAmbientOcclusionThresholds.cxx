@@ -13,6 +13,8 @@
 #include "vtkImageData.h"
 #include "vtkMultiProcessController.h"
 
+#include <new>
+
 //------------------------------------------------------------------------------
 bool vtkVolumetricAmbientOcclusion::IsDistributed() const
 {
@@ -48,15 +50,23 @@ vtkSmartPointer<vtkDoubleArray> vtkVolumetricAmbientOcclusion::ComputeHistogramT
   {
     const int port = this->GetInputConnection(0, 0)->GetIndex();
     vtkAmbientOcclusionArrayInput::ScalarVolume scalars; // the slab being read
-    const bool read = vtkAmbientOcclusionThresholds::ComputeInSlabs(producer, port, slabs, this->NumberOfBins,
-      [&](vtkImageData* image, vao::VolumeView& view, std::string& why) {
-        if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
-              this, this->GetInputArrayToProcess(0, image), image, this->Component, scalars, why))
-          return false;
-        view = scalars.view;
-        return true;
-      },
-      thresholds, error);
+    bool read = false;
+    try // outside RequestData, so outside the filters' memory guard
+    {
+      read = vtkAmbientOcclusionThresholds::ComputeInSlabs(producer, port, slabs, this->NumberOfBins,
+        [&](vtkImageData* image, vao::VolumeView& view, std::string& why) {
+          if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
+                this, this->GetInputArrayToProcess(0, image), image, this->Component, scalars, why))
+            return false;
+          view = scalars.view;
+          return true;
+        },
+        thresholds, error);
+    }
+    catch (const std::bad_alloc&)
+    {
+      error = "not enough memory for the value histogram; read the input in more slabs";
+    }
     if (!read && error.empty())
       error = "the input could not be read in slabs";
   }

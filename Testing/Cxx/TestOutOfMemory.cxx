@@ -115,6 +115,20 @@ TEST(OutOfMemory, VolumetricAmbientOcclusion)
     [&] { return filter->GetOutput()->GetNumberOfPoints(); });
 }
 
+TEST(OutOfMemory, VolumetricAmbientOcclusionSmoothedQuery)
+{
+  // The output (108 MB) fits; the smoothed query's own buffer, a double per voxel
+  // (216 MB), does not: the kernel's shortage, not the output's.
+  const auto large = Ball(300), small = Ball(24);
+  vtkNew<vtkVolumetricAmbientOcclusion> filter;
+  filter->SetRadius(2);
+  filter->SetQueryMode(vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE);
+  LimitAddressSpace(160);
+  ExpectShortageThenSuccess(
+    filter, [&](bool big) { filter->SetInputData(big ? large : small); },
+    [&] { return filter->GetOutput()->GetNumberOfPoints(); });
+}
+
 TEST(OutOfMemory, OcclusionSweeping)
 {
   const auto large = Ball(300), small = Ball(24); // 27 MB of input; 4 B + 32 B a voxel more

@@ -195,13 +195,15 @@ Status volumeThresholds(
   {
     return status;
   }
-  ValueHistogram histogram = ValueHistogram::forRange(volume.type, scan.minimum, scan.maximum);
-  status = addToValueHistogram(volume, Region::whole(volume), histogram, execution);
-  if (status.ok)
-  {
-    thresholds = histogramThresholds(histogram, bins);
-  }
-  return status;
+  return catchOutOfMemory("the value histogram of Histogram CDF", [&] {
+    ValueHistogram histogram = ValueHistogram::forRange(volume.type, scan.minimum, scan.maximum);
+    const Status added = addToValueHistogram(volume, Region::whole(volume), histogram, execution);
+    if (added.ok)
+    {
+      thresholds = histogramThresholds(histogram, bins);
+    }
+    return added;
+  });
 }
 
 std::string checkHistogramBins(int bins)
