@@ -44,16 +44,17 @@ struct AxisWeights
       const std::int64_t hi = std::min<std::int64_t>(n - 1, c + half);
       first[i] = lo;
       size[i] = hi - lo + 1;
+      double* w = &weights[i * taps];
       double total = 0.0;
       for (std::int64_t y = lo; y <= hi; ++y)
       {
         const double d = static_cast<double>(y - c);
-        total += std::exp(-d * d / (2.0 * sigma * sigma));
+        w[y - lo] = std::exp(-d * d / (2.0 * sigma * sigma));
+        total += w[y - lo];
       }
-      for (std::int64_t y = lo; y <= hi; ++y)
+      for (std::int64_t k = 0; k <= hi - lo; ++k)
       {
-        const double d = static_cast<double>(y - c);
-        weights[i * taps + (y - lo)] = std::exp(-d * d / (2.0 * sigma * sigma)) / total;
+        w[k] /= total;
       }
     }
   }
