@@ -7,8 +7,10 @@
 // scipy.ndimage.distance_transform_edt in the same run.
 //
 // Usage: vao_benchmark [--shared DIR] [--scipy PATH/TO/scipy_peer.py] [--repeat N]
-//                      [--exact] [--threads N] [--volumetric | --sweeping | --penner (one table only)]
-// Last, the variance occlusion maps: pyramid builds and the surface query rate.
+//                      [--exact] [--threads N] [--volumetric | --sweeping | --penner | --relight]
+//                      (one table only; --relight: the surface query rates alone)
+// Last, the variance occlusion maps: pyramid builds and the surface query rates (AO, soft
+// shadows) on the CT heads' bone surfaces.
 // Exact Box and Exact Sphere are O(R^3) references: by default they are timed on a
 // 32-slice slab and the whole-volume time is extrapolated (marked "~"); --exact times
 // them on the whole volume (minutes).
@@ -61,6 +63,7 @@ struct Options
   std::string scipyEdt = VAO_DEFAULT_SCIPY_EDT_PEER;
   bool sweepingOnly = false;
   bool pennerOnly = false;
+  bool relightOnly = false; // --relight: the surface query rates of --penner alone
   bool volumetricOnly = false;
   int repeat = 3;
   bool exact = false;
@@ -347,9 +350,8 @@ void BenchmarkSweeping(const Options& options, vtkImageData* ct)
   std::remove(raw.c_str());
 }
 
-/// Penner & Mitchell: the pyramid build on generated volumes of the paper's Table 1 sizes
-/// and the surface query rate on the CT head phantom's bone.
-void BenchmarkPyramid(const Options& options, vtkImageData* ct)
+/// Penner & Mitchell: the pyramid build on generated volumes of the paper's Table 1 sizes.
+void BenchmarkPyramid(const Options& options)
 {
   std::printf("\nVariance occlusion maps: pyramid build (4 levels, best of %d; paper Table 1: 170 / 678 / "
               "1524 ms CPU)\n", options.repeat);
@@ -373,8 +375,12 @@ void BenchmarkPyramid(const Options& options, vtkImageData* ct)
     }
     std::printf("  %4d x %4d x %4d int16   %8.0f ms\n", size[0], size[1], size[2], 1e3 * best);
   }
+}
 
-  // The bone surface of the CT head phantom and its normals.
+/// The surface query rates (what a light move costs once the pyramid is cached) on the
+/// bone surface (400 HU) of a CT head: default parameters, light (0, -1, 1).
+void BenchmarkRelighting(const Options& options, const char* name, vtkImageData* ct)
+{
   vtkNew<vtkFlyingEdges3D> contour;
   contour->SetInputData(ct);
   contour->SetValue(0, 400.0);
@@ -396,25 +402,26 @@ void BenchmarkPyramid(const Options& options, vtkImageData* ct)
   const double* o = ct->GetOrigin();
   const double* h = ct->GetSpacing();
   std::vector<vao::MomentLevel> pyramid;
-  vao::buildMomentPyramid(view, { o[0], o[1], o[2] }, { h[0], h[1], h[2] }, {}, pyramid);
-  std::vector<float> out(n);
-  auto rate = [&](bool shadows) {
+  vao::Execution execution;
+  execution.threads = options.threads;
+  vao::buildMomentPyramid(view, { o[0], o[1], o[2] }, { h[0], h[1], h[2] }, {}, pyramid, execution);
+  std::vector<float> ao(n), shadow(n);
+  auto rate = [&](bool occlusion, bool shadows) {
     double best = 1e300;
     for (int r = 0; r < options.repeat; ++r)
     {
       const auto start = std::chrono::steady_clock::now();
-      vao::surfaceAmbientOcclusion(pyramid, view, { o[0], o[1], o[2] }, { h[0], h[1], h[2] }, points.data(),
-        normals.data(), n, {}, out.data());
+      if (occlusion)
+        vao::surfaceAmbientOcclusion(pyramid, view, { o[0], o[1], o[2] }, { h[0], h[1], h[2] }, points.data(),
+          normals.data(), n, {}, ao.data(), execution);
       if (shadows)
-      {
-        vao::surfaceShadow(pyramid, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 }, {}, out.data());
-      }
+        vao::surfaceShadow(pyramid, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 }, {}, shadow.data(), execution);
       best = std::min(best, Seconds(start));
     }
-    return n / best;
+    return n / best / 1e6;
   };
-  std::printf("  CT head bone surface (400 HU, %lld points): AO %.1f M points/s, AO + shadows %.1f M points/s\n",
-    static_cast<long long>(n), rate(false) / 1e6, rate(true) / 1e6);
+  std::printf("  %s bone surface (400 HU, %lld points): AO %.1f, shadows %.1f, AO + shadows %.1f M points/s\n",
+    name, static_cast<long long>(n), rate(true, false), rate(false, true), rate(true, true));
 }
 
 } // namespace
@@ -439,11 +446,13 @@ int main(int argc, char* argv[])
       options.sweepingOnly = true;
     else if (arg == "--penner")
       options.pennerOnly = true;
+    else if (arg == "--relight")
+      options.pennerOnly = options.relightOnly = true;
     else if (arg == "--volumetric")
       options.volumetricOnly = true;
     else
     {
-      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--volumetric | --sweeping | --penner]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--volumetric | --sweeping | --penner | --relight]\n", argv[0]);
       return 2;
     }
   }
@@ -477,7 +486,13 @@ int main(int argc, char* argv[])
   }
   if (!options.sweepingOnly)
   {
-    BenchmarkPyramid(options, head);
+    if (!options.relightOnly)
+      BenchmarkPyramid(options);
+    std::printf("\nVariance occlusion maps: relighting, AO and soft shadows from a cached pyramid (best of %d)\n",
+      options.repeat);
+    BenchmarkRelighting(options, "CT head 128x128x136", head);
+    BenchmarkRelighting(options, "CT head 512x512x209",
+      ReadScanOrExit(options.shared + "/ct_head_phantom/ct_head_phantom_512x512x209_int16.mha"));
   }
   return 0;
 }

@@ -94,13 +94,25 @@ constexpr double kFlatSpread = 1e-7;
 /// sums (kSumRoundingUlps ulps of the data's largest deviation, which roundingVariance
 /// squares), is one of the neighbourhood's values: q >= mu. An iso value closer than
 /// that to a flat region's value cannot be told from it.
-VAO_HD double flatOpenness(double query, double mean, double roundingVariance = 0.0)
+/// flatOpenness given the rounding spread of its sums (flatRoundingSpread): callers that
+/// query one set of sums many times take the square root once.
+VAO_HD double flatOpennessWithin(double query, double mean, double roundingSpread)
 {
   const double scale = mean > 1.0 ? mean : (mean < -1.0 ? -mean : 1.0);
   const double relative = kFlatSpread * scale;
-  // No square root for exact sums (no rounding): flat boxes are most of many volumes.
-  const double rounding = roundingVariance > 0.0 ? sqrt(roundingVariance * kSumRoundingUlps * kDoubleUlp) : 0.0;
-  return query >= mean - (rounding > relative ? rounding : relative) ? 1.0 : 0.0;
+  return query >= mean - (roundingSpread > relative ? roundingSpread : relative) ? 1.0 : 0.0;
+}
+
+/// How far below its mean the rounding of double sums can put a flat value (0 for exact
+/// sums, which skip the square root: flat boxes are most of many volumes).
+VAO_HD double flatRoundingSpread(double roundingVariance)
+{
+  return roundingVariance > 0.0 ? sqrt(roundingVariance * kSumRoundingUlps * kDoubleUlp) : 0.0;
+}
+
+VAO_HD double flatOpenness(double query, double mean, double roundingVariance = 0.0)
+{
+  return flatOpennessWithin(query, mean, flatRoundingSpread(roundingVariance));
 }
 
 VAO_HD double clamp01(double x)
@@ -161,18 +173,22 @@ VAO_HD double opennessGaussianCdf(double query, const NeighbourhoodStats& s, Erf
 
 /// Cantelli's one-tailed bound on the occluder fraction P(v >= q), as METHODS.md fixes it:
 /// p_max = 1 if q <= mu, else s2 / (s2 + (q - mu)^2); O = 1 - p_max <= P(v <= q).
+/// opennessChebyshev given the flat rule's rounding spread (flatRoundingSpread of the
+/// rounding variance). Both answers are formed and one is kept, with no branch, so a loop
+/// over many samples compiles to vector code (the bound's 0/0 on a flat box is not kept).
+VAO_HD double opennessChebyshevWithin(double query, double mean, double variance, double roundingVariance,
+  double roundingSpread)
+{
+  const double d = query - mean;
+  const double occluderShare = variance / (variance + d * d);
+  const double bound = d > 0.0 ? clamp01(1.0 - occluderShare) : 0.0;
+  return isFlatVariance(mean, variance, roundingVariance) ? flatOpennessWithin(query, mean, roundingSpread) : bound;
+}
+
 VAO_HD double opennessChebyshev(double query, const NeighbourhoodStats& s)
 {
-  if (isFlatVariance(s.mean, s.variance, s.roundingVariance))
-  {
-    return flatOpenness(query, s.mean, s.roundingVariance);
-  }
-  if (query <= s.mean)
-  {
-    return 0.0;
-  }
-  const double d = query - s.mean;
-  return clamp01(1.0 - s.variance / (s.variance + d * d));
+  return opennessChebyshevWithin(
+    query, s.mean, s.variance, s.roundingVariance, flatRoundingSpread(s.roundingVariance));
 }
 
 /// Index of the first threshold >= q among the n ascending thresholds (n when none is):

@@ -3,6 +3,7 @@
 #include "vao/VarianceOcclusionMap.h"
 #include "vao/Validation.h"
 
+#include "LevelGrid.h"
 #include "Parallel.h"
 #include "VolumeAccess.h"
 
@@ -118,12 +119,6 @@ Status checkPoints(const double* points, const double* normals, std::int64_t cou
   return Status::success();
 }
 
-std::array<double, 3> unit(const double* v)
-{
-  const double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-  return { v[0] / l, v[1] / l, v[2] / l };
-}
-
 /// The grid cell around a world position, clamped to the grid: lower and upper corner
 /// indices and the fractions towards the upper one, per axis.
 struct TrilinearCell
@@ -167,33 +162,44 @@ double trilinear(const detail::TypedVolume<T>& volume, const std::array<double, 
   return c0 * (1 - f[2]) + c1 * f[2];
 }
 
-double levelOcclusion(const MomentLevel& level, const std::array<double, 3>& position, double query,
-  Method estimator)
+/// The levels a query uses, prepared for sampling.
+struct PreparedPyramid
 {
-  double mean = 0.0, variance = 0.0;
-  sampleLevel(level, position, mean, variance);
-  const NeighbourhoodStats stats{ mean, variance, mean, mean, level.roundingVariance };
-  const double open = estimator == Method::GaussianCdf
-    ? opennessGaussianCdf(query, stats, ErfMode::Exact)
-    : opennessChebyshev(query, stats);
-  return 1.0 - open;
-}
+  std::vector<detail::LevelGrid> grids;
+  std::vector<double> kernelRadius;
 
-bool insideBounds(const MomentLevel& level, const std::array<double, 3>& p)
-{
-  const bool window = std::isfinite(level.wholeBounds[0]);
-  for (int a = 0; a < 3; ++a)
+  PreparedPyramid(const std::vector<MomentLevel>& pyramid, int levels)
   {
-    const double lo = window ? level.wholeBounds[2 * a] : level.origin[a];
-    const double hi =
-      window ? level.wholeBounds[2 * a + 1] : level.origin[a] + (level.dims[a] - 1) * level.spacing[a];
-    if (p[a] < lo || p[a] > hi)
+    for (int l = 0; l < levels; ++l)
     {
-      return false;
+      this->grids.emplace_back(pyramid[l]);
+      this->kernelRadius.push_back(pyramid[l].kernelRadius);
     }
   }
-  return true;
-}
+};
+
+/// The box the shadow march stays in: level 0's bounds, or the whole volume's when the
+/// level is a distributed piece's window.
+struct MarchBounds
+{
+  double lo[3], hi[3];
+
+  explicit MarchBounds(const MomentLevel& level)
+  {
+    const bool window = std::isfinite(level.wholeBounds[0]);
+    for (int a = 0; a < 3; ++a)
+    {
+      this->lo[a] = window ? level.wholeBounds[2 * a] : level.origin[a];
+      this->hi[a] = window ? level.wholeBounds[2 * a + 1] : level.origin[a] + (level.dims[a] - 1) * level.spacing[a];
+    }
+  }
+
+  bool contains(const double* p) const
+  {
+    return p[0] >= this->lo[0] && p[0] <= this->hi[0] && p[1] >= this->lo[1] && p[1] <= this->hi[1] &&
+      p[2] >= this->lo[2] && p[2] <= this->hi[2];
+  }
+};
 
 } // namespace
 
@@ -208,25 +214,7 @@ double sampleVolume(const VolumeView& volume, const std::array<double, 3>& origi
 
 void sampleLevel(const MomentLevel& level, const std::array<double, 3>& position, double& mean, double& variance)
 {
-  const TrilinearCell cell(level.dims, level.origin, level.spacing, position);
-  const std::int64_t* i0 = cell.i0;
-  const std::int64_t* i1 = cell.i1;
-  const double* f = cell.f;
-  const std::int64_t nx = level.dims[0], ny = level.dims[1];
-  double m = 0.0, v = 0.0;
-  for (int c = 0; c < 8; ++c)
-  {
-    const std::int64_t x = (c & 1) ? i1[0] : i0[0];
-    const std::int64_t y = (c & 2) ? i1[1] : i0[1];
-    const std::int64_t z = (c & 4) ? i1[2] : i0[2];
-    const double w = ((c & 1) ? f[0] : 1 - f[0]) * ((c & 2) ? f[1] : 1 - f[1]) *
-      ((c & 4) ? f[2] : 1 - f[2]);
-    const std::int64_t i = (z * ny + y) * nx + x;
-    m += w * level.mean[i];
-    v += w * level.variance[i];
-  }
-  mean = m;
-  variance = std::max(0.0, v);
+  detail::trilinearSample<std::int64_t>(detail::LevelGrid(level), position[0], position[1], position[2], mean, variance);
 }
 
 namespace
@@ -247,19 +235,59 @@ Status checkQuery(const std::vector<MomentLevel>& pyramid, const SurfaceOcclusio
   return status;
 }
 
-/// f(i) for every point i, on every thread, reporting progress every `batch` points.
-/// Returns false when cancelled.
-template <class PerPoint>
-bool forEachPoint(std::int64_t count, int batch, const Execution& execution, PerPoint&& f)
+/// kLanes points at a time (the last batch padded with copies of its last point): their
+/// positions, unit normals and queries, structure of arrays.
+struct PointLanes
 {
+  std::int64_t first = 0;
+  int used = 0; // real points in the batch
+  double x[detail::kLanes], y[detail::kLanes], z[detail::kLanes];
+  double nx[detail::kLanes], ny[detail::kLanes], nz[detail::kLanes];
+  double query[detail::kLanes];
+
+  PointLanes(const double* points, const double* normals, std::int64_t count, std::int64_t batch)
+    : first(batch * detail::kLanes)
+    , used(static_cast<int>(std::min<std::int64_t>(detail::kLanes, count - batch * detail::kLanes)))
+  {
+    for (int k = 0; k < detail::kLanes; ++k)
+    {
+      const std::int64_t i = this->first + std::min(k, this->used - 1);
+      const double* p = points + 3 * i;
+      const double* n = normals + 3 * i;
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      this->x[k] = p[0];
+      this->y[k] = p[1];
+      this->z[k] = p[2];
+      this->nx[k] = n[0] / length;
+      this->ny[k] = n[1] / length;
+      this->nz[k] = n[2] / length;
+    }
+  }
+
+  /// The world position at distance d from point k along its normal.
+  std::array<double, 3> along(int k, double d) const
+  {
+    return { this->x[k] + d * this->nx[k], this->y[k] + d * this->ny[k], this->z[k] + d * this->nz[k] };
+  }
+};
+
+/// f(lanes) for every batch of kLanes points, on every thread, reporting progress every
+/// 64 batches. Returns false when cancelled.
+template <class PerBatch>
+bool forEachBatch(const double* points, const double* normals, std::int64_t count, const Execution& execution,
+  PerBatch&& f)
+{
+  constexpr int kProgressBatches = 64;
+  const std::int64_t batches = (count + detail::kLanes - 1) / detail::kLanes;
   const int threads = detail::resolveThreadCount(execution.threads);
-  const int chunks = static_cast<int>(std::min<std::int64_t>(std::max<std::int64_t>(count, 1), threads * 8));
-  return detail::parallelFor(count, chunks, threads, execution,
+  const int chunks = static_cast<int>(std::min<std::int64_t>(std::max<std::int64_t>(batches, 1), threads * 8));
+  return detail::parallelFor(batches, chunks, threads, execution,
     [&](std::int64_t begin, std::int64_t end, detail::ChunkProgress& progress) {
-      for (std::int64_t i = begin; i < end; ++i)
+      for (std::int64_t b = begin; b < end; ++b)
       {
-        f(i);
-        if ((i - begin) % batch == batch - 1 && !progress.advance(batch))
+        PointLanes lanes(points, normals, count, b);
+        f(lanes);
+        if ((b - begin) % kProgressBatches == kProgressBatches - 1 && !progress.advance(kProgressBatches))
         {
           return;
         }
@@ -267,49 +295,83 @@ bool forEachPoint(std::int64_t count, int batch, const Execution& execution, Per
     });
 }
 
-/// The occlusion of one surface point p (unit outward normal n) from the levels used.
-double pointOcclusion(const std::vector<MomentLevel>& pyramid, int levels, const double* p,
-  const std::array<double, 3>& n, double query, const SurfaceOcclusionParameters& parameters)
+/// The occlusions of a batch of surface points from the levels used (sampled at
+/// p + k r_l n, combined by maximum or mean).
+void batchOcclusion(const PreparedPyramid& pyramid, int levels, const PointLanes& lanes,
+  const SurfaceOcclusionParameters& parameters, double* combined)
 {
-  double combined = 0.0;
+  constexpr int W = detail::kLanes;
+  double x[W], y[W], z[W], occlusion[W];
+  std::fill(combined, combined + W, 0.0);
   for (int l = 0; l < levels; ++l)
   {
-    const double offset = parameters.offsetFactor * pyramid[l].kernelRadius;
-    const std::array<double, 3> at = { p[0] + offset * n[0], p[1] + offset * n[1], p[2] + offset * n[2] };
-    const double occlusion = levelOcclusion(pyramid[l], at, query, parameters.estimator);
-    combined = parameters.combination == LevelCombination::Mean ? combined + occlusion / levels
-                                                                : std::max(combined, occlusion);
+    const double offset = parameters.offsetFactor * pyramid.kernelRadius[l];
+    for (int k = 0; k < W; ++k)
+    {
+      x[k] = lanes.x[k] + offset * lanes.nx[k];
+      y[k] = lanes.y[k] + offset * lanes.ny[k];
+      z[k] = lanes.z[k] + offset * lanes.nz[k];
+    }
+    detail::occlusionLanes(pyramid.grids[l], parameters.estimator, x, y, z, lanes.query, occlusion);
+    for (int k = 0; k < W; ++k)
+    {
+      combined[k] = parameters.combination == LevelCombination::Mean ? combined[k] + occlusion[k] / levels
+                                                                     : std::max(combined[k], occlusion[k]);
+    }
   }
-  return combined;
 }
 
-/// The largest occlusion met by the march from `start` along the unit `light`.
-double marchOcclusion(const std::vector<MomentLevel>& pyramid, int levels, const std::array<double, 3>& start,
-  const std::array<double, 3>& light, double query, Method estimator)
+/// The largest occlusion each lane's march meets from p + r_0 n along the unit `light`.
+/// The lanes share the steps (t and the level depend on the distance alone); a lane stops
+/// on leaving the bounds or at occlusion >= 0.999, the batch when every lane has.
+void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int levels, const PointLanes& lanes,
+  const std::array<double, 3>& light, Method estimator, double* occlusion)
 {
   // Steps of half the level's radius: a blob of the level's size cannot fall between two.
   constexpr double kStepFraction = 0.5;
   constexpr int kMaxSteps = 1 << 16;
-  const MomentLevel& base = pyramid[0];
-  const double r0 = base.kernelRadius;
-  double occlusion = 0.0;
+  constexpr int W = detail::kLanes;
+  const double r0 = pyramid.kernelRadius[0];
+  double sx[W], sy[W], sz[W], x[W], y[W], z[W], sample[W];
+  bool alive[W];
+  for (int k = 0; k < W; ++k)
+  {
+    const std::array<double, 3> start = lanes.along(k, r0);
+    sx[k] = start[0];
+    sy[k] = start[1];
+    sz[k] = start[2];
+    occlusion[k] = 0.0;
+    alive[k] = true;
+  }
   double t = 0.0;
   for (int s = 0; s < kMaxSteps; ++s)
   {
-    const std::array<double, 3> at = { start[0] + t * light[0], start[1] + t * light[1], start[2] + t * light[2] };
-    if (!insideBounds(base, at))
+    bool any = false;
+    for (int k = 0; k < W; ++k)
+    {
+      x[k] = sx[k] + t * light[0];
+      y[k] = sy[k] + t * light[1];
+      z[k] = sz[k] + t * light[2];
+      const double at[3] = { x[k], y[k], z[k] };
+      alive[k] = alive[k] && bounds.contains(at);
+      any = any || alive[k];
+    }
+    if (!any)
     {
       break;
     }
     const int l = std::min(levels - 1, std::max(0, static_cast<int>(std::floor(std::log2(1.0 + t / r0)))));
-    occlusion = std::max(occlusion, levelOcclusion(pyramid[l], at, query, estimator));
-    if (occlusion >= 0.999)
+    detail::occlusionLanes(pyramid.grids[l], estimator, x, y, z, lanes.query, sample);
+    for (int k = 0; k < W; ++k)
     {
-      break;
+      if (alive[k])
+      {
+        occlusion[k] = std::max(occlusion[k], sample[k]);
+        alive[k] = occlusion[k] < 0.999;
+      }
     }
-    t += kStepFraction * pyramid[l].kernelRadius;
+    t += kStepFraction * pyramid.kernelRadius[l];
   }
-  return occlusion;
 }
 
 } // namespace
@@ -337,15 +399,20 @@ Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const Vo
     return status;
   }
   const double h = std::min(spacing[0], std::min(spacing[1], spacing[2]));
+  const PreparedPyramid prepared(pyramid, levels);
   const bool finished = detail::dispatchScalarType(half ? volume.type : ScalarType::Float32, [&](auto tag) {
     const detail::TypedVolume<decltype(tag)> typed(half ? volume : VolumeView{});
-    return forEachPoint(count, 1024, execution, [&](std::int64_t i) {
-      const double* p = points + 3 * i;
-      const std::array<double, 3> n = unit(normals + 3 * i);
-      const double query = half
-        ? trilinear(typed, origin, spacing, { p[0] - 0.5 * h * n[0], p[1] - 0.5 * h * n[1], p[2] - 0.5 * h * n[2] })
-        : parameters.isoValue;
-      out[i] = static_cast<float>(1.0 - clamp01(pointOcclusion(pyramid, levels, p, n, query, parameters)));
+    return forEachBatch(points, normals, count, execution, [&](PointLanes& lanes) {
+      for (int k = 0; k < detail::kLanes; ++k)
+      {
+        lanes.query[k] = half ? trilinear(typed, origin, spacing, lanes.along(k, -0.5 * h)) : parameters.isoValue;
+      }
+      double occlusion[detail::kLanes];
+      batchOcclusion(prepared, levels, lanes, parameters, occlusion);
+      for (int k = 0; k < lanes.used; ++k)
+      {
+        out[lanes.first + k] = static_cast<float>(1.0 - clamp01(occlusion[k]));
+      }
     });
   });
   return finished ? Status::success() : Status::cancelled();
@@ -372,20 +439,27 @@ Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* poin
   const std::array<double, 3> light = { lightDirection[0] / lightLength, lightDirection[1] / lightLength,
     lightDirection[2] / lightLength };
   const MomentLevel& base = pyramid[0];
-  const double r0 = base.kernelRadius;
   const double h = std::min(base.spacing[0], std::min(base.spacing[1], base.spacing[2]));
-  const bool finished = forEachPoint(count, 256, execution, [&](std::int64_t i) {
-    const double* p = points + 3 * i;
-    const std::array<double, 3> n = unit(normals + 3 * i);
-    double query = parameters.isoValue;
-    if (parameters.query == SurfaceQuery::HalfVoxelInside)
+  const PreparedPyramid prepared(pyramid, levels);
+  const MarchBounds bounds(base);
+  const bool finished = forEachBatch(points, normals, count, execution, [&](PointLanes& lanes) {
+    for (int k = 0; k < detail::kLanes; ++k)
     {
-      // No raw volume here: level 0's (blurred) mean half a voxel inside.
-      double variance = 0.0;
-      sampleLevel(base, { p[0] - 0.5 * h * n[0], p[1] - 0.5 * h * n[1], p[2] - 0.5 * h * n[2] }, query, variance);
+      lanes.query[k] = parameters.isoValue;
+      if (parameters.query == SurfaceQuery::HalfVoxelInside)
+      {
+        // No raw volume here: level 0's (blurred) mean half a voxel inside.
+        const std::array<double, 3> inside = lanes.along(k, -0.5 * h);
+        double variance = 0.0;
+        detail::trilinearSample<std::int64_t>(prepared.grids[0], inside[0], inside[1], inside[2], lanes.query[k], variance);
+      }
     }
-    const std::array<double, 3> start = { p[0] + r0 * n[0], p[1] + r0 * n[1], p[2] + r0 * n[2] };
-    out[i] = static_cast<float>(1.0 - clamp01(marchOcclusion(pyramid, levels, start, light, query, parameters.estimator)));
+    double occlusion[detail::kLanes];
+    batchMarch(prepared, bounds, levels, lanes, light, parameters.estimator, occlusion);
+    for (int k = 0; k < lanes.used; ++k)
+    {
+      out[lanes.first + k] = static_cast<float>(1.0 - clamp01(occlusion[k]));
+    }
   });
   return finished ? Status::success() : Status::cancelled();
 }

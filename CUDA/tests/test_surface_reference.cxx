@@ -1,0 +1,263 @@
+// Surface ambient occlusion and soft shadows against a reference written from the Penner
+// & Mitchell section of METHODS.md (and the query's documented rules in
+// vao/VarianceOcclusionMap.h): its own trilinear weights, estimators and march, on a noisy
+// volume (no flat neighbourhood, so the flat rule never decides), anisotropic spacing, an
+// origin off zero, unnormalised normals, and point counts around the lane width of the
+// implementation. Also the lanes' vector path against their plain loop.
+#include "../src/cpu/LevelGrid.h"
+#include "vao/VarianceOcclusionMap.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace
+{
+
+using Vec3 = std::array<double, 3>;
+
+/// Trilinear value of a grid of `dims` values at world p (clamped): the sum over the 8
+/// corners of the product of the per-axis weights.
+template <class Get>
+double refTrilinear(const vao::Index3& dims, const Vec3& origin, const Vec3& spacing, const Vec3& p, Get get)
+{
+  std::int64_t lo[3], hi[3];
+  double w[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    double u = (p[a] - origin[a]) / spacing[a];
+    u = std::clamp(u, 0.0, static_cast<double>(dims[a] - 1));
+    lo[a] = static_cast<std::int64_t>(std::floor(u));
+    hi[a] = std::min<std::int64_t>(lo[a] + 1, dims[a] - 1);
+    w[a] = u - std::floor(u);
+  }
+  double sum = 0.0;
+  for (int c = 0; c < 8; ++c)
+  {
+    double weight = 1.0;
+    std::int64_t i[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const bool upper = (c >> a) & 1;
+      i[a] = upper ? hi[a] : lo[a];
+      weight *= upper ? w[a] : 1.0 - w[a];
+    }
+    sum += weight * get(i[0], i[1], i[2]);
+  }
+  return sum;
+}
+
+/// Occluder fraction of q for a level sample: Cantelli's bound or the Gaussian tail.
+double refOcclusion(const vao::MomentLevel& level, const Vec3& p, double q, vao::Method estimator)
+{
+  auto at = [&](const vao::LevelArray& a) {
+    return [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+      return static_cast<double>(a[static_cast<std::size_t>((z * level.dims[1] + y) * level.dims[0] + x)]);
+    };
+  };
+  const double mu = refTrilinear(level.dims, level.origin, level.spacing, p, at(level.mean));
+  const double s2 = std::max(0.0, refTrilinear(level.dims, level.origin, level.spacing, p, at(level.variance)));
+  if (estimator == vao::Method::GaussianCdf)
+    return 1.0 - 0.5 * std::erfc(-(q - mu) / std::sqrt(2.0 * s2));
+  return q <= mu ? 1.0 : s2 / (s2 + (q - mu) * (q - mu));
+}
+
+struct Scene
+{
+  vao::Index3 dims = { 21, 17, 19 };
+  Vec3 origin = { -3.0, 1.5, 10.0 };
+  Vec3 spacing = { 0.7, 1.1, 1.6 };
+  std::vector<float> values;
+  std::vector<vao::MomentLevel> pyramid;
+  std::vector<double> points, normals;
+
+  Scene(int levels, int count, unsigned seed)
+  {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, 30.0);
+    values.resize(static_cast<std::size_t>(dims[0] * dims[1] * dims[2]));
+    for (std::int64_t z = 0; z < dims[2]; ++z)
+      for (std::int64_t y = 0; y < dims[1]; ++y)
+        for (std::int64_t x = 0; x < dims[0]; ++x) // a ball of 400 in 0, plus noise
+        {
+          const double r = std::hypot(x - 10.0, y - 8.0, z - 9.0);
+          values[static_cast<std::size_t>((z * dims[1] + y) * dims[0] + x)] =
+            static_cast<float>((r < 6.0 ? 400.0 : 0.0) + noise(rng));
+        }
+    EXPECT_TRUE(vao::buildMomentPyramid(view(), origin, spacing, { levels, false }, pyramid).ok);
+    std::uniform_real_distribution<double> unit(0.0, 1.0), direction(-2.0, 2.0);
+    for (int i = 0; i < count; ++i)
+    {
+      for (int a = 0; a < 3; ++a)
+        points.push_back(origin[a] + unit(rng) * (dims[a] - 1) * spacing[a]);
+      Vec3 n;
+      do
+        n = { direction(rng), direction(rng), direction(rng) };
+      while (n[0] * n[0] + n[1] * n[1] + n[2] * n[2] < 0.1);
+      normals.insert(normals.end(), n.begin(), n.end());
+    }
+  }
+
+  vao::VolumeView view() const
+  {
+    vao::VolumeView v;
+    v.data = values.data();
+    v.type = vao::ScalarType::Float32;
+    v.dims = dims;
+    return v;
+  }
+
+  Vec3 point(int i) const { return { points[3 * i], points[3 * i + 1], points[3 * i + 2] }; }
+  Vec3 normal(int i) const
+  {
+    const double* n = &normals[3 * i];
+    const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return { n[0] / l, n[1] / l, n[2] / l };
+  }
+};
+
+Vec3 along(const Vec3& p, const Vec3& n, double d)
+{
+  return { p[0] + d * n[0], p[1] + d * n[1], p[2] + d * n[2] };
+}
+
+double refAo(const Scene& s, int i, const vao::SurfaceOcclusionParameters& p)
+{
+  const Vec3 x = s.point(i), n = s.normal(i);
+  const double h = std::min({ s.spacing[0], s.spacing[1], s.spacing[2] });
+  const double q = p.query == vao::SurfaceQuery::IsoValue
+    ? p.isoValue
+    : refTrilinear(s.dims, s.origin, s.spacing, along(x, n, -h / 2),
+        [&](std::int64_t a, std::int64_t b, std::int64_t c) {
+          return static_cast<double>(s.values[static_cast<std::size_t>((c * s.dims[1] + b) * s.dims[0] + a)]);
+        });
+  const int levels = static_cast<int>(s.pyramid.size());
+  double combined = 0.0;
+  for (int l = 0; l < levels; ++l)
+  {
+    const double o = refOcclusion(s.pyramid[l], along(x, n, p.offsetFactor * s.pyramid[l].kernelRadius), q, p.estimator);
+    combined = p.combination == vao::LevelCombination::Mean ? combined + o / levels : std::max(combined, o);
+  }
+  return 1.0 - std::clamp(combined, 0.0, 1.0);
+}
+
+double refShadow(const Scene& s, int i, const Vec3& light, const vao::SurfaceOcclusionParameters& p)
+{
+  const vao::MomentLevel& base = s.pyramid[0];
+  const Vec3 x = s.point(i), n = s.normal(i);
+  const double h = std::min({ base.spacing[0], base.spacing[1], base.spacing[2] });
+  double q = p.isoValue;
+  if (p.query == vao::SurfaceQuery::HalfVoxelInside) // level 0's mean half a voxel inside
+  {
+    const Vec3 inside = along(x, n, -h / 2);
+    q = refTrilinear(base.dims, base.origin, base.spacing, inside, [&](std::int64_t a, std::int64_t b, std::int64_t c) {
+      return static_cast<double>(base.mean[static_cast<std::size_t>((c * base.dims[1] + b) * base.dims[0] + a)]);
+    });
+  }
+  const double length = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
+  const Vec3 l = { light[0] / length, light[1] / length, light[2] / length };
+  const double r0 = base.kernelRadius;
+  const Vec3 start = along(x, n, r0);
+  const int levels = static_cast<int>(s.pyramid.size());
+  double occlusion = 0.0;
+  for (double t = 0.0;;)
+  {
+    const Vec3 at = along(start, l, t);
+    bool inside = true;
+    for (int a = 0; a < 3; ++a)
+      inside = inside && at[a] >= base.origin[a] && at[a] <= base.origin[a] + (base.dims[a] - 1) * base.spacing[a];
+    if (!inside)
+      break;
+    const int level = std::clamp(static_cast<int>(std::floor(std::log2(1.0 + t / r0))), 0, levels - 1);
+    occlusion = std::max(occlusion, refOcclusion(s.pyramid[level], at, q, p.estimator));
+    if (occlusion >= 0.999)
+      break;
+    t += s.pyramid[level].kernelRadius / 2;
+  }
+  return 1.0 - std::clamp(occlusion, 0.0, 1.0);
+}
+
+} // namespace
+
+TEST(SurfaceReference, AmbientOcclusionAndShadowsMatchTheDefinition)
+{
+  int compared = 0;
+  for (int count : { 1, 5, 8, 37 })
+  {
+    const Scene s(count == 37 ? 4 : 3, count, 17u + count);
+    for (vao::Method estimator : { vao::Method::Chebyshev, vao::Method::GaussianCdf })
+      for (vao::SurfaceQuery query : { vao::SurfaceQuery::HalfVoxelInside, vao::SurfaceQuery::IsoValue })
+        for (vao::LevelCombination combination : { vao::LevelCombination::MaximumOcclusion, vao::LevelCombination::Mean })
+        {
+          vao::SurfaceOcclusionParameters p;
+          p.estimator = estimator;
+          p.query = query;
+          p.isoValue = 150.0;
+          p.combination = combination;
+          p.offsetFactor = 0.8;
+          std::vector<float> ao(count, -1.0f), shadow(count, -1.0f);
+          ASSERT_TRUE(vao::surfaceAmbientOcclusion(s.pyramid, s.view(), s.origin, s.spacing, s.points.data(),
+            s.normals.data(), count, p, ao.data()).ok);
+          const Vec3 light = { 0.3, -1.0, 0.7 };
+          ASSERT_TRUE(vao::surfaceShadow(s.pyramid, s.points.data(), s.normals.data(), count, light, p, shadow.data()).ok);
+          for (int i = 0; i < count; ++i)
+          {
+            EXPECT_NEAR(ao[i], refAo(s, i, p), 2e-5) << "AO, point " << i << " of " << count;
+            EXPECT_NEAR(shadow[i], refShadow(s, i, light, p), 2e-5) << "shadow, point " << i << " of " << count;
+            ++compared;
+          }
+        }
+  }
+  EXPECT_EQ(compared, 8 * (1 + 5 + 8 + 37));
+}
+
+TEST(SurfaceLanes, VectorPathEqualsThePlainLoop)
+{
+  // Positions inside, on the faces and outside (clamped), on a level with a one-voxel axis.
+  for (const vao::Index3 dims : { vao::Index3{ 9, 7, 5 }, vao::Index3{ 6, 1, 4 } })
+  {
+    vao::MomentLevel level;
+    level.dims = dims;
+    level.origin = { 1.0, -2.0, 0.5 };
+    level.spacing = { 1.5, 0.5, 2.0 };
+    level.roundingVariance = 1e-9;
+    const auto n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
+    level.mean.resize(n);
+    level.variance.resize(n);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> value(-50.0, 50.0);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      level.mean[i] = static_cast<float>(value(rng));
+      level.variance[i] = i % 5 == 0 ? 0.0f : static_cast<float>(std::fabs(value(rng))); // some flat corners
+    }
+    const vao::detail::LevelGrid grid(level);
+    std::uniform_real_distribution<double> where(-4.0, 16.0);
+    int lanesCompared = 0;
+    for (int batch = 0; batch < 200; ++batch)
+    {
+      double x[vao::detail::kLanes], y[vao::detail::kLanes], z[vao::detail::kLanes], q[vao::detail::kLanes];
+      for (int k = 0; k < vao::detail::kLanes; ++k)
+      {
+        x[k] = where(rng);
+        y[k] = where(rng);
+        z[k] = k == 3 ? level.origin[2] + (dims[2] - 1) * level.spacing[2] : where(rng); // on the last face
+        q[k] = value(rng);
+      }
+      double plain[vao::detail::kLanes], wide[vao::detail::kLanes], vector[vao::detail::kLanes];
+      vao::detail::chebyshevLanes<std::int32_t>(grid, x, y, z, q, plain);
+      vao::detail::chebyshevLanes<std::int64_t>(grid, x, y, z, q, wide);
+      vao::detail::occlusionLanes(grid, vao::Method::Chebyshev, x, y, z, q, vector);
+      for (int k = 0; k < vao::detail::kLanes; ++k)
+      {
+        EXPECT_EQ(plain[k], wide[k]);
+        EXPECT_NEAR(vector[k], plain[k], 1e-12) << "lane " << k;
+        ++lanesCompared;
+      }
+    }
+    EXPECT_EQ(lanesCompared, 200 * vao::detail::kLanes);
+  }
+}
