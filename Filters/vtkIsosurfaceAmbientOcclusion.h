@@ -14,7 +14,10 @@
  *
  * The pyramid is cached: changing only the surface, the query, the combination, the
  * estimator or the light re-samples it without rebuilding it (GetNumberOfPyramidBuilds()
- * counts the builds).
+ * counts the builds). It is keyed on the volume's array (pointer and MTime) and grid, so a
+ * new shallow copy of the same volume (what ParaView passes on every update) reuses it;
+ * after changing values in place, call Modified() on the array. The AmbientOcclusion is
+ * kept too: moving the light only computes the shadows.
  */
 #ifndef vtkIsosurfaceAmbientOcclusion_h
 #define vtkIsosurfaceAmbientOcclusion_h

@@ -233,9 +233,79 @@ TEST(IsosurfaceAmbientOcclusionFilter, ThePyramidIsBuiltOnceWhileOnlyTheQueryCha
   filter->SetNumberOfLevels(3);
   filter->Update();
   EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 2);
-  volume->Modified();
+  // A new shallow copy of the same volume (what ParaView hands the filter on every
+  // update) is the same data: no rebuild.
+  vtkNew<vtkImageData> copy;
+  copy->ShallowCopy(volume);
+  filter->SetVolumeData(copy);
+  filter->SetLightDirection(0, 1, 1);
+  filter->Update();
+  EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 2) << "a shallow copy of the volume rebuilt the pyramid";
+  // New values in the array (announced as VTK asks, array->Modified()) or a new grid do.
+  copy->GetPointData()->GetScalars()->Modified();
   filter->Update();
   EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 3);
+  copy->SetSpacing(1.0, 1.0, 1.5);
+  filter->Update();
+  EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 4);
+  copy->SetOrigin(0.25, 0.0, 0.0);
+  filter->Update();
+  EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 5);
+}
+
+/// The first component of a point array, as doubles.
+std::vector<double> ValuesOf(vtkPolyData* surface, const char* name)
+{
+  vtkDataArray* a = surface->GetPointData()->GetArray(name);
+  std::vector<double> v(static_cast<size_t>(a->GetNumberOfTuples()));
+  for (size_t i = 0; i < v.size(); ++i)
+    v[i] = a->GetComponent(static_cast<vtkIdType>(i), 0);
+  return v;
+}
+
+TEST(IsosurfaceAmbientOcclusionFilter, ALightMoveReusesTheAmbientOcclusionAndNothingElseDoes)
+{
+  auto volume = Slab(32, 8, 12);
+  auto surface = Contour(volume, 500);
+  vtkNew<vtkIsosurfaceAmbientOcclusion> filter;
+  filter->SetInputData(0, surface);
+  filter->SetVolumeData(volume);
+  filter->ComputeShadowsOn();
+  filter->SetLightDirection(0, 0, 1);
+  filter->Update();
+  auto array = [&](const char* name) { return filter->GetOutput()->GetPointData()->GetArray(name); };
+  auto values = [&](const char* name) { return ValuesOf(filter->GetOutput(), name); };
+  vtkDataArray* first = array("AmbientOcclusion");
+  const auto firstAo = values("AmbientOcclusion");
+  const auto firstShadow = values("Shadow");
+  filter->SetLightDirection(1, 0, -1);
+  filter->Update();
+  EXPECT_EQ(array("AmbientOcclusion"), first) << "the light does not change the AO: it is reused";
+  EXPECT_NE(values("Shadow"), firstShadow);
+  // Whatever the AO reads makes it new, equal to a fresh filter's.
+  auto fresh = [&](vtkPolyData* s, double offset) {
+    vtkNew<vtkIsosurfaceAmbientOcclusion> other;
+    other->SetInputData(0, s);
+    other->SetVolumeData(volume);
+    other->SetOffsetFactor(offset);
+    other->Update();
+    return ValuesOf(other->GetOutput(), "AmbientOcclusion");
+  };
+  filter->SetOffsetFactor(2.5);
+  filter->Update();
+  EXPECT_NE(values("AmbientOcclusion"), firstAo);
+  EXPECT_EQ(values("AmbientOcclusion"), fresh(surface, 2.5)) << "a new offset factor";
+  vtkDataArray* points = surface->GetPoints()->GetData();
+  for (vtkIdType i = 0; i < points->GetNumberOfTuples(); ++i)
+    points->SetComponent(i, 2, points->GetComponent(i, 2) + 0.5); // moved in place, then announced
+  points->Modified();
+  filter->Update();
+  EXPECT_EQ(values("AmbientOcclusion"), fresh(surface, 2.5)) << "moved points";
+  auto other = Contour(volume, 300);
+  filter->SetInputData(0, other);
+  filter->Update();
+  EXPECT_EQ(values("AmbientOcclusion"), fresh(other, 2.5)) << "a new surface";
+  EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 1);
 }
 
 TEST(IsosurfaceAmbientOcclusionFilter, ShadowsFallBehindASlabAndFollowTheLight)

@@ -189,6 +189,21 @@ for name in ["AmbientOcclusion", "Shadow"]:
     values = vtk_to_numpy(surface.GetPointData().GetArray(name))
     check(values.size == surface.GetNumberOfPoints() > 10000 and values.min() >= 0 and values.max() <= 1
           and values.std() > 0.05, "bone surface %s in [0, 1] with contrast (std %.3f)" % (name, values.std()))
+# Moving the light re-samples the cached pyramid, it does not rebuild it (ParaView hands the
+# filter a new shallow copy of the volume on every update).
+def pyramid_builds(proxy):
+    return int(re.search(r"PyramidBuilds: (\d+)", str(proxy.GetClientSideObject())).group(1))
+
+
+builds_before = pyramid_builds(shaded)
+shadow_before = vtk_to_numpy(surface.GetPointData().GetArray("Shadow")).copy()
+shaded.LightDirection = [1.0, 0.0, 1.0]
+moved = servermanager.Fetch(shaded)
+check(pyramid_builds(shaded) == builds_before == 1,
+      "a light move through pvpython re-samples the pyramid (%d builds before, %d after)"
+      % (builds_before, pyramid_builds(shaded)))
+check(np.abs(vtk_to_numpy(moved.GetPointData().GetArray("Shadow")) - shadow_before).max() > 0.1,
+      "the shadows follow the moved light")
 # Ambient Occlusion Shading on both data types, with default settings.
 colours = AmbientOcclusionShading(Input=shaded)
 lit_surface = servermanager.Fetch(colours)

@@ -1,0 +1,292 @@
+// vtkIsosurfaceAmbientOcclusion, what it keeps between updates: the moment pyramid (built
+// once per volume, serially or as distributed pieces with a shared coarsest level) and the
+// last AmbientOcclusion (which a light move reuses), and the shading that samples them.
+#include "vtkIsosurfaceAmbientOcclusion.h"
+
+#include "vtkAmbientOcclusionArrayInput.h"
+#include "vtkAmbientOcclusionCollectives.h"
+#include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionMemory.h"
+#include "vtkAmbientOcclusionPyramidImages.h"
+
+#include "vao/VarianceOcclusionMap.h"
+
+#include "vtkDataArray.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkMultiProcessController.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+
+#include <algorithm>
+#include <array>
+#include <string>
+#include <tuple>
+#include <vector>
+
+namespace Extents = vtkAmbientOcclusionExtents;
+namespace PyramidImages = vtkAmbientOcclusionPyramidImages;
+using vtkAmbientOcclusionArrayInput::ExecutionOf;
+using vtkAmbientOcclusionArrayInput::PrepareScalars;
+
+namespace
+{
+/// What a surface's AmbientOcclusion depends on besides the pyramid (its build count): the
+/// point and normal arrays (by identity and MTime, as for the volume), the point count and
+/// the query.
+struct SurfaceKey
+{
+  vtkDataArray* points = nullptr;
+  vtkMTimeType pointsTime = 0;
+  vtkDataArray* normals = nullptr;
+  vtkMTimeType normalsTime = 0;
+  vtkIdType count = 0;
+  std::array<double, 6> query{};
+  int pyramidBuilds = 0;
+
+  SurfaceKey() = default;
+  SurfaceKey(vtkPolyData* surface, const vao::SurfaceOcclusionParameters& p, int builds)
+    : points(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr)
+    , normals(surface->GetPointData()->GetNormals() ? surface->GetPointData()->GetNormals()
+                                                     : surface->GetPointData()->GetArray("Normals"))
+    , count(surface->GetNumberOfPoints())
+    , query{ static_cast<double>(p.query), p.isoValue, p.offsetFactor, static_cast<double>(p.estimator),
+      static_cast<double>(p.combination), static_cast<double>(p.levels) }
+    , pyramidBuilds(builds)
+  {
+    this->pointsTime = this->points ? this->points->GetMTime() : 0;
+    this->normalsTime = this->normals ? this->normals->GetMTime() : 0;
+  }
+
+  bool operator==(const SurfaceKey& o) const
+  {
+    return std::tie(this->points, this->pointsTime, this->normals, this->normalsTime, this->count, this->query,
+             this->pyramidBuilds) ==
+      std::tie(o.points, o.pointsTime, o.normals, o.normalsTime, o.count, o.query, o.pyramidBuilds);
+  }
+};
+} // namespace
+
+/// The pyramid of the last volume, and what it was built from: the array (and its MTime,
+/// which VTK bumps whenever a source refills it or a user calls array->Modified()) on the
+/// volume's grid. Not the volume object's MTime: ParaView hands the filter a shallow copy
+/// of the reader's output that is made again on every update (vtkPVPostFilter), which
+/// rebuilt the pyramid on every light move.
+struct vtkIsosurfaceAmbientOcclusion::Cache
+{
+  std::vector<vao::MomentLevel> levels;
+  std::array<int, 6> extent{};
+  vtkDataArray* array = nullptr;
+  vtkMTimeType arrayTime = 0;
+  int component = -1;
+  int numberOfLevels = 0;
+  bool halfResolution = false;
+  // The input scalars as the kernels read them (for the half-voxel-inside query).
+  vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
+  std::array<double, 3> origin{};
+  std::array<double, 3> spacing{};
+  // The last AmbientOcclusion, which does not depend on the light: a light move reuses it
+  // while the surface, the query and the pyramid stay (SurfaceKey).
+  vtkSmartPointer<vtkFloatArray> occlusion;
+  SurfaceKey occlusionKey;
+};
+
+//------------------------------------------------------------------------------
+vtkIsosurfaceAmbientOcclusion::vtkIsosurfaceAmbientOcclusion()
+  : Controller(vtkMultiProcessController::GetGlobalController())
+  , Pyramid(new Cache)
+{
+  this->SetNumberOfInputPorts(2);
+  this->SetInputArrayToProcess(
+    0, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+}
+
+vtkIsosurfaceAmbientOcclusion::~vtkIsosurfaceAmbientOcclusion() = default;
+
+//------------------------------------------------------------------------------
+bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataArray* chosen)
+{
+  Cache& cache = *this->Pyramid;
+  const int* extent = volume->GetExtent();
+  const double* h = volume->GetSpacing();
+  const bool sameGrid = std::equal(extent, extent + 6, cache.extent.begin()) &&
+    cache.origin == PyramidImages::ExtentOrigin(volume) && cache.spacing == std::array<double, 3>{ h[0], h[1], h[2] };
+  const bool fresh = chosen && cache.array == chosen && cache.arrayTime == chosen->GetMTime() && sameGrid &&
+    cache.component == this->Component &&
+    cache.numberOfLevels == this->NumberOfLevels && cache.halfResolution == (this->StartAtHalfResolution != 0) &&
+    !cache.levels.empty();
+  if (fresh)
+  {
+    return true;
+  }
+  cache.levels.clear();
+  std::string error;
+  if (!Extents::CheckWholeExtent(volume->GetExtent(), error) ||
+    !PrepareScalars(this, chosen, volume, this->Component, cache.scalars, error) ||
+    !PyramidImages::BuildPyramid(cache.scalars, volume, this->PyramidRequest(),
+      ExecutionOf(this, this->NumberOfThreads), cache.levels, error))
+  {
+    cache.levels.clear();
+    if (!error.empty())
+    {
+      vtkErrorMacro(<< error);
+    }
+    return false;
+  }
+  cache.origin = PyramidImages::ExtentOrigin(volume);
+  cache.spacing = { h[0], h[1], h[2] };
+  std::copy(extent, extent + 6, cache.extent.begin());
+  cache.array = chosen;
+  cache.arrayTime = chosen ? chosen->GetMTime() : 0;
+  cache.component = this->Component;
+  cache.numberOfLevels = this->NumberOfLevels;
+  cache.halfResolution = this->StartAtHalfResolution != 0;
+  ++this->PyramidBuilds;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
+  vtkImageData* volume, vtkDataArray* chosen, const int whole[6], int piece[6])
+{
+  Cache& cache = *this->Pyramid;
+  cache.levels.clear();
+  cache.array = nullptr; // not reused: the pieces follow the decomposition
+  std::string error;
+  int expected[6];
+  this->VolumeExtentOf(whole, volume->GetSpacing(), piece, expected);
+  const bool empty = Extents::EmptyExtent(piece);
+  if (!empty && !std::equal(expected, expected + 6, volume->GetExtent()))
+  {
+    error = "The volume input delivered another extent than this process's piece and its reach: under MPI, "
+            "feed the Volume input from its own reader.";
+  }
+  else if (!empty && Extents::CheckWholeExtent(whole, error) &&
+    PrepareScalars(this, chosen, volume, this->Component, cache.scalars, error))
+  {
+    PyramidImages::BuildPyramid(cache.scalars, volume, this->PyramidRequest(),
+      ExecutionOf(this, this->NumberOfThreads), cache.levels, error);
+  }
+  // Every process learns whether any failed before the coarsest level is shared.
+  const bool failed = !error.empty() || (!empty && cache.levels.empty());
+  if (vtkAmbientOcclusionCollectives::GlobalMax(this->Controller, failed ? 1.0 : 0.0) > 0.0)
+  {
+    vtkErrorMacro(<< (error.empty() ? std::string("The pyramid failed on another process (see its message).") : error));
+    cache.levels.clear();
+    return false;
+  }
+  this->ShareCoarsestLevel(volume, whole, expected, piece);
+  if (empty)
+  {
+    return false;
+  }
+  const double* h = volume->GetSpacing();
+  cache.origin = PyramidImages::ExtentOrigin(volume);
+  cache.spacing = { h[0], h[1], h[2] };
+  ++this->PyramidBuilds;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkIsosurfaceAmbientOcclusion::ShareCoarsestLevel(
+  vtkImageData* volume, const int whole[6], const int inputExt[6], const int piece[6])
+{
+  // This piece's voxels of the coarsest level go to every process; the whole level is
+  // assembled from them (they overlap where pieces share a face).
+  Cache& cache = *this->Pyramid;
+  const bool half = this->StartAtHalfResolution != 0;
+  const int last = this->NumberOfLevels - 1;
+  const int step = (half ? 2 : 1) << last;
+  vtkSmartPointer<vtkImageData> part;
+  if (!cache.levels.empty())
+  {
+    part = PyramidImages::LevelPiece(cache.levels[last], whole, inputExt, piece, step);
+  }
+  vao::MomentLevel coarsest = PyramidImages::WholeLevelGeometry(volume, whole, step);
+  vtkAmbientOcclusionCollectives::GatherLevel(this->Controller, part, coarsest);
+  // Every process treats the same samples as flat: the largest rounding bound of any piece.
+  const double rounding = vtkAmbientOcclusionCollectives::GlobalMax(
+    this->Controller, cache.levels.empty() ? 0.0 : cache.levels[0].roundingVariance);
+  if (cache.levels.empty())
+  {
+    return; // an empty piece: nothing of its own to sample
+  }
+  coarsest.kernelRadius = cache.levels[last].kernelRadius;
+  cache.levels[last] = std::move(coarsest);
+  for (vao::MomentLevel& level : cache.levels)
+  {
+    level.roundingVariance = rounding;
+  }
+  // The shadows' march stops at the whole volume's border, not at this piece's.
+  const vao::MomentLevel base = PyramidImages::WholeLevelGeometry(volume, whole, half ? 2 : 1);
+  for (int a = 0; a < 3; ++a)
+  {
+    cache.levels[0].wholeBounds[2 * a] = base.origin[a];
+    cache.levels[0].wholeBounds[2 * a + 1] = base.origin[a] + (base.dims[a] - 1) * base.spacing[a];
+  }
+}
+
+//------------------------------------------------------------------------------
+bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* output)
+{
+  Cache& cache = *this->Pyramid;
+  const vtkIdType n = surface->GetNumberOfPoints();
+  std::vector<double> points(static_cast<size_t>(3 * n)), normals;
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    surface->GetPoint(i, &points[3 * i]);
+  }
+  std::string error;
+  if (!vtkAmbientOcclusionArrayInput::SurfaceNormals(
+        surface, cache.scalars, cache.origin, cache.spacing, normals, error))
+  {
+    vtkErrorMacro(<< error);
+    return false;
+  }
+  const vao::SurfaceOcclusionParameters parameters = this->Parameters();
+  const vao::Execution execution = ExecutionOf(this, this->NumberOfThreads);
+  const SurfaceKey key(surface, parameters, this->PyramidBuilds);
+  vao::Status status = vao::Status::success();
+  if (!cache.occlusion || !(cache.occlusionKey == key))
+  {
+    cache.occlusion = nullptr;
+    vtkNew<vtkFloatArray> occlusion;
+    occlusion->SetName("AmbientOcclusion");
+    vtkAmbientOcclusionMemory::Allocate(occlusion, n, "the AmbientOcclusion output");
+    status = vao::surfaceAmbientOcclusion(cache.levels, cache.scalars.view, cache.origin, cache.spacing,
+      points.data(), normals.data(), n, parameters, occlusion->GetPointer(0), execution);
+    if (status.ok)
+    {
+      cache.occlusion = occlusion;
+      cache.occlusionKey = key;
+    }
+  }
+  vtkNew<vtkFloatArray> shadow;
+  if (status.ok && this->ComputeShadows)
+  {
+    shadow->SetName("Shadow");
+    vtkAmbientOcclusionMemory::Allocate(shadow, n, "the Shadow output");
+    const double* l = this->LightDirection;
+    status = vao::surfaceShadow(cache.levels, points.data(), normals.data(), n, { l[0], l[1], l[2] }, parameters,
+      shadow->GetPointer(0), execution);
+  }
+  if (!status.ok)
+  {
+    error = vtkAmbientOcclusionArrayInput::KernelError(status, cache.scalars, "Isosurface ambient occlusion failed");
+    if (!error.empty())
+    {
+      vtkErrorMacro(<< error);
+    }
+    return false;
+  }
+  output->GetPointData()->AddArray(cache.occlusion);
+  if (this->ComputeShadows)
+  {
+    output->GetPointData()->AddArray(shadow);
+  }
+  return true;
+}
+
