@@ -1,8 +1,8 @@
 // A level of the moment pyramid prepared for many trilinear samples. The surface queries
 // sample every point's levels tens of times (the shadow march), so the divisions, bounds
 // and strides are done once here, and kLanes points are sampled together: their loads are
-// independent (the processor overlaps the cache misses), and on AVX2 the lane loop
-// compiles to gathers and vector arithmetic (CpuDispatch.h).
+// independent, so the processor overlaps them. This is the definition of a lane's sample;
+// SurfaceLanes.h has the AVX2 form and the dispatch.
 #pragma once
 
 #include "CpuDispatch.h"
@@ -12,10 +12,6 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
-
-#if VAO_HAVE_AVX2_TARGET
-#include <immintrin.h>
-#endif
 
 namespace vao
 {
@@ -108,108 +104,6 @@ void chebyshevLanes(const LevelGrid& g, const double* x, const double* y, const 
     double mean, variance;
     trilinearSample<IndexT>(g, x[k], y[k], z[k], mean, variance);
     occlusion[k] = 1.0 - opennessChebyshevWithin(query[k], mean, variance, g.roundingVariance, g.roundingSpread);
-  }
-}
-
-#if VAO_HAVE_AVX2_TARGET
-#define VAO_AVX2_INLINE __attribute__((target("avx2,fma"))) inline
-
-VAO_AVX2_INLINE __m256d lerpAvx2(__m256d a, __m256d b, __m256d t)
-{
-  return _mm256_fmadd_pd(t, _mm256_sub_pd(b, a), a);
-}
-
-/// Four trilinear blends of c: cells from `base` (32-bit indices), corner steps per axis
-/// (0 where clamped), fractions f (trilinearSample's nested lerps).
-VAO_AVX2_INLINE __m256d blendAvx2(const float* c, __m128i base, const __m128i* step, const __m256d* f)
-{
-  const __m128i corner[4] = { base, _mm_add_epi32(base, step[1]), _mm_add_epi32(base, step[2]),
-    _mm_add_epi32(_mm_add_epi32(base, step[2]), step[1]) };
-  __m256d rows[4];
-  for (int r = 0; r < 4; ++r)
-  {
-    const __m256d lo = _mm256_cvtps_pd(_mm_i32gather_ps(c, corner[r], 4));
-    const __m256d hi = _mm256_cvtps_pd(_mm_i32gather_ps(c, _mm_add_epi32(corner[r], step[0]), 4));
-    rows[r] = lerpAvx2(lo, hi, f[0]);
-  }
-  return lerpAvx2(lerpAvx2(rows[0], rows[1], f[1]), lerpAvx2(rows[2], rows[3], f[1]), f[2]);
-}
-
-/// chebyshevLanes<std::int32_t> four lanes per vector: the corners by 32-bit gathers, the
-/// blends and the estimator's both branches in vector arithmetic, one kept by a mask.
-/// (GCC does not vectorise the plain loop: its float-to-int conversions and selects stay
-/// branches.) Equal to the plain loop but for the rounding of fused multiply-adds.
-VAO_AVX2_INLINE void chebyshevLanesAvx2(const LevelGrid& g, const double* x,
-  const double* y, const double* z, const double* query, double* occlusion)
-{
-  const double* position[3] = { x, y, z };
-  const __m256d zero = _mm256_setzero_pd();
-  const __m256d one = _mm256_set1_pd(1.0);
-  for (int h = 0; h < kLanes; h += 4)
-  {
-    __m128i base = _mm_setzero_si128();
-    __m128i step[3];
-    __m256d f[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      const __m256d maxIndex = _mm256_set1_pd(g.maxIndex[a]);
-      const __m256d offset = _mm256_sub_pd(_mm256_loadu_pd(position[a] + h), _mm256_set1_pd(g.origin[a]));
-      const __m256d u = _mm256_min_pd(
-        _mm256_max_pd(_mm256_mul_pd(offset, _mm256_set1_pd(g.inverseSpacing[a])), zero), maxIndex);
-      const __m128i lower = _mm256_cvttpd_epi32(u);
-      f[a] = _mm256_sub_pd(u, _mm256_cvtepi32_pd(lower));
-      const __m128i stride = _mm_set1_epi32(static_cast<int>(g.stride[a]));
-      base = _mm_add_epi32(base, _mm_mullo_epi32(lower, stride));
-      // The 64-bit lane masks of u < maxIndex, narrowed to 32 bits.
-      const __m256i below = _mm256_castpd_si256(_mm256_cmp_pd(u, maxIndex, _CMP_LT_OQ));
-      const __m128i narrow =
-        _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(below, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
-      step[a] = _mm_and_si128(narrow, stride);
-    }
-    const __m256d mean = blendAvx2(g.mean, base, step, f);
-    const __m256d variance = _mm256_max_pd(blendAvx2(g.variance, base, step, f), zero);
-    const __m256d q = _mm256_loadu_pd(query + h);
-    // opennessChebyshevWithin, both branches.
-    const __m256d d = _mm256_sub_pd(q, mean);
-    const __m256d share = _mm256_div_pd(variance, _mm256_fmadd_pd(d, d, variance));
-    const __m256d bound = _mm256_and_pd(_mm256_cmp_pd(d, zero, _CMP_GT_OQ),
-      _mm256_min_pd(_mm256_max_pd(_mm256_sub_pd(one, share), zero), one));
-    const __m256d flatLimit = _mm256_max_pd(_mm256_set1_pd(g.roundingVariance),
-      _mm256_mul_pd(_mm256_set1_pd(kFlatEpsilon), _mm256_max_pd(_mm256_mul_pd(mean, mean), one)));
-    const __m256d flat = _mm256_cmp_pd(variance, flatLimit, _CMP_LE_OQ);
-    const __m256d magnitude = _mm256_max_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), mean), one);
-    const __m256d spread = _mm256_max_pd(_mm256_set1_pd(g.roundingSpread), _mm256_mul_pd(_mm256_set1_pd(kFlatSpread), magnitude));
-    const __m256d flatOpen = _mm256_and_pd(_mm256_cmp_pd(q, _mm256_sub_pd(mean, spread), _CMP_GE_OQ), one);
-    _mm256_storeu_pd(occlusion + h, _mm256_sub_pd(one, _mm256_blendv_pd(bound, flatOpen, flat)));
-  }
-}
-#endif
-
-/// The occlusions of kLanes samples of one level with the given estimator.
-inline void occlusionLanes(const LevelGrid& g, Method estimator, const double* x, const double* y, const double* z,
-  const double* query, double* occlusion)
-{
-  if (estimator == Method::Chebyshev)
-  {
-#if VAO_HAVE_AVX2_TARGET
-    static const bool avx2 = cpuHasAvx2();
-    if (avx2 && g.narrowIndices)
-    {
-      chebyshevLanesAvx2(g, x, y, z, query, occlusion);
-      return;
-    }
-#endif
-    if (g.narrowIndices)
-      chebyshevLanes<std::int32_t>(g, x, y, z, query, occlusion);
-    else
-      chebyshevLanes<std::int64_t>(g, x, y, z, query, occlusion);
-    return;
-  }
-  for (int k = 0; k < kLanes; ++k) // the exact erf has no vector form here
-  {
-    double mean, variance;
-    trilinearSample<std::int64_t>(g, x[k], y[k], z[k], mean, variance);
-    occlusion[k] = sampleOcclusion(estimator, query[k], mean, variance, g.roundingVariance);
   }
 }
 

@@ -3,7 +3,7 @@
 #include "vao/VarianceOcclusionMap.h"
 #include "vao/Validation.h"
 
-#include "LevelGrid.h"
+#include "SurfaceLanes.h"
 #include "Parallel.h"
 #include "VolumeAccess.h"
 
@@ -168,12 +168,16 @@ struct PreparedPyramid
   std::vector<detail::LevelGrid> grids;
   std::vector<double> kernelRadius;
 
+  // The AVX2 march applies: the processor has it and every level's indices fit in 32 bits.
+  bool vectorMarch = detail::cpuHasAvx2();
+
   PreparedPyramid(const std::vector<MomentLevel>& pyramid, int levels)
   {
     for (int l = 0; l < levels; ++l)
     {
       this->grids.emplace_back(pyramid[l]);
       this->kernelRadius.push_back(pyramid[l].kernelRadius);
+      this->vectorMarch = this->vectorMarch && this->grids.back().narrowIndices;
     }
   }
 };
@@ -323,28 +327,34 @@ void batchOcclusion(const PreparedPyramid& pyramid, int levels, const PointLanes
 
 /// The largest occlusion each lane's march meets from p + r_0 n along the unit `light`.
 /// The lanes share the steps (t and the level depend on the distance alone); a lane stops
-/// on leaving the bounds or at occlusion >= 0.999, the batch when every lane has.
+/// on leaving the bounds or at full occlusion, the batch when every lane has.
 void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int levels, const PointLanes& lanes,
   const std::array<double, 3>& light, Method estimator, double* occlusion)
 {
-  // Steps of half the level's radius: a blob of the level's size cannot fall between two.
-  constexpr double kStepFraction = 0.5;
-  constexpr int kMaxSteps = 1 << 16;
   constexpr int W = detail::kLanes;
   const double r0 = pyramid.kernelRadius[0];
   double sx[W], sy[W], sz[W], x[W], y[W], z[W], sample[W];
-  bool alive[W];
   for (int k = 0; k < W; ++k)
   {
     const std::array<double, 3> start = lanes.along(k, r0);
     sx[k] = start[0];
     sy[k] = start[1];
     sz[k] = start[2];
-    occlusion[k] = 0.0;
-    alive[k] = true;
   }
+#if VAO_HAVE_AVX2_TARGET
+  if (estimator == Method::Chebyshev && pyramid.vectorMarch)
+  {
+    const double* start[3] = { sx, sy, sz };
+    detail::chebyshevMarchAvx2(pyramid.grids.data(), pyramid.kernelRadius.data(), levels, bounds.lo, bounds.hi,
+      start, light.data(), lanes.query, occlusion);
+    return;
+  }
+#endif
+  bool alive[W];
+  std::fill(occlusion, occlusion + W, 0.0);
+  std::fill(alive, alive + W, true);
   double t = 0.0;
-  for (int s = 0; s < kMaxSteps; ++s)
+  for (int s = 0; s < detail::kMarchMaxSteps; ++s)
   {
     bool any = false;
     for (int k = 0; k < W; ++k)
@@ -360,17 +370,17 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int l
     {
       break;
     }
-    const int l = std::min(levels - 1, std::max(0, static_cast<int>(std::floor(std::log2(1.0 + t / r0)))));
+    const int l = detail::marchLevel(t, r0, levels);
     detail::occlusionLanes(pyramid.grids[l], estimator, x, y, z, lanes.query, sample);
     for (int k = 0; k < W; ++k)
     {
       if (alive[k])
       {
         occlusion[k] = std::max(occlusion[k], sample[k]);
-        alive[k] = occlusion[k] < 0.999;
+        alive[k] = occlusion[k] < detail::kMarchFullOcclusion;
       }
     }
-    t += kStepFraction * pyramid.kernelRadius[l];
+    t += detail::kMarchStepFraction * pyramid.kernelRadius[l];
   }
 }
 

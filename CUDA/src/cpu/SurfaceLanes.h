@@ -1,0 +1,192 @@
+// The surface queries' lanes (LevelGrid.h) on AVX2 + FMA, and the dispatch between them
+// and the plain loops: the trilinear Chebyshev sample of four lanes per vector by 32-bit
+// gathers, and the whole shadow march of a batch in vector registers, so one step is
+// few enough instructions for the processor to overlap the gathers' latency of several.
+// (GCC does not vectorise the plain loops: their float-to-int conversions and selects stay
+// branches.) Equal to the plain loops but for the rounding of fused multiply-adds.
+#pragma once
+
+#include "CpuDispatch.h"
+#include "LevelGrid.h"
+
+#include <cmath>
+
+#if VAO_HAVE_AVX2_TARGET
+#include <immintrin.h>
+#endif
+
+namespace vao
+{
+namespace detail
+{
+
+/// The shadow march's rules, shared by its plain and vector forms: steps of half the
+/// level's radius (a blob of the level's size cannot fall between two), a stop at this
+/// occlusion, and the level at distance t: clamp(floor(log2(1 + t / r0)), 0, levels - 1).
+constexpr double kMarchStepFraction = 0.5;
+constexpr int kMarchMaxSteps = 1 << 16;
+constexpr double kMarchFullOcclusion = 0.999;
+inline int marchLevel(double t, double r0, int levels)
+{
+  return std::min(levels - 1, std::max(0, static_cast<int>(std::floor(std::log2(1.0 + t / r0)))));
+}
+
+#if VAO_HAVE_AVX2_TARGET
+#define VAO_AVX2_INLINE __attribute__((target("avx2,fma"))) inline
+
+VAO_AVX2_INLINE __m256d lerpAvx2(__m256d a, __m256d b, __m256d t)
+{
+  return _mm256_fmadd_pd(t, _mm256_sub_pd(b, a), a);
+}
+
+/// Four trilinear blends of c: cells from `base` (32-bit indices), corner steps per axis
+/// (0 where clamped), fractions f (trilinearSample's nested lerps).
+VAO_AVX2_INLINE __m256d blendAvx2(const float* c, __m128i base, const __m128i* step, const __m256d* f)
+{
+  const __m128i corner[4] = { base, _mm_add_epi32(base, step[1]), _mm_add_epi32(base, step[2]),
+    _mm_add_epi32(_mm_add_epi32(base, step[2]), step[1]) };
+  __m256d rows[4];
+  for (int r = 0; r < 4; ++r)
+  {
+    const __m256d lo = _mm256_cvtps_pd(_mm_i32gather_ps(c, corner[r], 4));
+    const __m256d hi = _mm256_cvtps_pd(_mm_i32gather_ps(c, _mm_add_epi32(corner[r], step[0]), 4));
+    rows[r] = lerpAvx2(lo, hi, f[0]);
+  }
+  return lerpAvx2(lerpAvx2(rows[0], rows[1], f[1]), lerpAvx2(rows[2], rows[3], f[1]), f[2]);
+}
+
+/// The Chebyshev occlusion of q at four world positions of one level (chebyshevLanes'
+/// formula): the corners by 32-bit gathers, the blends and both of the estimator's branches
+/// in vector arithmetic, one kept by a mask.
+VAO_AVX2_INLINE __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d* position, __m256d q)
+{
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d one = _mm256_set1_pd(1.0);
+  __m128i base = _mm_setzero_si128();
+  __m128i step[3];
+  __m256d f[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const __m256d maxIndex = _mm256_set1_pd(g.maxIndex[a]);
+    const __m256d offset = _mm256_sub_pd(position[a], _mm256_set1_pd(g.origin[a]));
+    const __m256d u = _mm256_min_pd(
+      _mm256_max_pd(_mm256_mul_pd(offset, _mm256_set1_pd(g.inverseSpacing[a])), zero), maxIndex);
+    const __m128i lower = _mm256_cvttpd_epi32(u);
+    f[a] = _mm256_sub_pd(u, _mm256_cvtepi32_pd(lower));
+    const __m128i stride = _mm_set1_epi32(static_cast<int>(g.stride[a]));
+    base = _mm_add_epi32(base, _mm_mullo_epi32(lower, stride));
+    // The 64-bit lane masks of u < maxIndex, narrowed to 32 bits.
+    const __m256i below = _mm256_castpd_si256(_mm256_cmp_pd(u, maxIndex, _CMP_LT_OQ));
+    const __m128i narrow =
+      _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(below, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
+    step[a] = _mm_and_si128(narrow, stride);
+  }
+  const __m256d mean = blendAvx2(g.mean, base, step, f);
+  const __m256d variance = _mm256_max_pd(blendAvx2(g.variance, base, step, f), zero);
+  // opennessChebyshevWithin, both branches.
+  const __m256d d = _mm256_sub_pd(q, mean);
+  const __m256d share = _mm256_div_pd(variance, _mm256_fmadd_pd(d, d, variance));
+  const __m256d bound = _mm256_and_pd(_mm256_cmp_pd(d, zero, _CMP_GT_OQ),
+    _mm256_min_pd(_mm256_max_pd(_mm256_sub_pd(one, share), zero), one));
+  const __m256d flatLimit = _mm256_max_pd(_mm256_set1_pd(g.roundingVariance),
+    _mm256_mul_pd(_mm256_set1_pd(kFlatEpsilon), _mm256_max_pd(_mm256_mul_pd(mean, mean), one)));
+  const __m256d flat = _mm256_cmp_pd(variance, flatLimit, _CMP_LE_OQ);
+  const __m256d magnitude = _mm256_max_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), mean), one);
+  const __m256d spread = _mm256_max_pd(_mm256_set1_pd(g.roundingSpread), _mm256_mul_pd(_mm256_set1_pd(kFlatSpread), magnitude));
+  const __m256d flatOpen = _mm256_and_pd(_mm256_cmp_pd(q, _mm256_sub_pd(mean, spread), _CMP_GE_OQ), one);
+  return _mm256_sub_pd(one, _mm256_blendv_pd(bound, flatOpen, flat));
+}
+
+/// chebyshevLanes<std::int32_t>, four lanes per vector.
+VAO_AVX2_INLINE void chebyshevLanesAvx2(const LevelGrid& g, const double* x, const double* y, const double* z,
+  const double* query, double* occlusion)
+{
+  for (int h = 0; h < kLanes; h += 4)
+  {
+    const __m256d position[3] = { _mm256_loadu_pd(x + h), _mm256_loadu_pd(y + h), _mm256_loadu_pd(z + h) };
+    _mm256_storeu_pd(occlusion + h, chebyshevOcclusionAvx2(g, position, _mm256_loadu_pd(query + h)));
+  }
+}
+
+/// The Chebyshev shadow march of a batch (batchMarch in SurfaceSampling.cxx, whose rules it
+/// follows lane by lane) with the positions, bounds, occlusions and the lanes still
+/// marching in registers: from start (x, y, z per lane) along the unit light, inside
+/// [lo, hi], on levels whose indices fit in 32 bits.
+VAO_AVX2_INLINE void chebyshevMarchAvx2(const LevelGrid* grids, const double* kernelRadius, int levels,
+  const double* lo, const double* hi, const double* const* start, const double* light, const double* query,
+  double* occlusion)
+{
+  constexpr int kHalves = kLanes / 4;
+  const __m256d full = _mm256_set1_pd(kMarchFullOcclusion);
+  __m256d occ[kHalves], alive[kHalves], q[kHalves], from[kHalves][3];
+  for (int h = 0; h < kHalves; ++h)
+  {
+    occ[h] = _mm256_setzero_pd();
+    alive[h] = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+    q[h] = _mm256_loadu_pd(query + 4 * h);
+    for (int a = 0; a < 3; ++a)
+      from[h][a] = _mm256_loadu_pd(start[a] + 4 * h);
+  }
+  const double r0 = kernelRadius[0];
+  double t = 0.0;
+  for (int s = 0; s < kMarchMaxSteps; ++s)
+  {
+    __m256d at[kHalves][3];
+    int any = 0;
+    for (int h = 0; h < kHalves; ++h)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        at[h][a] = _mm256_fmadd_pd(_mm256_set1_pd(t), _mm256_set1_pd(light[a]), from[h][a]);
+        const __m256d inside = _mm256_and_pd(_mm256_cmp_pd(at[h][a], _mm256_set1_pd(lo[a]), _CMP_GE_OQ),
+          _mm256_cmp_pd(at[h][a], _mm256_set1_pd(hi[a]), _CMP_LE_OQ));
+        alive[h] = _mm256_and_pd(alive[h], inside);
+      }
+      any |= _mm256_movemask_pd(alive[h]);
+    }
+    if (!any)
+      break;
+    const int l = marchLevel(t, r0, levels);
+    for (int h = 0; h < kHalves; ++h)
+    {
+      const __m256d sample = chebyshevOcclusionAvx2(grids[l], at[h], q[h]);
+      occ[h] = _mm256_blendv_pd(occ[h], _mm256_max_pd(sample, occ[h]), alive[h]);
+      alive[h] = _mm256_and_pd(alive[h], _mm256_cmp_pd(occ[h], full, _CMP_LT_OQ));
+    }
+    t += kMarchStepFraction * kernelRadius[l];
+  }
+  for (int h = 0; h < kHalves; ++h)
+    _mm256_storeu_pd(occlusion + 4 * h, occ[h]);
+}
+#endif
+
+
+/// The occlusions of kLanes samples of one level with the given estimator.
+inline void occlusionLanes(const LevelGrid& g, Method estimator, const double* x, const double* y, const double* z,
+  const double* query, double* occlusion)
+{
+  if (estimator == Method::Chebyshev)
+  {
+#if VAO_HAVE_AVX2_TARGET
+    if (cpuHasAvx2() && g.narrowIndices)
+    {
+      chebyshevLanesAvx2(g, x, y, z, query, occlusion);
+      return;
+    }
+#endif
+    if (g.narrowIndices)
+      chebyshevLanes<std::int32_t>(g, x, y, z, query, occlusion);
+    else
+      chebyshevLanes<std::int64_t>(g, x, y, z, query, occlusion);
+    return;
+  }
+  for (int k = 0; k < kLanes; ++k) // the exact erf has no vector form here
+  {
+    double mean, variance;
+    trilinearSample<std::int64_t>(g, x[k], y[k], z[k], mean, variance);
+    occlusion[k] = sampleOcclusion(estimator, query[k], mean, variance, g.roundingVariance);
+  }
+}
+
+} // namespace detail
+} // namespace vao
