@@ -216,8 +216,9 @@ TEST(SurfaceReference, AmbientOcclusionAndShadowsMatchTheDefinition)
 
 TEST(SurfaceLanes, VectorPathEqualsThePlainLoop)
 {
-  // Positions inside, on the faces and outside (clamped), on a level with a one-voxel axis.
-  for (const vao::Index3 dims : { vao::Index3{ 9, 7, 5 }, vao::Index3{ 6, 1, 4 } })
+  // Positions inside, on the faces and outside (clamped), on levels with a one-voxel axis
+  // (x: the cells have no x pair, the vector path gathers corner by corner).
+  for (const vao::Index3 dims : { vao::Index3{ 9, 7, 5 }, vao::Index3{ 6, 1, 4 }, vao::Index3{ 1, 5, 3 } })
   {
     vao::MomentLevel level;
     level.dims = dims;

@@ -34,6 +34,8 @@ struct LevelGrid
   double roundingSpread = 0.0;          // flatRoundingSpread(roundingVariance)
   // Voxel indices fit in 32 bits: the lanes use 32-bit gathers (else 64-bit ones).
   bool narrowIndices = true;
+  // At least two voxels along x: a cell's two x corners are one 8-byte load.
+  bool pairedRows = false;
 
   LevelGrid() = default;
   explicit LevelGrid(const MomentLevel& level)
@@ -51,6 +53,7 @@ struct LevelGrid
     this->stride[1] = level.dims[0];
     this->stride[2] = level.dims[0] * level.dims[1];
     this->narrowIndices = this->stride[2] * level.dims[2] <= std::numeric_limits<std::int32_t>::max();
+    this->pairedRows = level.dims[0] >= 2;
   }
 };
 

@@ -55,6 +55,25 @@ VAO_AVX2_INLINE __m256d blendAvx2(const float* c, __m128i base, const __m128i* s
   return lerpAvx2(lerpAvx2(rows[0], rows[1], f[1]), lerpAvx2(rows[2], rows[3], f[1]), f[2]);
 }
 
+/// blendAvx2 where every cell's x corners are adjacent (the lower one at most dims - 2,
+/// the fraction 1 at the last voxel): each row's two corners are one 64-bit gather.
+VAO_AVX2_INLINE __m256d blendPairsAvx2(const float* c, __m128i base, const __m128i* step, const __m256d* f)
+{
+  const __m128i corner[4] = { base, _mm_add_epi32(base, step[1]), _mm_add_epi32(base, step[2]),
+    _mm_add_epi32(_mm_add_epi32(base, step[2]), step[1]) };
+  const __m256i split = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+  __m256d rows[4];
+  for (int r = 0; r < 4; ++r)
+  {
+    // Four (lower, upper) float pairs, regrouped as four lowers then four uppers.
+    const __m256i pairs = _mm256_i32gather_epi64(reinterpret_cast<const long long*>(c), corner[r], 4);
+    const __m256 grouped = _mm256_permutevar8x32_ps(_mm256_castsi256_ps(pairs), split);
+    rows[r] = lerpAvx2(_mm256_cvtps_pd(_mm256_castps256_ps128(grouped)),
+      _mm256_cvtps_pd(_mm256_extractf128_ps(grouped, 1)), f[0]);
+  }
+  return lerpAvx2(lerpAvx2(rows[0], rows[1], f[1]), lerpAvx2(rows[2], rows[3], f[1]), f[2]);
+}
+
 /// The Chebyshev occlusion of q at four world positions of one level (chebyshevLanes'
 /// formula): the corners by 32-bit gathers, the blends and both of the estimator's branches
 /// in vector arithmetic, one kept by a mask.
@@ -71,7 +90,9 @@ VAO_AVX2_INLINE __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d
     const __m256d offset = _mm256_sub_pd(position[a], _mm256_set1_pd(g.origin[a]));
     const __m256d u = _mm256_min_pd(
       _mm256_max_pd(_mm256_mul_pd(offset, _mm256_set1_pd(g.inverseSpacing[a])), zero), maxIndex);
-    const __m128i lower = _mm256_cvttpd_epi32(u);
+    __m128i lower = _mm256_cvttpd_epi32(u);
+    if (a == 0 && g.pairedRows) // the last voxel as the upper corner of the cell below it
+      lower = _mm_min_epi32(lower, _mm_set1_epi32(static_cast<int>(g.maxIndex[0]) - 1));
     f[a] = _mm256_sub_pd(u, _mm256_cvtepi32_pd(lower));
     const __m128i stride = _mm_set1_epi32(static_cast<int>(g.stride[a]));
     base = _mm_add_epi32(base, _mm_mullo_epi32(lower, stride));
@@ -81,8 +102,9 @@ VAO_AVX2_INLINE __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d
       _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(below, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
     step[a] = _mm_and_si128(narrow, stride);
   }
-  const __m256d mean = blendAvx2(g.mean, base, step, f);
-  const __m256d variance = _mm256_max_pd(blendAvx2(g.variance, base, step, f), zero);
+  const __m256d mean = g.pairedRows ? blendPairsAvx2(g.mean, base, step, f) : blendAvx2(g.mean, base, step, f);
+  const __m256d variance = _mm256_max_pd(
+    g.pairedRows ? blendPairsAvx2(g.variance, base, step, f) : blendAvx2(g.variance, base, step, f), zero);
   // opennessChebyshevWithin, both branches.
   const __m256d d = _mm256_sub_pd(q, mean);
   const __m256d share = _mm256_div_pd(variance, _mm256_fmadd_pd(d, d, variance));
