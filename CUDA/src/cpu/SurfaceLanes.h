@@ -32,16 +32,18 @@ inline int marchLevel(double t, double r0, int levels)
 }
 
 #if VAO_HAVE_AVX2_TARGET
+// The entry points, called from baseline code, and the helpers they inline.
 #define VAO_AVX2_INLINE __attribute__((target("avx2,fma"))) inline
+#define VAO_AVX2_HELPER __attribute__((target("avx2,fma"), always_inline)) inline
 
-VAO_AVX2_INLINE __m256d lerpAvx2(__m256d a, __m256d b, __m256d t)
+VAO_AVX2_HELPER __m256d lerpAvx2(__m256d a, __m256d b, __m256d t)
 {
   return _mm256_fmadd_pd(t, _mm256_sub_pd(b, a), a);
 }
 
 /// Four trilinear blends of c: cells from `base` (32-bit indices), corner steps per axis
 /// (0 where clamped), fractions f (trilinearSample's nested lerps).
-VAO_AVX2_INLINE __m256d blendAvx2(const float* c, __m128i base, const __m128i* step, const __m256d* f)
+VAO_AVX2_HELPER __m256d blendAvx2(const float* c, __m128i base, const __m128i* step, const __m256d* f)
 {
   const __m128i corner[4] = { base, _mm_add_epi32(base, step[1]), _mm_add_epi32(base, step[2]),
     _mm_add_epi32(_mm_add_epi32(base, step[2]), step[1]) };
@@ -57,7 +59,7 @@ VAO_AVX2_INLINE __m256d blendAvx2(const float* c, __m128i base, const __m128i* s
 
 /// blendAvx2 where every cell's x corners are adjacent (the lower one at most dims - 2,
 /// the fraction 1 at the last voxel): each row's two corners are one 64-bit gather.
-VAO_AVX2_INLINE __m256d blendPairsAvx2(const float* c, __m128i base, const __m128i* step, const __m256d* f)
+VAO_AVX2_HELPER __m256d blendPairsAvx2(const float* c, __m128i base, const __m128i* step, const __m256d* f)
 {
   const __m128i corner[4] = { base, _mm_add_epi32(base, step[1]), _mm_add_epi32(base, step[2]),
     _mm_add_epi32(_mm_add_epi32(base, step[2]), step[1]) };
@@ -77,7 +79,7 @@ VAO_AVX2_INLINE __m256d blendPairsAvx2(const float* c, __m128i base, const __m12
 /// The Chebyshev occlusion of q at four world positions of one level (chebyshevLanes'
 /// formula): the corners by 32-bit gathers, the blends and both of the estimator's branches
 /// in vector arithmetic, one kept by a mask.
-VAO_AVX2_INLINE __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d* position, __m256d q)
+VAO_AVX2_HELPER __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d* position, __m256d q)
 {
   const __m256d zero = _mm256_setzero_pd();
   const __m256d one = _mm256_set1_pd(1.0);
@@ -159,7 +161,9 @@ VAO_AVX2_INLINE void chebyshevMarchAvx2(const LevelGrid* grids, const double* ke
     {
       for (int a = 0; a < 3; ++a)
       {
-        at[h][a] = _mm256_fmadd_pd(_mm256_set1_pd(t), _mm256_set1_pd(light[a]), from[h][a]);
+        // start + t * light rounded as the plain loop does (no fused multiply-add): both
+        // forms stop at the same step on a bound.
+        at[h][a] = _mm256_add_pd(from[h][a], _mm256_mul_pd(_mm256_set1_pd(t), _mm256_set1_pd(light[a])));
         const __m256d inside = _mm256_and_pd(_mm256_cmp_pd(at[h][a], _mm256_set1_pd(lo[a]), _CMP_GE_OQ),
           _mm256_cmp_pd(at[h][a], _mm256_set1_pd(hi[a]), _CMP_LE_OQ));
         alive[h] = _mm256_and_pd(alive[h], inside);
@@ -181,7 +185,6 @@ VAO_AVX2_INLINE void chebyshevMarchAvx2(const LevelGrid* grids, const double* ke
     _mm256_storeu_pd(occlusion + 4 * h, occ[h]);
 }
 #endif
-
 
 /// The occlusions of kLanes samples of one level with the given estimator.
 inline void occlusionLanes(const LevelGrid& g, Method estimator, const double* x, const double* y, const double* z,
