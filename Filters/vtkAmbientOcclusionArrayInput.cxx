@@ -139,17 +139,22 @@ bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData*
   return true;
 }
 
-bool SurfaceNormals(vtkPolyData* surface, const ScalarVolume& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, std::vector<double>& normals, std::string& error)
+vtkDataArray* GivenNormals(vtkPolyData* surface)
 {
-  const vtkIdType n = surface->GetNumberOfPoints();
-  normals.resize(static_cast<size_t>(3 * n));
   vtkDataArray* given = surface->GetPointData()->GetNormals();
   if (!given)
   {
     given = surface->GetPointData()->GetArray("Normals");
   }
-  if (given && given->GetNumberOfComponents() == 3)
+  return given && given->GetNumberOfComponents() == 3 ? given : nullptr;
+}
+
+bool SurfaceNormals(vtkPolyData* surface, const ScalarVolume& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, std::vector<double>& normals, std::string& error)
+{
+  const vtkIdType n = surface->GetNumberOfPoints();
+  normals.resize(static_cast<size_t>(3 * n));
+  if (vtkDataArray* given = GivenNormals(surface))
   {
     for (vtkIdType i = 0; i < n; ++i)
     {

@@ -38,6 +38,10 @@ struct ScalarVolume
 bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input, int component,
   ScalarVolume& volume, std::string& error);
 
+/// The surface's own point normals: its active normals, else a 3-component point array
+/// named "Normals"; nullptr when it has neither.
+vtkDataArray* GivenNormals(vtkPolyData* surface);
+
 /// The unit normals of the surface's points as the surface kernels read them (3 doubles
 /// a point): its point normals, or without them the gradient of `volume` (voxel 0 at
 /// `origin`) at each point, pointing towards lower values. On failure (no normals and a

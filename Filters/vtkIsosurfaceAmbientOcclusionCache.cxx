@@ -50,8 +50,7 @@ struct SurfaceKey
   SurfaceKey() = default;
   SurfaceKey(vtkPolyData* surface, const vao::SurfaceOcclusionParameters& p, int builds)
     : points(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr)
-    , normals(surface->GetPointData()->GetNormals() ? surface->GetPointData()->GetNormals()
-                                                     : surface->GetPointData()->GetArray("Normals"))
+    , normals(vtkAmbientOcclusionArrayInput::GivenNormals(surface))
     , count(surface->GetNumberOfPoints())
     , query{ static_cast<double>(p.query), p.isoValue, p.offsetFactor, static_cast<double>(p.estimator),
       static_cast<double>(p.combination), static_cast<double>(p.levels) }
@@ -233,24 +232,31 @@ void vtkIsosurfaceAmbientOcclusion::ShareCoarsestLevel(
 bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* output)
 {
   Cache& cache = *this->Pyramid;
-  const vtkIdType n = surface->GetNumberOfPoints();
-  std::vector<double> points(static_cast<size_t>(3 * n)), normals;
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    surface->GetPoint(i, &points[3 * i]);
-  }
-  std::string error;
-  if (!vtkAmbientOcclusionArrayInput::SurfaceNormals(
-        surface, cache.scalars, cache.origin, cache.spacing, normals, error))
-  {
-    vtkErrorMacro(<< error);
-    return false;
-  }
   const vao::SurfaceOcclusionParameters parameters = this->Parameters();
   const vao::Execution execution = ExecutionOf(this, this->NumberOfThreads);
   const SurfaceKey key(surface, parameters, this->PyramidBuilds);
+  const bool newOcclusion = !cache.occlusion || !(cache.occlusionKey == key);
+  // The points and normals as the kernels read them, only when a kernel runs (with the AO
+  // kept and shadows off there is nothing to compute).
+  const vtkIdType n = surface->GetNumberOfPoints();
+  std::vector<double> points, normals;
+  std::string error;
+  if (newOcclusion || this->ComputeShadows)
+  {
+    points.resize(static_cast<size_t>(3 * n));
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      surface->GetPoint(i, &points[3 * i]);
+    }
+    if (!vtkAmbientOcclusionArrayInput::SurfaceNormals(
+          surface, cache.scalars, cache.origin, cache.spacing, normals, error))
+    {
+      vtkErrorMacro(<< error);
+      return false;
+    }
+  }
   vao::Status status = vao::Status::success();
-  if (!cache.occlusion || !(cache.occlusionKey == key))
+  if (newOcclusion)
   {
     cache.occlusion = nullptr;
     vtkNew<vtkFloatArray> occlusion;

@@ -253,16 +253,6 @@ TEST(IsosurfaceAmbientOcclusionFilter, ThePyramidIsBuiltOnceWhileOnlyTheQueryCha
   EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 5);
 }
 
-/// The first component of a point array, as doubles.
-std::vector<double> ValuesOf(vtkPolyData* surface, const char* name)
-{
-  vtkDataArray* a = surface->GetPointData()->GetArray(name);
-  std::vector<double> v(static_cast<size_t>(a->GetNumberOfTuples()));
-  for (size_t i = 0; i < v.size(); ++i)
-    v[i] = a->GetComponent(static_cast<vtkIdType>(i), 0);
-  return v;
-}
-
 TEST(IsosurfaceAmbientOcclusionFilter, ALightMoveReusesTheAmbientOcclusionAndNothingElseDoes)
 {
   auto volume = Slab(32, 8, 12);
@@ -274,7 +264,7 @@ TEST(IsosurfaceAmbientOcclusionFilter, ALightMoveReusesTheAmbientOcclusionAndNot
   filter->SetLightDirection(0, 0, 1);
   filter->Update();
   auto array = [&](const char* name) { return filter->GetOutput()->GetPointData()->GetArray(name); };
-  auto values = [&](const char* name) { return ValuesOf(filter->GetOutput(), name); };
+  auto values = [&](const char* name) { return Values(array(name)); };
   vtkDataArray* first = array("AmbientOcclusion");
   const auto firstAo = values("AmbientOcclusion");
   const auto firstShadow = values("Shadow");
@@ -284,12 +274,8 @@ TEST(IsosurfaceAmbientOcclusionFilter, ALightMoveReusesTheAmbientOcclusionAndNot
   EXPECT_NE(values("Shadow"), firstShadow);
   // Whatever the AO reads makes it new, equal to a fresh filter's.
   auto fresh = [&](vtkPolyData* s, double offset) {
-    vtkNew<vtkIsosurfaceAmbientOcclusion> other;
-    other->SetInputData(0, s);
-    other->SetVolumeData(volume);
-    other->SetOffsetFactor(offset);
-    other->Update();
-    return ValuesOf(other->GetOutput(), "AmbientOcclusion");
+    const ShadeRun run = Shade(s, volume, [&](vtkIsosurfaceAmbientOcclusion* f) { f->SetOffsetFactor(offset); });
+    return Values(run.output->GetPointData()->GetArray("AmbientOcclusion"));
   };
   filter->SetOffsetFactor(2.5);
   filter->Update();

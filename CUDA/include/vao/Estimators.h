@@ -87,13 +87,6 @@ VAO_HD bool isFlatVariance(double mean, double variance, double roundingVariance
 /// sqrt(kFlatEpsilon), since their variance is at most kFlatEpsilon * max(1, mu^2).
 constexpr double kFlatSpread = 1e-7;
 
-/// The exact answer on a flat neighbourhood, which every estimator returns there:
-/// O = (q >= mu). The computed mu carries the rounding of streamed sums (the CPU's and the
-/// GPU's differ by a few ulps), so a query equal to the common value may land a hair below
-/// it. A query within the flat spread of mu, or within the rounding of a mean of double
-/// sums (kSumRoundingUlps ulps of the data's largest deviation, which roundingVariance
-/// squares), is one of the neighbourhood's values: q >= mu. An iso value closer than
-/// that to a flat region's value cannot be told from it.
 /// flatOpenness given the rounding spread of its sums (flatRoundingSpread): callers that
 /// query one set of sums many times take the square root once.
 VAO_HD double flatOpennessWithin(double query, double mean, double roundingSpread)
@@ -110,6 +103,13 @@ VAO_HD double flatRoundingSpread(double roundingVariance)
   return roundingVariance > 0.0 ? sqrt(roundingVariance * kSumRoundingUlps * kDoubleUlp) : 0.0;
 }
 
+/// The exact answer on a flat neighbourhood, which every estimator returns there:
+/// O = (q >= mu). The computed mu carries the rounding of streamed sums (the CPU's and the
+/// GPU's differ by a few ulps), so a query equal to the common value may land a hair below
+/// it. A query within the flat spread of mu, or within the rounding of a mean of double
+/// sums (kSumRoundingUlps ulps of the data's largest deviation, which roundingVariance
+/// squares), is one of the neighbourhood's values: q >= mu. An iso value closer than
+/// that to a flat region's value cannot be told from it.
 VAO_HD double flatOpenness(double query, double mean, double roundingVariance = 0.0)
 {
   return flatOpennessWithin(query, mean, flatRoundingSpread(roundingVariance));
@@ -171,11 +171,10 @@ VAO_HD double opennessGaussianCdf(double query, const NeighbourhoodStats& s, Erf
   return clamp01(0.5 * (1.0 + e));
 }
 
-/// Cantelli's one-tailed bound on the occluder fraction P(v >= q), as METHODS.md fixes it:
-/// p_max = 1 if q <= mu, else s2 / (s2 + (q - mu)^2); O = 1 - p_max <= P(v <= q).
 /// opennessChebyshev given the flat rule's rounding spread (flatRoundingSpread of the
-/// rounding variance). Both answers are formed and one is kept, with no branch, so a loop
-/// over many samples compiles to vector code (the bound's 0/0 on a flat box is not kept).
+/// rounding variance): callers that query one set of sums many times take the square root
+/// once. Both answers are formed and one is kept, as the AVX2 form of the surface queries
+/// (src/cpu/SurfaceLanes.h) does with masks; the bound's 0/0 on a flat box is not kept.
 VAO_HD double opennessChebyshevWithin(double query, double mean, double variance, double roundingVariance,
   double roundingSpread)
 {
@@ -185,6 +184,8 @@ VAO_HD double opennessChebyshevWithin(double query, double mean, double variance
   return isFlatVariance(mean, variance, roundingVariance) ? flatOpennessWithin(query, mean, roundingSpread) : bound;
 }
 
+/// Cantelli's one-tailed bound on the occluder fraction P(v >= q), as METHODS.md fixes it:
+/// p_max = 1 if q <= mu, else s2 / (s2 + (q - mu)^2); O = 1 - p_max <= P(v <= q).
 VAO_HD double opennessChebyshev(double query, const NeighbourhoodStats& s)
 {
   return opennessChebyshevWithin(

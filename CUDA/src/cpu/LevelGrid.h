@@ -5,7 +5,6 @@
 // SurfaceLanes.h has the AVX2 form and the dispatch.
 #pragma once
 
-#include "CpuDispatch.h"
 #include "vao/Estimators.h"
 #include "vao/VarianceOcclusionMap.h"
 
@@ -32,7 +31,7 @@ struct LevelGrid
   std::int64_t stride[3] = { 1, 0, 0 }; // 1, nx, nx ny
   double roundingVariance = 0.0;        // of the level's moments (the estimators' flat rule)
   double roundingSpread = 0.0;          // flatRoundingSpread(roundingVariance)
-  // Voxel indices fit in 32 bits: the lanes use 32-bit gathers (else 64-bit ones).
+  // Voxel indices fit in 32 bits: the AVX2 lanes' gathers apply (else the plain loop).
   bool narrowIndices = true;
   // At least two voxels along x: a cell's two x corners are one 8-byte load.
   bool pairedRows = false;
@@ -59,10 +58,10 @@ struct LevelGrid
 
 /// Trilinear mean and variance (clamped at 0) of the level at world (x, y, z), clamped to
 /// the level's bounds: the cell's lower corner, the fractions towards the upper one, and
-/// nested lerps along x, y, z. IndexT holds voxel indices (int32 where they fit).
-template <class IndexT>
-VAO_ALWAYS_INLINE void trilinearSample(const LevelGrid& g, double x, double y, double z, double& mean, double& variance)
+/// nested lerps along x, y, z.
+inline void trilinearSample(const LevelGrid& g, double x, double y, double z, double& mean, double& variance)
 {
+  using IndexT = std::int64_t;
   const double p[3] = { x, y, z };
   IndexT base = 0;
   IndexT step[3];
@@ -86,27 +85,19 @@ VAO_ALWAYS_INLINE void trilinearSample(const LevelGrid& g, double x, double y, d
   variance = std::max(0.0, blend(g.variance));
 }
 
-/// 1 - the estimator's openness of q for a level sample (the estimators of METHODS.md).
-VAO_ALWAYS_INLINE double sampleOcclusion(Method estimator, double query, double mean, double variance,
-  double roundingVariance)
-{
-  const NeighbourhoodStats stats{ mean, variance, mean, mean, roundingVariance };
-  return 1.0 -
-    (estimator == Method::GaussianCdf ? opennessGaussianCdf(query, stats, ErfMode::Exact)
-                                      : opennessChebyshev(query, stats));
-}
-
-/// occlusion[k] = the Chebyshev occlusion of query[k] at world (x[k], y[k], z[k]) of one
-/// level, for the kLanes lanes: the definition, and the path without AVX2.
-template <class IndexT>
-void chebyshevLanes(const LevelGrid& g, const double* x, const double* y, const double* z, const double* query,
-  double* occlusion)
+/// occlusion[k] = 1 - the estimator's openness of query[k] at world (x[k], y[k], z[k]) of
+/// one level, for the kLanes lanes: the definition, and the path without AVX2.
+inline void occlusionLanesPlain(const LevelGrid& g, Method estimator, const double* x, const double* y,
+  const double* z, const double* query, double* occlusion)
 {
   for (int k = 0; k < kLanes; ++k)
   {
     double mean, variance;
-    trilinearSample<IndexT>(g, x[k], y[k], z[k], mean, variance);
-    occlusion[k] = 1.0 - opennessChebyshevWithin(query[k], mean, variance, g.roundingVariance, g.roundingSpread);
+    trilinearSample(g, x[k], y[k], z[k], mean, variance);
+    occlusion[k] = 1.0 -
+      (estimator == Method::Chebyshev
+          ? opennessChebyshevWithin(query[k], mean, variance, g.roundingVariance, g.roundingSpread)
+          : opennessFromStats(estimator, query[k], { mean, variance, mean, mean, g.roundingVariance }, ErfMode::Exact));
   }
 }
 

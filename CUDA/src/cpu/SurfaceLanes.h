@@ -76,7 +76,7 @@ VAO_AVX2_HELPER __m256d blendPairsAvx2(const float* c, __m128i base, const __m12
   return lerpAvx2(lerpAvx2(rows[0], rows[1], f[1]), lerpAvx2(rows[2], rows[3], f[1]), f[2]);
 }
 
-/// The Chebyshev occlusion of q at four world positions of one level (chebyshevLanes'
+/// The Chebyshev occlusion of q at four world positions of one level (occlusionLanesPlain's
 /// formula): the corners by 32-bit gathers, the blends and both of the estimator's branches
 /// in vector arithmetic, one kept by a mask.
 VAO_AVX2_HELPER __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d* position, __m256d q)
@@ -121,7 +121,7 @@ VAO_AVX2_HELPER __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d
   return _mm256_sub_pd(one, _mm256_blendv_pd(bound, flatOpen, flat));
 }
 
-/// chebyshevLanes<std::int32_t>, four lanes per vector.
+/// occlusionLanesPlain for Chebyshev, four lanes per vector.
 VAO_AVX2_INLINE void chebyshevLanesAvx2(const LevelGrid& g, const double* x, const double* y, const double* z,
   const double* query, double* occlusion)
 {
@@ -186,31 +186,20 @@ VAO_AVX2_INLINE void chebyshevMarchAvx2(const LevelGrid* grids, const double* ke
 }
 #endif
 
-/// The occlusions of kLanes samples of one level with the given estimator.
+/// The occlusions of kLanes samples of one level with the given estimator: Chebyshev on
+/// AVX2 where the indices fit in 32 bits, else the plain loop (the exact erf has no vector
+/// form here).
 inline void occlusionLanes(const LevelGrid& g, Method estimator, const double* x, const double* y, const double* z,
   const double* query, double* occlusion)
 {
-  if (estimator == Method::Chebyshev)
-  {
 #if VAO_HAVE_AVX2_TARGET
-    if (cpuHasAvx2() && g.narrowIndices)
-    {
-      chebyshevLanesAvx2(g, x, y, z, query, occlusion);
-      return;
-    }
-#endif
-    if (g.narrowIndices)
-      chebyshevLanes<std::int32_t>(g, x, y, z, query, occlusion);
-    else
-      chebyshevLanes<std::int64_t>(g, x, y, z, query, occlusion);
+  if (estimator == Method::Chebyshev && cpuHasAvx2() && g.narrowIndices)
+  {
+    chebyshevLanesAvx2(g, x, y, z, query, occlusion);
     return;
   }
-  for (int k = 0; k < kLanes; ++k) // the exact erf has no vector form here
-  {
-    double mean, variance;
-    trilinearSample<std::int64_t>(g, x[k], y[k], z[k], mean, variance);
-    occlusion[k] = sampleOcclusion(estimator, query[k], mean, variance, g.roundingVariance);
-  }
+#endif
+  occlusionLanesPlain(g, estimator, x, y, z, query, occlusion);
 }
 
 } // namespace detail

@@ -218,7 +218,7 @@ double sampleVolume(const VolumeView& volume, const std::array<double, 3>& origi
 
 void sampleLevel(const MomentLevel& level, const std::array<double, 3>& position, double& mean, double& variance)
 {
-  detail::trilinearSample<std::int64_t>(detail::LevelGrid(level), position[0], position[1], position[2], mean, variance);
+  detail::trilinearSample(detail::LevelGrid(level), position[0], position[1], position[2], mean, variance);
 }
 
 namespace
@@ -461,7 +461,7 @@ Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* poin
         // No raw volume here: level 0's (blurred) mean half a voxel inside.
         const std::array<double, 3> inside = lanes.along(k, -0.5 * h);
         double variance = 0.0;
-        detail::trilinearSample<std::int64_t>(prepared.grids[0], inside[0], inside[1], inside[2], lanes.query[k], variance);
+        detail::trilinearSample(prepared.grids[0], inside[0], inside[1], inside[2], lanes.query[k], variance);
       }
     }
     double occlusion[detail::kLanes];
