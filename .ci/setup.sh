@@ -58,7 +58,7 @@ case "$job" in
     # generated phantom and, when ../shared is beside the checkout, the CT head phantom.
     ct=../shared/data/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha
     [ -f "$ct" ] || ct=""
-    exec xvfb-run -a -s "-screen 0 1280x1024x24" /usr/bin/pvpython --force-offscreen-rendering \
+    exec bash .ci/with-xvfb.sh /usr/bin/pvpython --force-offscreen-rendering \
       Examples/figures.py "$(cat build/VolumetricAOPluginPath.txt)" vao-output/figures $ct ;;
   test)
     # Open MPI refuses to run as root without these (the MPI tests add the flags too).

@@ -1,9 +1,9 @@
 # Driver of the ParaView GUI test (cmake -P): starts the real `paraview` client under
 # Xvfb, plays AmbientOcclusionMenu.xml and checks what the playback left behind.
-#   -DPARAVIEW=<paraview> -DXVFB_RUN=<xvfb-run> -DTIMEOUT=<coreutils timeout>
+#   -DPARAVIEW=<paraview> -DWITH_XVFB=<bash;.ci/with-xvfb.sh> -DTIMEOUT=<coreutils timeout>
 #   -DPLUGIN_DIR=<dir of VolumetricAO.so> (empty: no plugin, the test must then fail)
 #   -DTEST_SCRIPT=<configured playback xml> -DOUTPUT_DIR=<dir for status.txt and the PNG>
-foreach(var IN ITEMS PARAVIEW XVFB_RUN TIMEOUT TEST_SCRIPT OUTPUT_DIR)
+foreach(var IN ITEMS PARAVIEW WITH_XVFB TIMEOUT TEST_SCRIPT OUTPUT_DIR)
   if(NOT DEFINED ${var} OR "${${var}}" STREQUAL "")
     message(FATAL_ERROR "FAILED: -D${var}=... is required")
   endif()
@@ -27,11 +27,11 @@ if(NOT DEFINED ENV{XDG_RUNTIME_DIR})
   file(CHMOD "$ENV{XDG_RUNTIME_DIR}" PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE)
 endif()
 
-# `timeout` inside xvfb-run kills paraview if it hangs, so xvfb-run still stops its Xvfb;
+# `timeout` inside with-xvfb.sh kills paraview if it hangs, so the script still stops its Xvfb;
 # the outer TIMEOUT is the last resort. --dr ignores the user's settings, --exit quits
 # when the playback ends (the exit code is non-zero if an event could not be played).
 execute_process(
-  COMMAND "${XVFB_RUN}" -a -s "-screen 0 1280x1024x24"
+  COMMAND ${WITH_XVFB} -s 1280x1024x24
     "${TIMEOUT}" -k 5 75
     "${PARAVIEW}" --dr "--test-directory=${OUTPUT_DIR}/test-directory"
       "--test-script=${TEST_SCRIPT}" --exit
