@@ -2,6 +2,7 @@
 // (and the box extrema for CDF Reconstruction), the box histograms of Histogram CDF, or the
 // exact references; with the voxel's value, the iso value or the smoothed query as q.
 #include "BoxEngine.h"
+#include "EstimatorRows.h"
 #include "ExactReference.h"
 #include "HistogramChannels.h"
 #include "SmoothedQuery.h"
@@ -38,17 +39,17 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   const bool withExtrema = output.openness && p.method == Method::CdfReconstruction;
   const bool voxelQuery = p.queryMode == QueryMode::VoxelValue;
   const detail::MomentScale scale = detail::momentScale(volume, scan.minimum, scan.maximum);
-  const bool ok = detail::forEachNeighbourhood(volume, geometry, scale, withExtrema, execution,
-    [&](const detail::VoxelNeighbourhood& voxel) {
+  const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, withExtrema, execution,
+    [&](const detail::NeighbourhoodRow& row) {
       if (output.variance)
       {
-        output.variance[voxel.index] = static_cast<float>(voxel.stats.variance);
+        for (std::int64_t i = 0; i < row.size; ++i)
+          output.variance[row.index + i] = static_cast<float>(row.variance[i]);
       }
       if (output.openness)
       {
-        const double q = query ? query[voxel.index] : (voxelQuery ? voxel.value : p.isoValue);
-        output.openness[voxel.index] =
-          static_cast<float>(opennessFromStats(p.method, q, voxel.stats, p.erfMode));
+        const double* q = query ? query + row.index : (voxelQuery ? row.value : nullptr);
+        detail::opennessRow(p.method, p.erfMode, row, q, p.isoValue, output.openness + row.index);
       }
     });
   return ok ? Status::success() : Status::cancelled();

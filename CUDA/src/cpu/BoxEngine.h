@@ -361,16 +361,28 @@ namespace vao
 namespace detail
 {
 
-/// One voxel of the region with its neighbourhood's statistics, as handed to a consumer.
-struct VoxelNeighbourhood
+/// One row of the region with the statistics of its voxels' neighbourhoods, as arrays
+/// (x fastest), handed to a consumer: a row at a time lets the estimators run on vectors.
+struct NeighbourhoodRow
 {
-  std::int64_t index; // in the region, x fastest
-  double value;       // the voxel's own value
-  std::int64_t count; // voxels in the clipped box
-  NeighbourhoodStats stats; // minimum/maximum only when asked for
+  std::int64_t index = 0; // of the row's first voxel in the region, x fastest
+  std::int64_t size = 0;  // voxels in the row
+  const double* value = nullptr;    // the voxels' own values
+  const double* count = nullptr;    // voxels in each clipped box
+  const double* mean = nullptr;
+  const double* variance = nullptr; // population variance, clamped at 0
+  const double* minimum = nullptr;  // null unless the extrema were asked for
+  const double* maximum = nullptr;
+  double roundingVariance = 0.0;    // as NeighbourhoodStats::roundingVariance
+
+  NeighbourhoodStats stats(std::int64_t i) const
+  {
+    return { this->mean[i], this->variance[i], this->minimum ? this->minimum[i] : 0.0,
+      this->maximum ? this->maximum[i] : 0.0, this->roundingVariance };
+  }
 };
 
-/// forEachNeighbourhood on one band (band.region, a slab of rows of `whole`): voxel
+/// forEachNeighbourhoodRow on one band (band.region, a slab of rows of `whole`): voxel
 /// indices are those of the whole region.
 template <class T, class Visit>
 bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Region& whole,
@@ -392,25 +404,44 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
     [&](const MomentSlice<T>& slice) {
       const std::int64_t bandBase = (slice.z - region.begin[2]) * nx * ny;
       const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
-      VoxelNeighbourhood voxel{ 0, 0.0, 0, { 0.0, 0.0, 0.0, 0.0, slice.roundingVariance } };
+      const auto n = static_cast<std::size_t>(nx);
+      std::vector<double> value(n), count(n), mean(n), variance(n), minimum, maximum;
+      if (withExtrema)
+      {
+        minimum.resize(n);
+        maximum.resize(n);
+      }
+      NeighbourhoodRow out;
+      out.size = nx;
+      out.value = value.data();
+      out.count = count.data();
+      out.mean = mean.data();
+      out.variance = variance.data();
+      out.minimum = withExtrema ? minimum.data() : nullptr;
+      out.maximum = withExtrema ? maximum.data() : nullptr;
+      out.roundingVariance = slice.roundingVariance;
       for (std::int64_t j = 0; j < ny; ++j)
       {
         const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
+        const std::int64_t countYZ = countY[j] * slice.countZ;
         for (std::int64_t i = 0; i < nx; ++i)
         {
           const std::int64_t p = j * nx + i;
-          voxel.index = base + p;
-          voxel.value = static_cast<double>(row[i * volume.stride]);
-          voxel.count = countX[i] * countY[j] * slice.countZ;
-          meanVarianceFromSums(slice.sum[p], slice.sumSquares[p], voxel.count, slice.shift,
-            voxel.stats.mean, voxel.stats.variance);
-          if (withExtrema)
-          {
-            voxel.stats.minimum = static_cast<double>(extrema.minimum(bandBase + p));
-            voxel.stats.maximum = static_cast<double>(extrema.maximum(bandBase + p));
-          }
-          visit(voxel);
+          const std::int64_t c = countX[i] * countYZ;
+          value[i] = static_cast<double>(row[i * volume.stride]);
+          count[i] = static_cast<double>(c);
+          meanVarianceFromSums(slice.sum[p], slice.sumSquares[p], c, slice.shift, mean[i], variance[i]);
         }
+        if (withExtrema)
+        {
+          for (std::int64_t i = 0; i < nx; ++i)
+          {
+            minimum[i] = static_cast<double>(extrema.minimum(bandBase + j * nx + i));
+            maximum[i] = static_cast<double>(extrema.maximum(bandBase + j * nx + i));
+          }
+        }
+        out.index = base + j * nx;
+        visit(static_cast<const NeighbourhoodRow&>(out));
       }
     });
 }
@@ -425,12 +456,12 @@ inline std::int64_t extremaBandRows(const BoxGeometry& geometry)
   return std::max<std::int64_t>({ 8, geometry.dims[1] / 16, 2 * std::int64_t(geometry.radius.y) + 1 });
 }
 
-/// The separable statistics of every region voxel, handed to visit(VoxelNeighbourhood)
-/// slice by slice on worker threads: the streamed moments, after the extrema passes when
+/// The separable statistics of every region voxel, handed to visit(NeighbourhoodRow) row
+/// by row, slice by slice on worker threads: the streamed moments, after the extrema passes when
 /// withExtrema. With the extrema the region goes band by band of rows (extremaBandRows),
 /// each band's extrema first, then its moments. Returns false when cancelled.
 template <class T, class Visit>
-bool forEachNeighbourhood(const TypedVolume<T>& volume, const BoxGeometry& geometry,
+bool forEachNeighbourhoodRow(const TypedVolume<T>& volume, const BoxGeometry& geometry,
   const MomentScale& scale, bool withExtrema, const Execution& execution, Visit&& visit)
 {
   const Region& region = geometry.region;

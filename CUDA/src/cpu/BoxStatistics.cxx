@@ -4,6 +4,8 @@
 
 #include "vao/Validation.h"
 
+#include <algorithm>
+
 namespace vao
 {
 
@@ -22,19 +24,17 @@ Status computeBoxStatistics(const VolumeView& view, const Region& region, const 
     const detail::TypedVolume<decltype(tag)> volume(view);
     // Only the shift matters here: the statistics are written as they are.
     const detail::MomentScale scale{ detail::momentScale(volume, 0.0, 0.0).shift, 0.0 };
-    const bool ok = detail::forEachNeighbourhood(volume, geometry, scale, withExtrema, execution,
-      [&](const detail::VoxelNeighbourhood& voxel) {
-        const std::int64_t k = voxel.index;
-        if (output.count)
-          output.count[k] = static_cast<double>(voxel.count);
-        if (output.mean)
-          output.mean[k] = voxel.stats.mean;
-        if (output.variance)
-          output.variance[k] = voxel.stats.variance;
-        if (output.minimum)
-          output.minimum[k] = voxel.stats.minimum;
-        if (output.maximum)
-          output.maximum[k] = voxel.stats.maximum;
+    const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, withExtrema, execution,
+      [&](const detail::NeighbourhoodRow& row) {
+        const auto put = [&](double* field, const double* values) {
+          if (field)
+            std::copy(values, values + row.size, field + row.index);
+        };
+        put(output.count, row.count);
+        put(output.mean, row.mean);
+        put(output.variance, row.variance);
+        put(output.minimum, row.minimum);
+        put(output.maximum, row.maximum);
       });
     return ok ? Status::success() : Status::cancelled();
   });

@@ -3,17 +3,14 @@
 // gathers, and the whole shadow march of a batch in vector registers, so one step is
 // few enough instructions for the processor to overlap the gathers' latency of several.
 // (GCC does not vectorise the plain loops: their float-to-int conversions and selects stay
-// branches.) Equal to the plain loops but for the rounding of fused multiply-adds.
+// branches.) Equal to the plain loops but for the rounding of the blends' fused
+// multiply-adds.
 #pragma once
 
-#include "CpuDispatch.h"
+#include "EstimatorsAvx2.h"
 #include "LevelGrid.h"
 
 #include <cmath>
-
-#if VAO_HAVE_AVX2_TARGET
-#include <immintrin.h>
-#endif
 
 namespace vao
 {
@@ -32,10 +29,6 @@ inline int marchLevel(double t, double r0, int levels)
 }
 
 #if VAO_HAVE_AVX2_TARGET
-// The entry points, called from baseline code, and the helpers they inline.
-#define VAO_AVX2_INLINE __attribute__((target("avx2,fma"))) inline
-#define VAO_AVX2_HELPER __attribute__((target("avx2,fma"), always_inline)) inline
-
 VAO_AVX2_HELPER __m256d lerpAvx2(__m256d a, __m256d b, __m256d t)
 {
   return _mm256_fmadd_pd(t, _mm256_sub_pd(b, a), a);
@@ -107,18 +100,8 @@ VAO_AVX2_HELPER __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d
   const __m256d mean = g.pairedRows ? blendPairsAvx2(g.mean, base, step, f) : blendAvx2(g.mean, base, step, f);
   const __m256d variance = _mm256_max_pd(
     g.pairedRows ? blendPairsAvx2(g.variance, base, step, f) : blendAvx2(g.variance, base, step, f), zero);
-  // opennessChebyshevWithin, both branches.
-  const __m256d d = _mm256_sub_pd(q, mean);
-  const __m256d share = _mm256_div_pd(variance, _mm256_fmadd_pd(d, d, variance));
-  const __m256d bound = _mm256_and_pd(_mm256_cmp_pd(d, zero, _CMP_GT_OQ),
-    _mm256_min_pd(_mm256_max_pd(_mm256_sub_pd(one, share), zero), one));
-  const __m256d flatLimit = _mm256_max_pd(_mm256_set1_pd(g.roundingVariance),
-    _mm256_mul_pd(_mm256_set1_pd(kFlatEpsilon), _mm256_max_pd(_mm256_mul_pd(mean, mean), one)));
-  const __m256d flat = _mm256_cmp_pd(variance, flatLimit, _CMP_LE_OQ);
-  const __m256d magnitude = _mm256_max_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), mean), one);
-  const __m256d spread = _mm256_max_pd(_mm256_set1_pd(g.roundingSpread), _mm256_mul_pd(_mm256_set1_pd(kFlatSpread), magnitude));
-  const __m256d flatOpen = _mm256_and_pd(_mm256_cmp_pd(q, _mm256_sub_pd(mean, spread), _CMP_GE_OQ), one);
-  return _mm256_sub_pd(one, _mm256_blendv_pd(bound, flatOpen, flat));
+  return _mm256_sub_pd(one, chebyshevOpennessAvx2(q, mean, variance, _mm256_set1_pd(g.roundingVariance),
+    _mm256_set1_pd(g.roundingSpread)));
 }
 
 /// occlusionLanesPlain for Chebyshev, four lanes per vector.

@@ -1,0 +1,25 @@
+// The separable estimators over a row of neighbourhoods: on AVX2 four voxels at a time
+// (the Gaussian CDF with glibc's vector erf), elsewhere voxel by voxel.
+#pragma once
+
+#include "BoxEngine.h"
+
+namespace vao
+{
+namespace detail
+{
+
+/// openness[i] = opennessFromStats(method, q_i, row.stats(i), erfMode) as float, for the
+/// row's voxels, with q_i = query[i], or isoValue when query is null.
+void opennessRow(Method method, ErfMode erfMode, const NeighbourhoodRow& row, const double* query,
+  double isoValue, float* openness);
+
+/// The plain loop of opennessRow from voxel `begin` on (the vector forms' tail; tests).
+void opennessRowPlain(Method method, ErfMode erfMode, const NeighbourhoodRow& row, const double* query,
+  double isoValue, float* openness, std::int64_t begin = 0);
+
+/// True when opennessRow runs four voxels at a time here for this method.
+bool opennessRowIsVector(Method method, ErfMode erfMode);
+
+} // namespace detail
+} // namespace vao

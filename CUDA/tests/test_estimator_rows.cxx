@@ -1,0 +1,146 @@
+// The estimators over rows of neighbourhoods (EstimatorRows.h, four voxels at a time on
+// AVX2 with glibc's vector erf) against the formulas of METHODS.md written out again
+// (ReferenceFormulas.h): rows of every length around the vector width, queries per voxel
+// and one iso value, flat boxes among noisy ones, small and large magnitudes.
+#include "../src/cpu/EstimatorRows.h"
+#include "ReferenceFormulas.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+namespace
+{
+
+/// The error of erf's few ulps near +-1, halved in the openness (1 + erf) / 2.
+constexpr double kHalfUlpOfOne = 1.1102230246251565e-16;
+
+struct RowData
+{
+  std::vector<double> value, count, mean, variance, minimum, maximum, query;
+
+  vao::detail::NeighbourhoodRow row() const
+  {
+    vao::detail::NeighbourhoodRow r;
+    r.size = static_cast<std::int64_t>(this->mean.size());
+    r.value = this->value.data();
+    r.count = this->count.data();
+    r.mean = this->mean.data();
+    r.variance = this->variance.data();
+    r.minimum = this->minimum.data();
+    r.maximum = this->maximum.data();
+    return r;
+  }
+};
+
+/// n neighbourhoods around `magnitude`: a quarter flat (variance 0 or far below the flat
+/// limit), the rest with spreads from 1e-3 to 10 times the magnitude; queries a few
+/// standard deviations either side, or exactly the mean of a flat box.
+RowData makeRow(std::size_t n, double magnitude, std::mt19937& rng)
+{
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  RowData d;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const double mean = magnitude * unit(rng);
+    const bool flat = rng() % 4 == 0;
+    const double sd = flat ? 0.0 : magnitude * std::pow(10.0, 2.0 * unit(rng) - 1.0);
+    const double variance = flat ? (rng() % 2 ? 0.0 : 1e-17 * std::fmax(1.0, mean * mean)) : sd * sd;
+    double q = mean + 4.0 * sd * unit(rng);
+    if (flat)
+      q = rng() % 3 == 0 ? mean : mean + magnitude * unit(rng);
+    d.mean.push_back(mean);
+    d.variance.push_back(variance);
+    d.minimum.push_back(flat ? mean : mean - 3.0 * sd);
+    d.maximum.push_back(flat ? mean : mean + 3.0 * sd);
+    d.value.push_back(q);
+    d.count.push_back(27.0);
+    d.query.push_back(q);
+  }
+  return d;
+}
+
+double referenceOpenness(vao::Method method, double q, const RowData& d, std::size_t i)
+{
+  const vaotest::reference::Statistics s{ d.mean[i], d.variance[i], d.minimum[i], d.maximum[i] };
+  switch (method)
+  {
+    case vao::Method::Chebyshev:
+      return vaotest::reference::chebyshev(q, s);
+    case vao::Method::CdfReconstruction:
+      return vaotest::reference::cdfReconstruction(q, s);
+    default:
+      return vaotest::reference::gaussianCdf(q, s, false);
+  }
+}
+
+} // namespace
+
+TEST(EstimatorRows, EveryLengthQueryAndMagnitudeAgainstTheReference)
+{
+  std::mt19937 rng(20261202);
+  std::size_t compared = 0, offByOneUlp = 0;
+  for (const vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
+  {
+    for (const double magnitude : { 1.0, 1000.0, 3.0e6 })
+    {
+      for (std::size_t n = 0; n <= 37; ++n)
+      {
+        const RowData d = makeRow(n, magnitude, rng);
+        const double iso = magnitude * 0.25;
+        for (const bool perVoxel : { true, false })
+        {
+          std::vector<float> out(n, -1.0f);
+          vao::detail::opennessRow(method, vao::ErfMode::Exact, d.row(), perVoxel ? d.query.data() : nullptr, iso,
+            out.data());
+          for (std::size_t i = 0; i < n; ++i)
+          {
+            const double q = perVoxel ? d.query[i] : iso;
+            const float expected = static_cast<float>(referenceOpenness(method, q, d, i));
+            ++compared;
+            if (out[i] == expected)
+              continue;
+            // The vector erf is within a few double ulps of the scalar one: the float may
+            // round the other way (one float ulp), or, in the tails where 1 + erf cancels,
+            // differ by those few ulps of 1, as the scalar value differs from the truth.
+            ASSERT_EQ(method, vao::Method::GaussianCdf) << "voxel " << i << " of " << n << ": " << out[i] << " vs " << expected;
+            const double tolerance = std::fmax(std::fabs(std::nextafter(expected, out[i]) - expected), 8 * kHalfUlpOfOne);
+            ASSERT_LE(std::fabs(double(out[i]) - expected), tolerance) << "voxel " << i << " of " << n << ", q " << q
+              << ", mean " << d.mean[i] << ", variance " << d.variance[i];
+            ++offByOneUlp;
+          }
+        }
+      }
+    }
+  }
+  std::printf("%zu opennesses compared, %zu a rounding away from the reference, vector form: %s\n", compared,
+    offByOneUlp, vao::detail::opennessRowIsVector(vao::Method::GaussianCdf, vao::ErfMode::Exact) ? "yes" : "no");
+  EXPECT_LE(offByOneUlp * 1000, compared); // a rounding coincidence, not a habit
+}
+
+TEST(EstimatorRows, VectorAndPlainFormsAgree)
+{
+  std::mt19937 rng(7);
+  const RowData d = makeRow(4099, 500.0, rng);
+  for (const vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev })
+  {
+    std::vector<float> fast(d.mean.size()), plain(d.mean.size());
+    vao::detail::opennessRow(method, vao::ErfMode::Exact, d.row(), d.query.data(), 0.0, fast.data());
+    vao::detail::opennessRowPlain(method, vao::ErfMode::Exact, d.row(), d.query.data(), 0.0, plain.data());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < fast.size(); ++i)
+    {
+      if (fast[i] != plain[i])
+      {
+        ASSERT_EQ(method, vao::Method::GaussianCdf) << "Chebyshev rounds as the scalar formula, voxel " << i;
+        const double tolerance = std::fmax(std::fabs(std::nextafter(plain[i], fast[i]) - plain[i]), 8 * kHalfUlpOfOne);
+        ASSERT_LE(std::fabs(double(fast[i]) - plain[i]), tolerance) << "voxel " << i;
+        ++differ;
+      }
+    }
+    EXPECT_LE(differ * 1000, fast.size());
+  }
+}
