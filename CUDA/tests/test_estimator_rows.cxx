@@ -3,6 +3,7 @@
 // (ReferenceFormulas.h): rows of every length around the vector width, queries per voxel
 // and one iso value, flat boxes among noisy ones, small and large magnitudes.
 #include "../src/cpu/EstimatorRows.h"
+#include "../src/cpu/MomentRows.h"
 #include "ReferenceFormulas.h"
 
 #include <gtest/gtest.h>
@@ -142,5 +143,46 @@ TEST(EstimatorRows, VectorAndPlainFormsAgree)
       }
     }
     EXPECT_LE(differ * 1000, fast.size());
+  }
+}
+
+// The mean and variance of rows of boxes from exact sums: against the definition (double of
+// the exact integer numerator count * sum(v^2) - sum(v)^2, over count^2), bit for bit, for
+// sums that the vector form takes in doubles and sums too large for that (the int16 range
+// in large boxes), mixed within a row.
+TEST(MomentRows, MeanAndVarianceFromExactSumsBitForBit)
+{
+  std::mt19937_64 rng(99);
+  for (std::int64_t n = 0; n <= 29; ++n)
+  {
+    for (const std::int64_t countYZ : { std::int64_t(1), std::int64_t(441), std::int64_t(1) << 20 })
+    {
+      std::vector<std::int64_t> sum(n), sumSquares(n), countX(n);
+      for (std::int64_t i = 0; i < n; ++i)
+      {
+        countX[i] = 1 + static_cast<std::int64_t>(rng() % 21);
+        const std::int64_t count = countX[i] * countYZ;
+        const std::int64_t magnitude = rng() % 3 == 0 ? 32768 : 3000; // the int16 range, or a CT's
+        // Values of the box: a few distinct ones stand for all (only the sums matter).
+        const std::int64_t a = static_cast<std::int64_t>(rng() % (2 * magnitude)) - magnitude;
+        const std::int64_t b = static_cast<std::int64_t>(rng() % (2 * magnitude)) - magnitude;
+        const std::int64_t ofA = static_cast<std::int64_t>(rng() % (count + 1));
+        sum[i] = a * ofA + b * (count - ofA);
+        sumSquares[i] = a * a * ofA + b * b * (count - ofA);
+      }
+      std::vector<double> count(n), mean(n), variance(n);
+      vao::detail::meanVarianceRowExact(sum.data(), sumSquares.data(), countX.data(), countYZ, n, count.data(),
+        mean.data(), variance.data());
+      for (std::int64_t i = 0; i < n; ++i)
+      {
+        const std::int64_t c = countX[i] * countYZ;
+        const __int128 numerator = static_cast<__int128>(c) * sumSquares[i] - static_cast<__int128>(sum[i]) * sum[i];
+        const double cd = static_cast<double>(c);
+        ASSERT_EQ(count[i], cd);
+        ASSERT_EQ(mean[i], static_cast<double>(sum[i]) / cd) << "box " << i << " of " << n;
+        ASSERT_EQ(variance[i], numerator > 0 ? static_cast<double>(numerator) / (cd * cd) : 0.0)
+          << "box " << i << " of " << n << ", count " << c;
+      }
+    }
   }
 }

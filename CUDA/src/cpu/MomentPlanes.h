@@ -1,0 +1,311 @@
+// The box sums of v and v^2, streamed slice by slice along z.
+//
+// Each thread owns a chunk of output slices and keeps the 3-D box sums of v and v^2 for
+// the current slice as a plane. Moving to the next slice adds the 2-D box sum of the slice
+// that enters the window and subtracts the one that leaves; both are done in one x/y pass
+// over the difference of the two slices (box sums are linear). Per voxel and slice this is
+// O(1) whatever the radius, and only the input is read from memory and the output written:
+// the x-box rows stay in cache (a ring of 2 r_y + 2 of them), and the plane is read and
+// written once per slice.
+#pragma once
+
+#include "CpuDispatch.h"
+#include "Parallel.h"
+#include "VolumeAccess.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+namespace vao
+{
+namespace detail
+{
+
+/// Region geometry shared by the passes: spans read along each axis.
+struct BoxGeometry
+{
+  Index3 dims;
+  Region region;
+  Radius radius;
+  AxisSpan xs, ys, zs;
+
+  BoxGeometry(const Index3& volumeDims, const Region& outputRegion, const Radius& r)
+    : dims(volumeDims)
+    , region(outputRegion)
+    , radius(r)
+    , xs(readSpan(outputRegion.begin[0], outputRegion.size[0], r.x, volumeDims[0]))
+    , ys(readSpan(outputRegion.begin[1], outputRegion.size[1], r.y, volumeDims[1]))
+    , zs(readSpan(outputRegion.begin[2], outputRegion.size[2], r.z, volumeDims[2]))
+  {
+  }
+
+  std::int64_t planeSize() const { return region.size[0] * region.size[1]; }
+  /// Clipped window sizes along x and y of every region column and row.
+  std::vector<std::int64_t> windowCounts(int axis) const
+  {
+    const int r = axis == 0 ? radius.x : (axis == 1 ? radius.y : radius.z);
+    std::vector<std::int64_t> counts(static_cast<std::size_t>(region.size[axis]));
+    for (std::int64_t i = 0; i < region.size[axis]; ++i)
+    {
+      counts[i] = clippedWindowCount(region.begin[axis] + i, r, dims[axis]);
+    }
+    return counts;
+  }
+};
+
+/// One row of the y pass: plane += run (when plane is not null), then the running column
+/// sums move on: run = (run + entering) - leaving, in that order (the rounding of double
+/// sums is that of the scalar code it replaced). Compiled for AVX2 too (CpuDispatch.h).
+template <class Acc>
+struct SlideColumns
+{
+  static VAO_ALWAYS_INLINE void run(Acc* __restrict plane, Acc* __restrict run, const Acc* __restrict entering,
+    const Acc* __restrict leaving, std::int64_t n)
+  {
+    if (plane)
+      for (std::int64_t i = 0; i < n; ++i)
+        plane[i] += run[i];
+    for (std::int64_t i = 0; i < n; ++i)
+      run[i] = (run[i] + entering[i]) - leaving[i];
+  }
+};
+
+/// d1 = a - b and d2 = a^2 - b^2 with a, b the values of rows `in` and `out` less the
+/// shift (0 for a missing row). Compiled for AVX2 too.
+template <class T, class Acc>
+struct RowDifferences
+{
+  static VAO_ALWAYS_INLINE void run(const T* __restrict in, const T* __restrict out, std::int64_t stride,
+    std::int64_t n, Acc shift, Acc* __restrict d1, Acc* __restrict d2)
+  {
+    // Squares of 8-bit and int16 values and their differences fit in 32 bits, whose
+    // products vectorise (64-bit ones do not on AVX2).
+    using Product = typename std::conditional<std::is_integral<T>::value && (sizeof(T) == 1 ||
+      (sizeof(T) == 2 && std::is_signed<T>::value)), std::int32_t, Acc>::type;
+    const auto s = static_cast<Product>(shift);
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      const Product a = in ? static_cast<Product>(in[i * stride]) - s : Product(0);
+      const Product b = out ? static_cast<Product>(out[i * stride]) - s : Product(0);
+      d1[i] = static_cast<Acc>(a - b);
+      d2[i] = static_cast<Acc>(a * a - b * b);
+    }
+  }
+};
+
+/// box[i] = p[i + offset + width] - p[i + offset] for i in [begin, end), for both prefix
+/// rows. Compiled for AVX2 too.
+template <class Acc>
+struct WindowDifferences
+{
+  static VAO_ALWAYS_INLINE void run(const Acc* __restrict p1, const Acc* __restrict p2, std::int64_t offset,
+    std::int64_t width, Acc* __restrict box1, Acc* __restrict box2, std::int64_t begin, std::int64_t end)
+  {
+    for (std::int64_t i = begin; i < end; ++i)
+    {
+      box1[i] = p1[i + offset + width] - p1[i + offset];
+      box2[i] = p2[i + offset + width] - p2[i + offset];
+    }
+  }
+};
+
+/// Box sums of (v - shift) and (v - shift)^2 for one slice of the region at a time.
+template <class T>
+class MomentPlanes
+{
+public:
+  using Acc = typename MomentTraits<T>::Accumulator;
+
+  MomentPlanes(const TypedVolume<T>& volume, const BoxGeometry& geometry, Acc shift)
+    : Volume(volume)
+    , Geo(geometry)
+    , Shift(shift)
+    , Sum(geometry.planeSize())
+    , SumSquares(geometry.planeSize())
+    , Row1(geometry.xs.size() + 1)
+    , Row2(geometry.xs.size() + 1)
+    , RingRows(std::min<std::int64_t>(2 * std::int64_t(geometry.radius.y) + 2, geometry.ys.size()))
+    , XBox1(RingRows * geometry.region.size[0])
+    , XBox2(RingRows * geometry.region.size[0])
+    , Run1(geometry.region.size[0])
+    , Run2(geometry.region.size[0])
+    , Zeros(geometry.region.size[0], Acc(0))
+  {
+  }
+
+  /// Sets the planes to the box sums of output slice z (window clipped to the volume).
+  void startAt(std::int64_t z)
+  {
+    std::fill(this->Sum.begin(), this->Sum.end(), Acc(0));
+    std::fill(this->SumSquares.begin(), this->SumSquares.end(), Acc(0));
+    const std::int64_t lo = std::max<std::int64_t>(0, z - this->Geo.radius.z);
+    const std::int64_t hi = std::min<std::int64_t>(this->Geo.dims[2] - 1, z + this->Geo.radius.z);
+    for (std::int64_t s = lo; s <= hi; ++s)
+    {
+      this->addSliceDifference(s, -1);
+    }
+  }
+
+  /// Moves the planes from output slice z to z + 1.
+  void advanceFrom(std::int64_t z)
+  {
+    const std::int64_t entering = z + this->Geo.radius.z + 1;
+    const std::int64_t leaving = z - this->Geo.radius.z;
+    this->addSliceDifference(
+      entering < this->Geo.dims[2] ? entering : -1, leaving >= 0 ? leaving : -1);
+  }
+
+  const Acc* sum() const { return this->Sum.data(); }
+  const Acc* sumSquares() const { return this->SumSquares.data(); }
+
+private:
+  /// Adds the 2-D box sums of slice `entering` and subtracts those of `leaving` (-1: none):
+  /// plane[y] += the sum of the x-box rows in y's clipped window, by running sums over the
+  /// rows. Each x-box row is formed just before it enters the window, into a ring of the
+  /// 2 r_y + 2 rows that a window and its next entering row span, so the rows stay in cache.
+  void addSliceDifference(std::int64_t entering, std::int64_t leaving)
+  {
+    if (entering < 0 && leaving < 0)
+    {
+      return;
+    }
+    const std::int64_t nx = this->Geo.region.size[0];
+    const std::int64_t r = this->Geo.radius.y;
+    const std::int64_t ny = this->Geo.dims[1];
+    const std::int64_t y0 = this->Geo.region.begin[1];
+    const Acc* zeros = this->Zeros.data();
+    std::fill(this->Run1.begin(), this->Run1.end(), Acc(0));
+    std::fill(this->Run2.begin(), this->Run2.end(), Acc(0));
+    const auto slide = [&](std::int64_t row, std::int64_t in, std::int64_t out) {
+      Acc* plane1 = row < 0 ? nullptr : this->Sum.data() + row * nx;
+      Acc* plane2 = row < 0 ? nullptr : this->SumSquares.data() + row * nx;
+      runRows<SlideColumns<Acc>>(this->Avx2, plane1, this->Run1.data(), in < 0 ? zeros : this->xbox1(in),
+        out < 0 ? zeros : this->xbox1(out), nx);
+      runRows<SlideColumns<Acc>>(this->Avx2, plane2, this->Run2.data(), in < 0 ? zeros : this->xbox2(in),
+        out < 0 ? zeros : this->xbox2(out), nx);
+    };
+    for (std::int64_t y = std::max<std::int64_t>(0, y0 - r); y <= std::min(ny - 1, y0 + r); ++y)
+    {
+      this->boxRowDifference(y, entering, leaving);
+      slide(-1, y, -1);
+    }
+    for (std::int64_t row = 0; row < this->Geo.region.size[1]; ++row)
+    {
+      // The last row has no next one: its window's entering row may lie past the rows read.
+      const std::int64_t y = y0 + row;
+      const bool last = row + 1 == this->Geo.region.size[1];
+      const std::int64_t in = !last && y + r + 1 < ny ? y + r + 1 : -1;
+      const std::int64_t out = !last && y - r >= 0 ? y - r : -1;
+      if (in >= 0)
+        this->boxRowDifference(in, entering, leaving);
+      slide(row, in, out);
+    }
+  }
+
+  Acc* xbox1(std::int64_t y) { return this->XBox1.data() + (y - this->Geo.ys.lo) % this->RingRows * this->Geo.region.size[0]; }
+  Acc* xbox2(std::int64_t y) { return this->XBox2.data() + (y - this->Geo.ys.lo) % this->RingRows * this->Geo.region.size[0]; }
+
+  /// x box sums of one row of (entering - leaving), stored in the ring at xbox1(y), xbox2(y).
+  void boxRowDifference(std::int64_t y, std::int64_t entering, std::int64_t leaving)
+  {
+    const std::int64_t span = this->Geo.xs.size();
+    const std::int64_t stride = this->Volume.stride;
+    Acc* p1 = this->Row1.data();
+    Acc* p2 = this->Row2.data();
+    const T* in = entering >= 0 ? this->Volume.row(y, entering) + this->Geo.xs.lo * stride : nullptr;
+    const T* out = leaving >= 0 ? this->Volume.row(y, leaving) + this->Geo.xs.lo * stride : nullptr;
+    // The differences of the two rows (a vector loop), then their prefix sums:
+    // p[i] = sum of the first i values.
+    runRows<RowDifferences<T, Acc>>(this->Avx2, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
+    p1[0] = 0;
+    p2[0] = 0;
+    for (std::int64_t i = 0; i < span; ++i)
+    {
+      p1[i + 1] += p1[i];
+      p2[i + 1] += p2[i];
+    }
+    const std::int64_t nx = this->Geo.region.size[0];
+    const std::int64_t r = this->Geo.radius.x;
+    const std::int64_t x0 = this->Geo.region.begin[0] - this->Geo.xs.lo; // first output in span
+    Acc* box1 = this->xbox1(y);
+    Acc* box2 = this->xbox2(y);
+    // Outputs whose window lies inside the span (a vector loop) and the clamped ends.
+    const std::int64_t first = std::min(nx, std::max<std::int64_t>(0, r - x0));
+    const std::int64_t end = std::max(first, std::min(nx, span - r - x0));
+    const auto clamped = [&](std::int64_t i) {
+      const std::int64_t lo = std::max<std::int64_t>(0, x0 + i - r);
+      const std::int64_t hi = std::min<std::int64_t>(span, x0 + i + r + 1);
+      box1[i] = p1[hi] - p1[lo];
+      box2[i] = p2[hi] - p2[lo];
+    };
+    for (std::int64_t i = 0; i < first; ++i)
+      clamped(i);
+    runRows<WindowDifferences<Acc>>(this->Avx2, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+    for (std::int64_t i = end; i < nx; ++i)
+      clamped(i);
+  }
+
+  const TypedVolume<T>& Volume;
+  const BoxGeometry& Geo;
+  Acc Shift;
+  std::vector<Acc> Sum, SumSquares;
+  std::vector<Acc> Row1, Row2;
+  std::int64_t RingRows; // x-box rows kept: a window's and the next entering one
+  std::vector<Acc> XBox1, XBox2;
+  std::vector<Acc> Run1, Run2;
+  std::vector<Acc> Zeros; // a row outside the volume
+  bool Avx2 = cpuHasAvx2();
+};
+
+/// Per-slice view handed to the consumer of the moments: everything needed to turn the
+/// sums of slice z into statistics.
+template <class T>
+struct MomentSlice
+{
+  using Acc = typename MomentTraits<T>::Accumulator;
+  std::int64_t z;         // output slice, volume coordinates
+  const Acc* sum;         // region plane, x fastest
+  const Acc* sumSquares;  //
+  double shift;           // add to sum / count to get the mean
+  std::int64_t countZ;    // clipped window size along z
+  double roundingVariance; // what rounding can fake on a flat box (MomentScale)
+};
+
+/// Streams the moment planes of every region slice to consume(slice) on worker threads;
+/// each thread takes a contiguous chunk of slices. Returns false when cancelled.
+template <class T, class Consume>
+bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry, const MomentScale& scale,
+  const Execution& execution, Consume&& consume)
+{
+  const auto shift = static_cast<typename MomentTraits<T>::Accumulator>(scale.shift);
+  const int threads = resolveThreadCount(execution.threads);
+  const std::int64_t nz = geometry.region.size[2];
+  return parallelFor(nz, threads, threads, execution,
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+      MomentPlanes<T> planes(volume, geometry, shift);
+      for (std::int64_t k = begin; k < end; ++k)
+      {
+        const std::int64_t z = geometry.region.begin[2] + k;
+        if (k == begin)
+        {
+          planes.startAt(z);
+        }
+        else
+        {
+          planes.advanceFrom(z - 1);
+        }
+        MomentSlice<T> slice{ z, planes.sum(), planes.sumSquares(), static_cast<double>(shift),
+          clippedWindowCount(z, geometry.radius.z, geometry.dims[2]), scale.roundingVariance };
+        consume(slice);
+        if (!progress.advance())
+        {
+          return;
+        }
+      }
+    });
+}
+
+} // namespace detail
+} // namespace vao
