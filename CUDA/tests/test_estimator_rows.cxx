@@ -19,6 +19,10 @@ namespace
 /// The error of erf's few ulps near +-1, halved in the openness (1 + erf) / 2.
 constexpr double kHalfUlpOfOne = 1.1102230246251565e-16;
 
+/// Above this openness a float differing from the scalar formula's is a coincidence of
+/// rounding; below it, where 1 + erf cancels, the erf's last bits show in most floats.
+constexpr double kTail = 1e-6;
+
 struct RowData
 {
   std::vector<double> value, count, mean, variance, minimum, maximum, query;
@@ -38,9 +42,9 @@ struct RowData
 };
 
 /// n neighbourhoods around `magnitude`: a quarter flat (variance 0 or far below the flat
-/// limit), the rest with spreads from 1e-3 to 10 times the magnitude; queries a few
-/// standard deviations either side, or exactly the mean of a flat box.
-RowData makeRow(std::size_t n, double magnitude, std::mt19937& rng)
+/// limit), the rest with spreads from 1e-3 to 10 times the magnitude; queries up to
+/// `reach` standard deviations either side, or exactly the mean of a flat box.
+RowData makeRow(std::size_t n, double magnitude, std::mt19937& rng, double reach = 4.0)
 {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   RowData d;
@@ -50,7 +54,7 @@ RowData makeRow(std::size_t n, double magnitude, std::mt19937& rng)
     const bool flat = rng() % 4 == 0;
     const double sd = flat ? 0.0 : magnitude * std::pow(10.0, 2.0 * unit(rng) - 1.0);
     const double variance = flat ? (rng() % 2 ? 0.0 : 1e-17 * std::fmax(1.0, mean * mean)) : sd * sd;
-    double q = mean + 4.0 * sd * unit(rng);
+    double q = mean + reach * sd * unit(rng);
     if (flat)
       q = rng() % 3 == 0 ? mean : mean + magnitude * unit(rng);
     d.mean.push_back(mean);
@@ -86,11 +90,12 @@ TEST(EstimatorRows, EveryLengthQueryAndMagnitudeAgainstTheReference)
   std::size_t compared = 0, offByOneUlp = 0;
   for (const vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
   {
-    for (const double magnitude : { 1.0, 1000.0, 3.0e6 })
+    // Reach 12: most Gaussian CDF lanes beyond |z| = 6, where erf is +-1, often whole groups.
+    for (const double magnitude : { 1.0, 1000.0, 3.0e6, -12.0 })
     {
       for (std::size_t n = 0; n <= 37; ++n)
       {
-        const RowData d = makeRow(n, magnitude, rng);
+        const RowData d = magnitude > 0 ? makeRow(n, magnitude, rng) : makeRow(n, 1000.0, rng, -magnitude);
         const double iso = magnitude * 0.25;
         for (const bool perVoxel : { true, false })
         {
@@ -111,13 +116,13 @@ TEST(EstimatorRows, EveryLengthQueryAndMagnitudeAgainstTheReference)
             const double tolerance = std::fmax(std::fabs(std::nextafter(expected, out[i]) - expected), 8 * kHalfUlpOfOne);
             ASSERT_LE(std::fabs(double(out[i]) - expected), tolerance) << "voxel " << i << " of " << n << ", q " << q
               << ", mean " << d.mean[i] << ", variance " << d.variance[i];
-            ++offByOneUlp;
+            offByOneUlp += expected > kTail; // a rounding coincidence there
           }
         }
       }
     }
   }
-  std::printf("%zu opennesses compared, %zu a rounding away from the reference, vector form: %s\n", compared,
+  std::printf("%zu opennesses compared, %zu above the tail a rounding away from the reference, vector form: %s\n", compared,
     offByOneUlp, vao::detail::opennessRowIsVector(vao::Method::GaussianCdf, vao::ErfMode::Exact) ? "yes" : "no");
   EXPECT_LE(offByOneUlp * 1000, compared); // a rounding coincidence, not a habit
 }
@@ -125,7 +130,12 @@ TEST(EstimatorRows, EveryLengthQueryAndMagnitudeAgainstTheReference)
 TEST(EstimatorRows, VectorAndPlainFormsAgree)
 {
   std::mt19937 rng(7);
-  const RowData d = makeRow(4099, 500.0, rng);
+  RowData d = makeRow(2048, 500.0, rng);
+  const RowData far = makeRow(2051, 500.0, rng, 12.0); // erf at +-1, whole groups
+  using Field = std::vector<double> RowData::*;
+  for (const Field field : { &RowData::value, &RowData::count, &RowData::mean, &RowData::variance,
+         &RowData::minimum, &RowData::maximum, &RowData::query })
+    (d.*field).insert((d.*field).end(), (far.*field).begin(), (far.*field).end());
   for (const vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev })
   {
     std::vector<float> fast(d.mean.size()), plain(d.mean.size());
@@ -139,7 +149,7 @@ TEST(EstimatorRows, VectorAndPlainFormsAgree)
         ASSERT_EQ(method, vao::Method::GaussianCdf) << "Chebyshev rounds as the scalar formula, voxel " << i;
         const double tolerance = std::fmax(std::fabs(std::nextafter(plain[i], fast[i]) - plain[i]), 8 * kHalfUlpOfOne);
         ASSERT_LE(std::fabs(double(fast[i]) - plain[i]), tolerance) << "voxel " << i;
-        ++differ;
+        differ += plain[i] > kTail;
       }
     }
     EXPECT_LE(differ * 1000, fast.size());

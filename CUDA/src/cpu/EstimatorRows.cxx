@@ -52,8 +52,20 @@ VAO_AVX2_HELPER __m128 opennessFour(const NeighbourhoodRow& row, const double* q
   const __m256d flat = flatMaskAvx2(mean, variance, roundingVariance);
   const __m256d spread = _mm256_blendv_pd(variance, one, flat);
   const __m256d z = _mm256_div_pd(_mm256_sub_pd(q, mean), _mm256_sqrt_pd(_mm256_mul_pd(_mm256_set1_pd(2.0), spread)));
-  const __m256d cdf = _mm256_mul_pd(_mm256_set1_pd(0.5), _mm256_add_pd(one, _ZGVdN4v_erf(z)));
-  const __m256d open = _mm256_min_pd(_mm256_max_pd(cdf, _mm256_setzero_pd()), one);
+  // Beyond |z| = 6 erf is +-1 in doubles (1 - erf(6) ~ 2e-17 is under half an ulp of 1), so
+  // the openness is 1 or 0: groups of only such lanes and flat ones skip the erf (most of a
+  // volume with smooth regions).
+  const __m256d saturated = _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), z), _mm256_set1_pd(6.0), _CMP_GT_OQ);
+  __m256d open;
+  if (_mm256_movemask_pd(_mm256_or_pd(saturated, flat)) == 0xF)
+  {
+    open = _mm256_and_pd(_mm256_cmp_pd(z, _mm256_setzero_pd(), _CMP_GT_OQ), one);
+  }
+  else
+  {
+    const __m256d cdf = _mm256_mul_pd(_mm256_set1_pd(0.5), _mm256_add_pd(one, _ZGVdN4v_erf(z)));
+    open = _mm256_min_pd(_mm256_max_pd(cdf, _mm256_setzero_pd()), one);
+  }
   return _mm256_cvtpd_ps(_mm256_blendv_pd(open, flatOpennessAvx2(q, mean, roundingSpread), flat));
 #else
   return _mm_setzero_ps(); // not reached: opennessRowIsVector says no
