@@ -41,8 +41,9 @@ def statistics(volume, radius):
     return mean, mean_sq, lo, hi
 
 
-volume = read_volume(sys.argv[1])
-for radius in (int(r) for r in sys.argv[2:]):
-    start = time.perf_counter()
-    statistics(volume, radius)
-    print("scipy %d %.4f" % (radius, time.perf_counter() - start), flush=True)
+if __name__ == "__main__":
+    volume = read_volume(sys.argv[1])
+    for radius in (int(r) for r in sys.argv[2:]):
+        start = time.perf_counter()
+        statistics(volume, radius)
+        print("scipy %d %.4f" % (radius, time.perf_counter() - start), flush=True)

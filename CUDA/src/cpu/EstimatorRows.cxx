@@ -1,17 +1,20 @@
-// opennessRow: the Gaussian CDF and Chebyshev four voxels at a time on AVX2. The exact erf
-// is glibc's vector erf (libmvec, within 4 ulps of the scalar erf: the float32 openness is
-// the scalar's but where the double lies within a few ulps of a float32 rounding boundary).
+// opennessRow: the Gaussian CDF, Chebyshev and CDF Reconstruction four voxels at a time on
+// AVX2. The exact erf and pow are glibc's vector forms (libmvec, within 4 ulps of the
+// scalar functions: the float32 openness is the scalar's but where the double lies within
+// a few ulps of a float32 rounding boundary, or, for the erf, in the far tail where
+// 1 + erf cancels).
 // Everything else rounds as the scalar formulas (this file has no fused multiply-adds).
 #include "EstimatorRows.h"
 
 #include "EstimatorsAvx2.h"
 
 #if VAO_HAVE_AVX2_TARGET && defined(VAO_HAVE_LIBMVEC)
-#define VAO_VECTOR_ERF 1
-// glibc's AVX2 erf (the x86-64 vector function ABI name of erf for 4 doubles).
+#define VAO_VECTOR_MATH 1
+// glibc's AVX2 erf and pow (their x86-64 vector function ABI names for 4 doubles).
 extern "C" __attribute__((target("avx2"))) __m256d _ZGVdN4v_erf(__m256d);
+extern "C" __attribute__((target("avx2"))) __m256d _ZGVdN4vv_pow(__m256d, __m256d);
 #else
-#define VAO_VECTOR_ERF 0
+#define VAO_VECTOR_MATH 0
 #endif
 
 namespace vao
@@ -33,21 +36,13 @@ void opennessRowPlain(Method method, ErfMode erfMode, const NeighbourhoodRow& ro
 namespace
 {
 
-/// Four opennesses at voxel i of the row: Method::GaussianCdf (exact erf) or Chebyshev.
-template <Method M>
-VAO_AVX2_HELPER __m128 opennessFour(const NeighbourhoodRow& row, const double* query, double isoValue,
-  std::int64_t i, __m256d roundingVariance, __m256d roundingSpread)
+#if VAO_VECTOR_MATH
+/// opennessGaussianCdf with the exact erf. Flat lanes take a variance of 1 into the erf
+/// (their 0 would give it infinities or NaN, and libmvec a slow path) and their flat
+/// answer after it.
+VAO_AVX2_HELPER __m256d gaussianCdfAvx2(
+  __m256d q, __m256d mean, __m256d variance, __m256d roundingVariance, __m256d roundingSpread)
 {
-  const __m256d q = query ? _mm256_loadu_pd(query + i) : _mm256_set1_pd(isoValue);
-  const __m256d mean = _mm256_loadu_pd(row.mean + i);
-  const __m256d variance = _mm256_loadu_pd(row.variance + i);
-  if (M == Method::Chebyshev)
-  {
-    return _mm256_cvtpd_ps(chebyshevOpennessAvx2(q, mean, variance, roundingVariance, roundingSpread));
-  }
-#if VAO_VECTOR_ERF
-  // opennessGaussianCdf. Flat lanes take a variance of 1 into the erf (their 0 would give
-  // it infinities or NaN, and libmvec a slow path) and their flat answer after it.
   const __m256d one = _mm256_set1_pd(1.0);
   const __m256d flat = flatMaskAvx2(mean, variance, roundingVariance);
   const __m256d spread = _mm256_blendv_pd(variance, one, flat);
@@ -66,7 +61,58 @@ VAO_AVX2_HELPER __m128 opennessFour(const NeighbourhoodRow& row, const double* q
     const __m256d cdf = _mm256_mul_pd(_mm256_set1_pd(0.5), _mm256_add_pd(one, _ZGVdN4v_erf(z)));
     open = _mm256_min_pd(_mm256_max_pd(cdf, _mm256_setzero_pd()), one);
   }
-  return _mm256_cvtpd_ps(_mm256_blendv_pd(open, flatOpennessAvx2(q, mean, roundingSpread), flat));
+  return _mm256_blendv_pd(open, flatOpennessAvx2(q, mean, roundingSpread), flat);
+}
+
+/// opennessCdfReconstruction: t^beta, its cases (flat box, t at or past either end, the
+/// mean at the maximum) by masks in the scalar form's order of precedence. The lanes of
+/// those cases take t = 1/2 and beta = 1 into the pow; groups of only such lanes skip it.
+VAO_AVX2_HELPER __m256d cdfReconstructionAvx2(__m256d q, __m256d mean, __m256d minimum, __m256d maximum)
+{
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d one = _mm256_set1_pd(1.0);
+  const __m256d flat = _mm256_cmp_pd(maximum, minimum, _CMP_LE_OQ);
+  const __m256d flatOpen = _mm256_and_pd(_mm256_cmp_pd(q, minimum, _CMP_GE_OQ), one);
+  const __m256d range = _mm256_blendv_pd(_mm256_sub_pd(maximum, minimum), one, flat);
+  const __m256d t = _mm256_div_pd(_mm256_sub_pd(q, minimum), range);
+  const __m256d atTop = _mm256_cmp_pd(t, one, _CMP_GE_OQ);
+  const __m256d atBottom = _mm256_cmp_pd(t, zero, _CMP_LE_OQ);
+  const __m256d m = _mm256_min_pd(_mm256_max_pd(mean, minimum), maximum);
+  const __m256d meanAtMaximum = _mm256_cmp_pd(m, maximum, _CMP_GE_OQ);
+  const __m256d decided = _mm256_or_pd(_mm256_or_pd(flat, atTop), _mm256_or_pd(atBottom, meanAtMaximum));
+  // Every decided lane but t >= 1 (and a flat box's, which comes last) is 0.
+  __m256d open = _mm256_and_pd(atTop, one);
+  if (_mm256_movemask_pd(decided) != 0xF)
+  {
+    const __m256d half = _mm256_set1_pd(0.5);
+    const __m256d beta = _mm256_div_pd(_mm256_sub_pd(m, minimum), _mm256_blendv_pd(_mm256_sub_pd(maximum, m), one, decided));
+    const __m256d power = _ZGVdN4vv_pow(_mm256_blendv_pd(t, half, decided), _mm256_blendv_pd(beta, one, decided));
+    open = _mm256_blendv_pd(power, open, decided);
+  }
+  return _mm256_blendv_pd(open, flatOpen, flat);
+}
+#endif
+
+/// Four opennesses at voxel i of the row by method M (opennessRowIsVector says which).
+template <Method M>
+VAO_AVX2_HELPER __m128 opennessFour(const NeighbourhoodRow& row, const double* query, double isoValue,
+  std::int64_t i, __m256d roundingVariance, __m256d roundingSpread)
+{
+  const __m256d q = query ? _mm256_loadu_pd(query + i) : _mm256_set1_pd(isoValue);
+  const __m256d mean = _mm256_loadu_pd(row.mean + i);
+  if (M == Method::Chebyshev)
+  {
+    const __m256d variance = _mm256_loadu_pd(row.variance + i);
+    return _mm256_cvtpd_ps(chebyshevOpennessAvx2(q, mean, variance, roundingVariance, roundingSpread));
+  }
+#if VAO_VECTOR_MATH
+  if (M == Method::CdfReconstruction)
+  {
+    return _mm256_cvtpd_ps(
+      cdfReconstructionAvx2(q, mean, _mm256_loadu_pd(row.minimum + i), _mm256_loadu_pd(row.maximum + i)));
+  }
+  const __m256d variance = _mm256_loadu_pd(row.variance + i);
+  return _mm256_cvtpd_ps(gaussianCdfAvx2(q, mean, variance, roundingVariance, roundingSpread));
 #else
   return _mm_setzero_ps(); // not reached: opennessRowIsVector says no
 #endif
@@ -92,8 +138,9 @@ VAO_AVX2_INLINE void opennessRowAvx2(const NeighbourhoodRow& row, const double* 
 bool opennessRowIsVector(Method method, ErfMode erfMode)
 {
   const bool chebyshev = method == Method::Chebyshev;
-  const bool gaussian = VAO_VECTOR_ERF && method == Method::GaussianCdf && erfMode == ErfMode::Exact;
-  return cpuHasAvx2() && (chebyshev || gaussian);
+  const bool gaussian = VAO_VECTOR_MATH && method == Method::GaussianCdf && erfMode == ErfMode::Exact;
+  const bool reconstruction = VAO_VECTOR_MATH && method == Method::CdfReconstruction;
+  return cpuHasAvx2() && (chebyshev || gaussian || reconstruction);
 }
 
 void opennessRow(Method method, ErfMode erfMode, const NeighbourhoodRow& row, const double* query,
@@ -104,6 +151,8 @@ void opennessRow(Method method, ErfMode erfMode, const NeighbourhoodRow& row, co
   {
     if (method == Method::Chebyshev)
       opennessRowAvx2<Method::Chebyshev>(row, query, isoValue, openness);
+    else if (method == Method::CdfReconstruction)
+      opennessRowAvx2<Method::CdfReconstruction>(row, query, isoValue, openness);
     else
       opennessRowAvx2<Method::GaussianCdf>(row, query, isoValue, openness);
     return;
