@@ -6,7 +6,8 @@
 // (TileSize x TileSize output columns, a z-range each), which keeps a tile's state in the
 // L2 cache and the extra memory far below the input's size:
 //  - Window: the counts of the 2 Rz + 1 slices around z, per pixel of the tile grown by
-//    the radius. Moving to the next slice adds one voxel's bin and removes one: O(1).
+//    the radius. Moving to the next slice adds one voxel's bin and removes one: O(1), and
+//    nothing where both fall in the same bin.
 //  - Rows: the window summed along x (a running vector per row), then a running vector per
 //    column along y gives the 3-D box histogram of each output voxel.
 // The query q then needs F just below and at the bin of q: a masked sum of the histogram's
@@ -226,10 +227,13 @@ public:
     {
       if (z > z0)
       {
-        if (z + r.z < dims[2])
-          this->addSlice(z + r.z, 1);
-        if (z - r.z - 1 >= 0)
-          this->addSlice(z - r.z - 1, -1);
+        const std::int64_t entering = z + r.z, leaving = z - r.z - 1;
+        if (entering < dims[2] && leaving >= 0)
+          this->moveSlice(entering, leaving);
+        else if (entering < dims[2])
+          this->addSlice(entering, 1);
+        else if (leaving >= 0)
+          this->addSlice(leaving, -1);
       }
       this->outputSlice(y0, ny, z);
     }
@@ -254,6 +258,32 @@ private:
           L& lane = w[(x - this->HX0) * this->Lanes + b];
           lane = static_cast<L>(lane + step);
         }
+      }
+    }
+  }
+
+  /// addSlice(entering, 1) and addSlice(leaving, -1) in one pass, which leaves a pixel
+  /// alone when both voxels fall in the same bin (most of a smooth volume).
+  void moveSlice(std::int64_t entering, std::int64_t leaving)
+  {
+    const std::int64_t width = this->HX1 - this->HX0;
+    const std::int64_t stride = this->Volume.stride;
+    for (std::int64_t y = this->HY0; y < this->HY1; ++y)
+    {
+      const T* in = this->Volume.row(y, entering);
+      const T* out = this->Volume.row(y, leaving);
+      L* w = &this->Window[(y - this->HY0) * width * this->Lanes];
+      for (std::int64_t x = this->HX0; x < this->HX1; ++x)
+      {
+        const int added = this->Bin(in[x * stride]);
+        const int removed = this->Bin(out[x * stride]);
+        if (added == removed)
+          continue;
+        L* pixel = w + (x - this->HX0) * this->Lanes;
+        if (added < this->Bins)
+          pixel[added] = static_cast<L>(pixel[added] + 1);
+        if (removed < this->Bins)
+          pixel[removed] = static_cast<L>(pixel[removed] - 1);
       }
     }
   }
