@@ -221,19 +221,14 @@ public:
     std::fill(this->Window.begin(), this->Window.begin() + pixels * this->Lanes, L(0));
     for (std::int64_t s = std::max<std::int64_t>(0, z0 - r.z); s <= std::min<std::int64_t>(dims[2] - 1, z0 + r.z); ++s)
     {
-      this->addSlice(s, 1);
+      this->moveSlice(s, -1);
     }
     for (std::int64_t z = z0; z < z1; ++z)
     {
       if (z > z0)
       {
         const std::int64_t entering = z + r.z, leaving = z - r.z - 1;
-        if (entering < dims[2] && leaving >= 0)
-          this->moveSlice(entering, leaving);
-        else if (entering < dims[2])
-          this->addSlice(entering, 1);
-        else if (leaving >= 0)
-          this->addSlice(leaving, -1);
+        this->moveSlice(entering < dims[2] ? entering : -1, leaving);
       }
       this->outputSlice(y0, ny, z);
     }
@@ -242,41 +237,23 @@ public:
 private:
   const L* zeros() const { return this->Zeros.data(); }
 
-  void addSlice(std::int64_t s, int sign)
-  {
-    const std::int64_t width = this->HX1 - this->HX0;
-    const L step = static_cast<L>(sign);
-    for (std::int64_t y = this->HY0; y < this->HY1; ++y)
-    {
-      const T* row = this->Volume.row(y, s);
-      L* w = &this->Window[(y - this->HY0) * width * this->Lanes];
-      for (std::int64_t x = this->HX0; x < this->HX1; ++x)
-      {
-        const int b = this->Bin(row[x * this->Volume.stride]);
-        if (b < this->Bins)
-        {
-          L& lane = w[(x - this->HX0) * this->Lanes + b];
-          lane = static_cast<L>(lane + step);
-        }
-      }
-    }
-  }
-
-  /// addSlice(entering, 1) and addSlice(leaving, -1) in one pass, which leaves a pixel
-  /// alone when both voxels fall in the same bin (most of a smooth volume).
+  /// Adds the bins of slice `entering` to the window and removes those of `leaving` (-1:
+  /// none), in one pass that leaves a pixel alone when both voxels fall in the same bin
+  /// (most of a smooth volume).
   void moveSlice(std::int64_t entering, std::int64_t leaving)
   {
     const std::int64_t width = this->HX1 - this->HX0;
     const std::int64_t stride = this->Volume.stride;
     for (std::int64_t y = this->HY0; y < this->HY1; ++y)
     {
-      const T* in = this->Volume.row(y, entering);
-      const T* out = this->Volume.row(y, leaving);
+      const T* in = entering >= 0 ? this->Volume.row(y, entering) : nullptr;
+      const T* out = leaving >= 0 ? this->Volume.row(y, leaving) : nullptr;
       L* w = &this->Window[(y - this->HY0) * width * this->Lanes];
       for (std::int64_t x = this->HX0; x < this->HX1; ++x)
       {
-        const int added = this->Bin(in[x * stride]);
-        const int removed = this->Bin(out[x * stride]);
+        // A missing slice's voxel is in no bin (index Bins), as a value above every threshold.
+        const int added = in ? this->Bin(in[x * stride]) : this->Bins;
+        const int removed = out ? this->Bin(out[x * stride]) : this->Bins;
         if (added == removed)
           continue;
         L* pixel = w + (x - this->HX0) * this->Lanes;
