@@ -19,6 +19,13 @@
 #define VAO_HAVE_AVX2_TARGET 0
 #endif
 
+#if VAO_HAVE_AVX2_TARGET
+// Hand-written AVX2 code (intrinsics): its entry points, called from baseline code, and
+// the helpers they inline.
+#define VAO_AVX2_INLINE __attribute__((target("avx2,fma"))) inline
+#define VAO_AVX2_HELPER __attribute__((target("avx2,fma"), always_inline)) inline
+#endif
+
 namespace vao
 {
 namespace detail

@@ -1,5 +1,6 @@
 // The separable estimators over a row of neighbourhoods: on AVX2 four voxels at a time
-// (the Gaussian CDF with glibc's vector erf), elsewhere voxel by voxel.
+// (Chebyshev; with glibc's vector erf and pow, the Gaussian CDF and CDF Reconstruction),
+// elsewhere voxel by voxel.
 #pragma once
 
 #include "BoxEngine.h"

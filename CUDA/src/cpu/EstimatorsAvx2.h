@@ -11,10 +11,6 @@
 #if VAO_HAVE_AVX2_TARGET
 #include <immintrin.h>
 
-// The entry points, called from baseline code, and the helpers they inline.
-#define VAO_AVX2_INLINE __attribute__((target("avx2,fma"))) inline
-#define VAO_AVX2_HELPER __attribute__((target("avx2,fma"), always_inline)) inline
-
 namespace vao
 {
 namespace detail

@@ -35,13 +35,13 @@ namespace
 
 /// Integers of magnitude below 2^51 to doubles (exact): added to the bits of 1.5 * 2^52,
 /// they are its mantissa.
-__attribute__((target("avx2,fma"), always_inline)) inline __m256d smallIntegersToDouble(__m256i x)
+VAO_AVX2_HELPER __m256d smallIntegersToDouble(__m256i x)
 {
   const __m256d magic = _mm256_set1_pd(6755399441055744.0);
   return _mm256_sub_pd(_mm256_castsi256_pd(_mm256_add_epi64(x, _mm256_castpd_si256(magic))), magic);
 }
 
-__attribute__((target("avx2,fma"))) void meanVarianceRowExactAvx2(const std::int64_t* sum,
+VAO_AVX2_INLINE void meanVarianceRowExactAvx2(const std::int64_t* sum,
   const std::int64_t* sumSquares, const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, double* count,
   double* mean, double* variance)
 {
