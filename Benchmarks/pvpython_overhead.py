@@ -53,12 +53,12 @@ for method in ["Gaussian CDF", "Histogram CDF", "CDF Reconstruction"]:
     volumetric[method] = measure("Volumetric AO, " + method,
                                  lambda: VolumetricAmbientOcclusion(Input=body, Method=method, Radius=10))
 try:
-    import numpy as np
     from vtkmodules.util.numpy_support import vtk_to_numpy
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from scipy_peer import statistics  # the peer's own code, not a copy
     image = servermanager.Fetch(body)
-    volume = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(415, 256, 256)
+    nx, ny, nz = image.GetDimensions()
+    volume = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(nz, ny, nx)
     peer = min(seconds(lambda: statistics(volume, 10)) for repeat in range(3))
     print("scipy.ndimage box statistics, R = 10: %.1f ms; pvpython Volumetric AO faster by: %s"
           % (peer * 1e3, ", ".join("%s %.1fx" % (m, peer / t) for m, t in volumetric.items())))
