@@ -260,3 +260,100 @@ TEST(SurfaceLanes, VectorPathEqualsThePlainLoop)
     EXPECT_EQ(lanesCompared, 200 * vao::detail::kLanes);
   }
 }
+
+TEST(SurfaceLanes, CellBoundsHoldTheLargestCornerValues)
+{
+  for (const vao::Index3 dims : { vao::Index3{ 7, 6, 5 }, vao::Index3{ 1, 4, 3 }, vao::Index3{ 5, 1, 1 } })
+  {
+    vao::MomentLevel level;
+    level.dims = dims;
+    const auto n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> value(-80.0, 80.0);
+    level.mean.resize(n);
+    level.variance.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      level.mean[i] = static_cast<float>(value(rng));
+      level.variance[i] = static_cast<float>(value(rng)); // negatives: the bound is at least 0
+    }
+    vao::detail::LevelGrid grid(level);
+    const vao::detail::CellBounds bounds(level, grid);
+    auto index = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return (z * dims[1] + y) * dims[0] + x; };
+    for (std::int64_t z = 0; z < dims[2]; ++z)
+      for (std::int64_t y = 0; y < dims[1]; ++y)
+        for (std::int64_t x = 0; x < dims[0]; ++x)
+        {
+          float mean = -1e30f, variance = 0.0f;
+          for (std::int64_t c = 0; c < 8; ++c) // the cell's corners, clamped to the level
+          {
+            const std::int64_t i = index(std::min<std::int64_t>(x + (c & 1), dims[0] - 1),
+              std::min<std::int64_t>(y + ((c >> 1) & 1), dims[1] - 1), std::min<std::int64_t>(z + (c >> 2), dims[2] - 1));
+            mean = std::max(mean, level.mean[i]);
+            variance = std::max(variance, level.variance[i]);
+          }
+          EXPECT_EQ(grid.cellBounds[2 * index(x, y, z)], mean) << x << " " << y << " " << z;
+          EXPECT_EQ(grid.cellBounds[2 * index(x, y, z) + 1], variance) << x << " " << y << " " << z;
+        }
+  }
+}
+
+#if VAO_HAVE_AVX2_TARGET
+TEST(SurfaceLanes, MarchPassingOverBoundedCellsEqualsTheFullMarch)
+{
+  if (!vao::detail::cpuHasAvx2())
+    GTEST_SKIP() << "no AVX2: the vector march does not run here";
+  // The scene's ball and noise, plus queries from below the smallest to above the largest
+  // means: most cells' bounds fall below what a march already holds.
+  const Scene s(4, 0, 23u);
+  std::vector<vao::detail::LevelGrid> bare, bounded;
+  std::vector<vao::detail::CellBounds> bounds;
+  std::vector<double> radius;
+  bounds.reserve(s.pyramid.size());
+  for (const vao::MomentLevel& level : s.pyramid)
+  {
+    bare.emplace_back(level);
+    bounded.emplace_back(level);
+    bounds.emplace_back(level, bounded.back());
+    radius.push_back(level.kernelRadius);
+  }
+  const vao::MomentLevel& base = s.pyramid[0];
+  double lo[3], hi[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = base.origin[a];
+    hi[a] = base.origin[a] + (base.dims[a] - 1) * base.spacing[a];
+  }
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> unit(0.0, 1.0), query(-100.0, 600.0), direction(-1.0, 1.0);
+  int lanes = 0, occluded = 0;
+  for (int batch = 0; batch < 400; ++batch)
+  {
+    constexpr int W = vao::detail::kLanes;
+    double x[W], y[W], z[W], q[W], full[W], passed[W];
+    for (int k = 0; k < W; ++k)
+    {
+      x[k] = lo[0] + unit(rng) * (hi[0] - lo[0]);
+      y[k] = lo[1] + unit(rng) * (hi[1] - lo[1]);
+      z[k] = lo[2] + unit(rng) * (hi[2] - lo[2]);
+      q[k] = query(rng);
+    }
+    Vec3 light = { direction(rng), direction(rng), direction(rng) };
+    const double length = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
+    for (double& c : light)
+      c /= length;
+    const double* start[3] = { x, y, z };
+    const int levels = 1 + batch % 4;
+    vao::detail::chebyshevMarchAvx2(bare.data(), radius.data(), levels, lo, hi, start, light.data(), q, full);
+    vao::detail::chebyshevMarchAvx2(bounded.data(), radius.data(), levels, lo, hi, start, light.data(), q, passed);
+    for (int k = 0; k < W; ++k)
+    {
+      EXPECT_NEAR(passed[k], full[k], 1e-12) << "batch " << batch << ", lane " << k;
+      occluded += full[k] > 0.01 && full[k] < 0.99;
+      ++lanes;
+    }
+  }
+  EXPECT_EQ(lanes, 400 * vao::detail::kLanes);
+  EXPECT_GT(occluded, lanes / 4); // partial occlusions: the bounds decide, not the extremes
+}
+#endif

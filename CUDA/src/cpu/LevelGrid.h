@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 namespace vao
 {
@@ -35,6 +36,8 @@ struct LevelGrid
   bool narrowIndices = true;
   // At least two voxels along x: a cell's two x corners are one 8-byte load.
   bool pairedRows = false;
+  // Optional: the CellBounds below.
+  const float* cellBounds = nullptr;
 
   LevelGrid() = default;
   explicit LevelGrid(const MomentLevel& level)
@@ -54,6 +57,47 @@ struct LevelGrid
     this->narrowIndices = this->stride[2] * level.dims[2] <= std::numeric_limits<std::int32_t>::max();
     this->pairedRows = level.dims[0] >= 2;
   }
+};
+
+/// The largest mean and variance (at least 0) of the corners of every cell of a level, as
+/// float pairs indexed like the level's voxels (cell = its lower corner). A trilinear sample
+/// blends its cell's corners, so it lies below both; the Chebyshev occlusion of a query
+/// above that mean is then at most var / (var + (q - mean)^2). The shadow march passes over
+/// a sample whose bound cannot raise its occlusion.
+class CellBounds
+{
+public:
+  /// Builds the bounds of `level` and points `grid` at them.
+  CellBounds(const MomentLevel& level, LevelGrid& grid)
+    : pairs(2 * level.mean.size())
+  {
+    const std::int64_t n = static_cast<std::int64_t>(level.mean.size());
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      this->pairs[2 * i] = level.mean[i];
+      this->pairs[2 * i + 1] = std::max(0.0f, level.variance[i]);
+    }
+    // Separable: each voxel takes the maximum of itself and its upper neighbour (where
+    // there is one) along x, then y, then z.
+    const std::int64_t nx = level.dims[0], ny = level.dims[1], nz = level.dims[2];
+    auto take = [this](std::int64_t i, std::int64_t j) {
+      this->pairs[2 * i] = std::max(this->pairs[2 * i], this->pairs[2 * j]);
+      this->pairs[2 * i + 1] = std::max(this->pairs[2 * i + 1], this->pairs[2 * j + 1]);
+    };
+    for (std::int64_t line = 0; line < ny * nz; ++line)
+      for (std::int64_t x = 0; x + 1 < nx; ++x)
+        take(line * nx + x, line * nx + x + 1);
+    for (std::int64_t z = 0; z < nz; ++z)
+      for (std::int64_t y = 0; y + 1 < ny; ++y)
+        for (std::int64_t x = 0; x < nx; ++x)
+          take((z * ny + y) * nx + x, (z * ny + y + 1) * nx + x);
+    for (std::int64_t i = 0; i < nx * ny * (nz - 1); ++i)
+      take(i, i + nx * ny);
+    grid.cellBounds = this->pairs.data();
+  }
+
+private:
+  std::vector<float> pairs;
 };
 
 /// Trilinear mean and variance (clamped at 0) of the level at world (x, y, z), clamped to

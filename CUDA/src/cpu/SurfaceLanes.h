@@ -4,7 +4,8 @@
 // few enough instructions for the processor to overlap the gathers' latency of several.
 // (GCC does not vectorise the plain loops: their float-to-int conversions and selects stay
 // branches.) Equal to the plain loops but for the rounding of the blends' fused
-// multiply-adds.
+// multiply-adds; the vector march also passes over the samples that their cell's bound
+// (CellBounds) shows cannot raise a lane's occlusion, which changes no maximum.
 #pragma once
 
 #include "EstimatorsAvx2.h"
@@ -69,16 +70,21 @@ VAO_AVX2_HELPER __m256d blendPairsAvx2(const float* c, __m128i base, const __m12
   return lerpAvx2(lerpAvx2(rows[0], rows[1], f[1]), lerpAvx2(rows[2], rows[3], f[1]), f[2]);
 }
 
-/// The Chebyshev occlusion of q at four world positions of one level (occlusionLanesPlain's
-/// formula): the corners by 32-bit gathers, the blends and both of the estimator's branches
-/// in vector arithmetic, one kept by a mask.
-VAO_AVX2_HELPER __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d* position, __m256d q)
+/// Four lanes' cells of one level: the lower corners per axis and as flat 32-bit indices,
+/// the steps to the upper corners (0 where clamped) and the fractions towards them.
+struct CellsAvx2
 {
-  const __m256d zero = _mm256_setzero_pd();
-  const __m256d one = _mm256_set1_pd(1.0);
-  __m128i base = _mm_setzero_si128();
+  __m128i lower[3];
+  __m128i base;
   __m128i step[3];
   __m256d f[3];
+};
+
+VAO_AVX2_HELPER CellsAvx2 cellsAvx2(const LevelGrid& g, const __m256d* position)
+{
+  const __m256d zero = _mm256_setzero_pd();
+  CellsAvx2 c;
+  c.base = _mm_setzero_si128();
   for (int a = 0; a < 3; ++a)
   {
     const __m256d maxIndex = _mm256_set1_pd(g.maxIndex[a]);
@@ -88,20 +94,54 @@ VAO_AVX2_HELPER __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d
     __m128i lower = _mm256_cvttpd_epi32(u);
     if (a == 0 && g.pairedRows) // the last voxel as the upper corner of the cell below it
       lower = _mm_min_epi32(lower, _mm_set1_epi32(static_cast<int>(g.maxIndex[0]) - 1));
-    f[a] = _mm256_sub_pd(u, _mm256_cvtepi32_pd(lower));
+    c.lower[a] = lower;
+    c.f[a] = _mm256_sub_pd(u, _mm256_cvtepi32_pd(lower));
     const __m128i stride = _mm_set1_epi32(static_cast<int>(g.stride[a]));
-    base = _mm_add_epi32(base, _mm_mullo_epi32(lower, stride));
+    c.base = _mm_add_epi32(c.base, _mm_mullo_epi32(lower, stride));
     // The 64-bit lane masks of u < maxIndex, narrowed to 32 bits.
     const __m256i below = _mm256_castpd_si256(_mm256_cmp_pd(u, maxIndex, _CMP_LT_OQ));
     const __m128i narrow =
       _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(below, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
-    step[a] = _mm_and_si128(narrow, stride);
+    c.step[a] = _mm_and_si128(narrow, stride);
   }
-  const __m256d mean = g.pairedRows ? blendPairsAvx2(g.mean, base, step, f) : blendAvx2(g.mean, base, step, f);
-  const __m256d variance = _mm256_max_pd(
-    g.pairedRows ? blendPairsAvx2(g.variance, base, step, f) : blendAvx2(g.variance, base, step, f), zero);
-  return _mm256_sub_pd(one, chebyshevOpennessAvx2(q, mean, variance, _mm256_set1_pd(g.roundingVariance),
-    _mm256_set1_pd(g.roundingSpread)));
+  return c;
+}
+
+/// The Chebyshev occlusion of q in four cells (occlusionLanesPlain's formula): the corners
+/// by 32-bit gathers, the blends and both of the estimator's branches in vector
+/// arithmetic, one kept by a mask.
+VAO_AVX2_HELPER __m256d chebyshevCellsAvx2(const LevelGrid& g, const CellsAvx2& c, __m256d q)
+{
+  const __m256d mean =
+    g.pairedRows ? blendPairsAvx2(g.mean, c.base, c.step, c.f) : blendAvx2(g.mean, c.base, c.step, c.f);
+  const __m256d variance = _mm256_max_pd(g.pairedRows ? blendPairsAvx2(g.variance, c.base, c.step, c.f)
+                                                      : blendAvx2(g.variance, c.base, c.step, c.f),
+    _mm256_setzero_pd());
+  return _mm256_sub_pd(_mm256_set1_pd(1.0), chebyshevOpennessAvx2(q, mean, variance,
+    _mm256_set1_pd(g.roundingVariance), _mm256_set1_pd(g.roundingSpread)));
+}
+
+/// The Chebyshev occlusion of q at four world positions of one level.
+VAO_AVX2_HELPER __m256d chebyshevOcclusionAvx2(const LevelGrid& g, const __m256d* position, __m256d q)
+{
+  return chebyshevCellsAvx2(g, cellsAvx2(g, position), q);
+}
+
+/// Upper bounds of the Chebyshev occlusion of q in four cells, from the level's
+/// CellBounds: 1 where q is not above the cell's largest mean or the bound is NaN.
+VAO_AVX2_HELPER __m256d chebyshevBoundAvx2(const LevelGrid& g, const CellsAvx2& c, __m256d q)
+{
+  const __m256d one = _mm256_set1_pd(1.0);
+  const __m256i pairs = _mm256_i32gather_epi64(reinterpret_cast<const long long*>(g.cellBounds), c.base, 8);
+  const __m256 grouped =
+    _mm256_permutevar8x32_ps(_mm256_castsi256_ps(pairs), _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7));
+  const __m256d mean = _mm256_cvtps_pd(_mm256_castps256_ps128(grouped));
+  const __m256d variance = _mm256_cvtps_pd(_mm256_extractf128_ps(grouped, 1));
+  const __m256d d = _mm256_sub_pd(q, mean);
+  const __m256d share = _mm256_div_pd(variance, _mm256_add_pd(variance, _mm256_mul_pd(d, d)));
+  const __m256d defined = _mm256_and_pd(_mm256_cmp_pd(d, _mm256_setzero_pd(), _CMP_GT_OQ),
+    _mm256_cmp_pd(share, share, _CMP_ORD_Q));
+  return _mm256_blendv_pd(one, share, defined);
 }
 
 /// occlusionLanesPlain for Chebyshev, four lanes per vector.
@@ -156,9 +196,20 @@ VAO_AVX2_INLINE void chebyshevMarchAvx2(const LevelGrid* grids, const double* ke
     if (!any)
       break;
     const int l = marchLevel(t, r0, levels);
+    const LevelGrid& grid = grids[l];
     for (int h = 0; h < kHalves; ++h)
     {
-      const __m256d sample = chebyshevOcclusionAvx2(grids[l], at[h], q[h]);
+      const CellsAvx2 cells = cellsAvx2(grid, at[h]);
+      if (grid.cellBounds)
+      {
+        // No lane still marching can rise above its occlusion here: the sample is passed
+        // over, as the maximum it would enter is already held.
+        const __m256d bound = chebyshevBoundAvx2(grid, cells, q[h]);
+        const __m256d mayRaise = _mm256_andnot_pd(_mm256_cmp_pd(bound, occ[h], _CMP_LE_OQ), alive[h]);
+        if (_mm256_testz_pd(mayRaise, mayRaise))
+          continue;
+      }
+      const __m256d sample = chebyshevCellsAvx2(grid, cells, q[h]);
       occ[h] = _mm256_blendv_pd(occ[h], _mm256_max_pd(sample, occ[h]), alive[h]);
       alive[h] = _mm256_and_pd(alive[h], _mm256_cmp_pd(occ[h], full, _CMP_LT_OQ));
     }

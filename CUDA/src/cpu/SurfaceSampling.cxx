@@ -176,10 +176,28 @@ struct PreparedPyramid
     for (int l = 0; l < levels; ++l)
     {
       this->grids.emplace_back(pyramid[l]);
+      this->levels.push_back(&pyramid[l]);
       this->kernelRadius.push_back(pyramid[l].kernelRadius);
       this->vectorMarch = this->vectorMarch && this->grids.back().narrowIndices;
     }
   }
+
+  /// Cell bounds for the vector march on the levels small beside the work of marching
+  /// `count` points (building them reads the level once): the coarse levels, where most
+  /// of a march's steps fall.
+  void boundCells(std::int64_t count)
+  {
+    this->bounds.reserve(this->grids.size());
+    for (std::size_t l = 0; l < this->grids.size() && this->vectorMarch; ++l)
+    {
+      if (this->levels[l]->mean.size() <= static_cast<std::size_t>(8 * count))
+        this->bounds.emplace_back(*this->levels[l], this->grids[l]);
+    }
+  }
+
+private:
+  std::vector<const MomentLevel*> levels;
+  std::vector<detail::CellBounds> bounds;
 };
 
 /// The box the shadow march stays in: level 0's bounds, or the whole volume's when the
@@ -450,7 +468,8 @@ Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* poin
     lightDirection[2] / lightLength };
   const MomentLevel& base = pyramid[0];
   const double h = std::min(base.spacing[0], std::min(base.spacing[1], base.spacing[2]));
-  const PreparedPyramid prepared(pyramid, levels);
+  PreparedPyramid prepared(pyramid, levels);
+  prepared.boundCells(count);
   const MarchBounds bounds(base);
   const bool finished = forEachBatch(points, normals, count, execution, [&](PointLanes& lanes) {
     for (int k = 0; k < detail::kLanes; ++k)
