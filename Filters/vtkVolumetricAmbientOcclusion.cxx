@@ -405,11 +405,9 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
 {
   const vao::Execution execution = vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads);
   vao::Status status;
-  // The device runs the separable methods and Histogram CDF, with the voxel's value or an
-  // iso value as the query.
-  bool onDevice = this->ChooseCuda(
-    (vao::isSeparableMethod(parameters.method) || parameters.method == vao::Method::HistogramCdf) &&
-      parameters.queryMode != vao::QueryMode::SmoothedValue,
+  // The device runs every method, with the voxel's value or an iso value as the query.
+  bool onDevice = this->ChooseCuda(parameters.queryMode != vao::QueryMode::SmoothedValue,
+    !vao::isSeparableMethod(parameters.method) && parameters.method != vao::Method::HistogramCdf,
     region.voxelCount());
   if (onDevice)
   {
@@ -431,7 +429,7 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumetricAmbientOcclusion::ChooseCuda(bool separableMethod, long long voxels)
+bool vtkVolumetricAmbientOcclusion::ChooseCuda(bool onDeviceQuery, bool exactMethod, long long voxels)
 {
   if (this->Backend == BACKEND_CPU)
   {
@@ -440,12 +438,13 @@ bool vtkVolumetricAmbientOcclusion::ChooseCuda(bool separableMethod, long long v
   const vao::cuda::DeviceStatus device = vao::cuda::deviceStatus();
   if (this->Backend == BACKEND_AUTO)
   {
-    // Below about a million voxels the CPU finishes before the transfers would.
-    return device.available && separableMethod && voxels >= AutoCudaMinimumVoxels;
+    // Below about a million voxels the CPU finishes before the transfers would, except
+    // for the exact references, whose O(R^3) counts pay for them at any size.
+    return device.available && onDeviceQuery && (exactMethod || voxels >= AutoCudaMinimumVoxels);
   }
-  if (!separableMethod)
+  if (!onDeviceQuery)
   {
-    vtkWarningMacro(<< "Exact Box, Exact Sphere and the smoothed query run on the CPU only; computing on the CPU.");
+    vtkWarningMacro(<< "The smoothed query runs on the CPU only; computing on the CPU.");
     return false;
   }
   if (!device.available)

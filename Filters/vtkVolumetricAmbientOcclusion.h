@@ -179,12 +179,12 @@ public:
   ///@}
 
   ///@{
-  /// Compute backend: AUTO (default: CUDA for the separable methods and Histogram CDF,
-  /// with the voxel value or an iso value as the query, when a device is present and the
-  /// extent has at least AutoCudaMinimumVoxels voxels, else the CPU), CPU, or CUDA.
-  /// Without a CUDA build or device, for the exact methods or the smoothed query, or when the
-  /// device fails (e.g. out of memory), the CPU runs, with a warning when CUDA was asked
-  /// for. The backend that ran ("CPU" or "CUDA") is reported by GetLastBackend() and in
+  /// Compute backend: AUTO (default: CUDA for every method with the voxel value or an iso
+  /// value as the query, when a device is present and the extent has at least
+  /// AutoCudaMinimumVoxels voxels, or whatever its size for Exact Box and Exact Sphere;
+  /// else the CPU), CPU, or CUDA. Without a CUDA build or device, for the smoothed query,
+  /// or when the device fails (e.g. out of memory), the CPU runs, with a warning when CUDA
+  /// was asked for. The backend that ran ("CPU" or "CUDA") is reported by GetLastBackend() and in
   /// the output's field data string "AmbientOcclusionBackend".
   vtkSetMacro(Backend, int);
   vtkGetMacro(Backend, int);
@@ -254,7 +254,9 @@ private:
   /// The radius in voxels for the input's spacing; false when it is 0 on every axis or
   /// covers the whole extent on every axis.
   bool CheckVoxelRadius(vtkImageData* input, const int whole[6], int radius[3]);
-  bool ChooseCuda(bool separableMethod, long long voxels);
+  /// Whether to run on the device: the query is one it computes, the method is an exact
+  /// reference (worth the transfers at any size), the extent's voxels.
+  bool ChooseCuda(bool onDeviceQuery, bool exactMethod, long long voxels);
   /// Runs the kernel on the chosen backend; a device failure falls back to the CPU.
   vao::Status Compute(const vao::VolumeView& volume, const vao::Region& region,
     const vao::AmbientOcclusionParameters& parameters, const vao::AmbientOcclusionOutput& arrays);

@@ -5,6 +5,8 @@
 #include "TestVolumes.h"
 
 #include "../src/VolumeAccess.h"
+#include "../src/cpu/ExactReference.h"
+#include "../src/cuda/ExactPipeline.h"
 #include "../src/cuda/HistogramPipeline.h"
 #include "../src/cuda/Pipeline.h"
 
@@ -66,6 +68,7 @@ public:
           out[(z * nx + x) * ny + y] = in[(z * ny + y) * nx + x];
   }
 
+  void synchronize() {}
   void progress(double) {}
 };
 
@@ -235,7 +238,53 @@ void expectHistogramLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims,
     ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " bins " << bins;
 }
 
+/// Exact Box or Exact Sphere through the device's passes equals the CPU reference voxel
+/// for voxel; `visitsPerLaunch` small splits the region into slabs of one or a few slices.
+template <class T>
+void expectExactLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, const vao::Region& region,
+  const vao::Radius& radius, vao::Method method, bool iso, double isoValue, double visitsPerLaunch)
+{
+  const auto view = viewOf(v, dims);
+  vao::AmbientOcclusionParameters p;
+  p.method = method;
+  p.radius = radius;
+  p.queryMode = iso ? vao::QueryMode::IsoValue : vao::QueryMode::VoxelValue;
+  p.isoValue = isoValue;
+  std::vector<float> cpu(region.voxelCount());
+  ASSERT_TRUE(vao::computeAmbientOcclusion(view, region, p, { cpu.data(), nullptr }).ok);
+  const auto g = vao::gpu::geometryFor(dims, region, radius);
+  const std::vector<T> block = blockOf(v, dims, region, g);
+  const auto rows = vao::detail::neighbourhoodRowHalfWidths(radius, method == vao::Method::ExactSphere);
+  const std::vector<Index> widths(rows.begin(), rows.end());
+  Index neighbourhood = 0;
+  for (const Index w : widths)
+    neighbourhood += w >= 0 ? 2 * w + 1 : 0;
+  std::vector<float> gpu(region.voxelCount(), -1.0f);
+  HostExecutor ex;
+  vao::gpu::runExactPasses<T>(ex, block.data(), g, widths.data(), neighbourhood, iso, isoValue, gpu.data(), 0.0,
+    1.0, visitsPerLaunch);
+  for (size_t i = 0; i < cpu.size(); ++i)
+    ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " method " << static_cast<int>(method);
+}
+
 } // namespace
+
+TEST(GpuPipelineOnHost, ExactBoxAndSphereEqualTheCpu)
+{
+  const vao::Index3 dims = { 17, 12, 10 };
+  const auto i16 = randomVolume<std::int16_t>(dims, -20, 20, 311); // many ties with the query
+  const auto u8 = randomVolume<std::uint8_t>(dims, 0, 256, 312);
+  const auto f32 = randomVolume<float>(dims, -1, 1, 313);
+  const vao::Region whole{ { 0, 0, 0 }, dims }, inner{ { 3, 2, 4 }, { 11, 8, 5 } };
+  for (vao::Method method : { vao::Method::ExactBox, vao::Method::ExactSphere })
+  {
+    expectExactLikeTheCpu(i16, dims, whole, { 2, 2, 2 }, method, false, 0.0, 1 << 30);
+    expectExactLikeTheCpu(i16, dims, inner, { 3, 1, 4 }, method, true, 0.0, 500.0);
+    expectExactLikeTheCpu(u8, dims, inner, { 0, 3, 2 }, method, false, 0.0, 1.0);
+    expectExactLikeTheCpu(f32, dims, whole, { 4, 0, 0 }, method, true, 0.1, 2000.0);
+    expectExactLikeTheCpu(f32, dims, inner, { 20, 20, 20 }, method, false, 0.0, 1 << 30);
+  }
+}
 
 TEST(GpuPipelineOnHost, HistogramCdfEqualsTheCpu)
 {

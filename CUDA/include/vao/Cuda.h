@@ -52,8 +52,8 @@ struct Timing
 /// function may still succeed; bad input fails here as it would there.
 /// Execution: progress and cancellation between stages (a running kernel is not
 /// interrupted); the thread count does not apply.
-/// Method must be CdfReconstruction, GaussianCdf or Chebyshev: the exact references run
-/// on the CPU only.
+/// Every method runs here (the exact references by brute force, one thread per voxel);
+/// the smoothed query runs on the CPU only.
 Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
   const Execution& execution = {}, Timing* timing = nullptr);

@@ -14,9 +14,7 @@ namespace
 {
 
 /// Half-width along x of the neighbourhood's row at offset (dy, dz), or -1 when the row is
-/// outside it. The box takes every row whole; the ellipsoid keeps the voxels with
-/// sum_i (d_i / R_i)^2 <= 1 (an axis with R_i = 0 admits d_i = 0 only), tested in integers
-/// so that voxels exactly on the surface are in.
+/// outside it, tested in integers so that voxels exactly on the surface are in.
 std::int64_t rowHalfWidth(const Radius& r, std::int64_t dy, std::int64_t dz, bool sphere)
 {
   if (!sphere)
@@ -99,11 +97,8 @@ void exactSlice(const TypedVolume<T>& volume, const Region& region,
 
 } // namespace
 
-Status computeExactOpenness(const VolumeView& view, const Region& region,
-  const AmbientOcclusionParameters& p, const double* query, float* openness, const Execution& execution)
+std::vector<std::int64_t> neighbourhoodRowHalfWidths(const Radius& r, bool sphere)
 {
-  const bool sphere = p.method == Method::ExactSphere;
-  const Radius& r = p.radius;
   std::vector<std::int64_t> halfWidths;
   for (std::int64_t dz = -r.z; dz <= r.z; ++dz)
   {
@@ -112,6 +107,13 @@ Status computeExactOpenness(const VolumeView& view, const Region& region,
       halfWidths.push_back(rowHalfWidth(r, dy, dz, sphere));
     }
   }
+  return halfWidths;
+}
+
+Status computeExactOpenness(const VolumeView& view, const Region& region,
+  const AmbientOcclusionParameters& p, const double* query, float* openness, const Execution& execution)
+{
+  const std::vector<std::int64_t> halfWidths = neighbourhoodRowHalfWidths(p.radius, p.method == Method::ExactSphere);
   const bool finished = dispatchScalarType(view.type, [&](auto tag) {
     using T = decltype(tag);
     const TypedVolume<T> volume(view);

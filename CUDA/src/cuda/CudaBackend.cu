@@ -7,7 +7,9 @@
 
 #include "VolumeAccess.h"
 #include "CudaExecutor.h"
+#include "ExactPipeline.h"
 #include "HistogramPipeline.h"
+#include "cpu/ExactReference.h"
 #include "Pipeline.h"
 
 #include <cuda_runtime.h>
@@ -60,12 +62,14 @@ struct HostOutputs
   float* openness = nullptr;
   float* variance = nullptr;
   BoxStatisticsOutput statistics;
-  const AmbientOcclusionParameters* histogram = nullptr; // Histogram CDF's openness instead
+  // Histogram CDF's or an exact reference's openness instead (counts, not moments).
+  const AmbientOcclusionParameters* counting = nullptr;
 };
 
-/// Histogram CDF's openness (HistogramPipeline.h) into host.openness.
+/// The openness of Histogram CDF (HistogramPipeline.h) or of an exact reference
+/// (ExactPipeline.h) into hostOpenness.
 template <class T>
-void runHistogram(const VolumeView& view, const Region& region, const AmbientOcclusionParameters& p,
+void runCounting(const VolumeView& view, const Region& region, const AmbientOcclusionParameters& p,
   float* hostOpenness, const Execution& execution, Timing* timing)
 {
   const detail::TypedVolume<T> volume(view);
@@ -75,8 +79,23 @@ void runHistogram(const VolumeView& view, const Region& region, const AmbientOcc
   upload(volume, region, g, input.get());
   ex.progress(0.1);
   DeviceBuffer<float> openness(g.region());
-  gpu::runHistogramPasses<T>(ex, input.get(), g, p.thresholds.data(), static_cast<int>(p.thresholds.size()),
-    p.queryMode == QueryMode::IsoValue, p.isoValue, openness.get());
+  const bool iso = p.queryMode == QueryMode::IsoValue;
+  if (p.method == Method::HistogramCdf)
+  {
+    gpu::runHistogramPasses<T>(ex, input.get(), g, p.thresholds.data(), static_cast<int>(p.thresholds.size()),
+      iso, p.isoValue, openness.get());
+  }
+  else
+  {
+    const std::vector<std::int64_t> rows = detail::neighbourhoodRowHalfWidths(p.radius, p.method == Method::ExactSphere);
+    const std::vector<Index> widths(rows.begin(), rows.end());
+    Index neighbourhood = 0;
+    for (const Index w : widths)
+      neighbourhood += w >= 0 ? 2 * w + 1 : 0;
+    const DeviceBuffer<Index> deviceWidths = ex.upload(widths.data(), static_cast<Index>(widths.size()));
+    gpu::runExactPasses<T>(ex, input.get(), g, deviceWidths.get(), neighbourhood, iso, p.isoValue, openness.get(),
+      0.1, 0.95);
+  }
   if (timing)
   {
     ex.finish();
@@ -133,7 +152,7 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
 {
   ValueScan scan;
   Status status;
-  if (host.histogram)
+  if (host.counting)
   {
     // Counts, not moments: no magnitude limit, only finite values.
     status = validate(view, region, radius);
@@ -161,8 +180,8 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   try
   {
     detail::dispatchScalarType(view.type, [&](auto tag) {
-      if (host.histogram)
-        runHistogram<decltype(tag)>(view, region, *host.histogram, host.openness, execution, timing);
+      if (host.counting)
+        runCounting<decltype(tag)>(view, region, *host.counting, host.openness, execution, timing);
       else
         run<decltype(tag)>(view, region, radius, withExtrema, estimator, scan, host, execution, timing);
     });
@@ -230,22 +249,21 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& p, const AmbientOcclusionOutput& output,
   const Execution& execution, Timing* timing)
 {
-  if (!isSeparableMethod(p.method) && p.method != Method::HistogramCdf)
-  {
-    return Status::device("the exact references (Exact Box, Exact Sphere) run on the CPU only");
-  }
   if (p.queryMode == QueryMode::SmoothedValue)
   {
     return Status::device("the smoothed query runs on the CPU only");
   }
-  if (p.method == Method::HistogramCdf)
+  if (!isSeparableMethod(p.method))
   {
-    Status status = checkHistogramThresholds(p.thresholds);
+    Status status = p.method == Method::HistogramCdf ? checkHistogramThresholds(p.thresholds) : Status::success();
+    if (status.ok && p.method != Method::HistogramCdf && p.method != Method::ExactBox &&
+      p.method != Method::ExactSphere)
+      status = Status::failure("unknown method");
     if (status.ok && p.queryMode == QueryMode::IsoValue)
       status = checkFiniteParameter(p.isoValue, "the iso value");
     HostOutputs host;
     host.openness = output.openness;
-    host.histogram = &p;
+    host.counting = &p;
     const gpu::EstimatorSetting none{ Method::GaussianCdf, QueryMode::VoxelValue, 0.0, ErfMode::Exact };
     if (status.ok && output.openness)
       status = runChecked(volume, region, p.radius, false, none, host, execution, timing);

@@ -160,6 +160,9 @@ public:
     this->end(name, 2.0 * nx * ny * nz * sizeof(U));
   }
 
+  /// Waits for the launched kernels.
+  void synchronize() { check(cudaDeviceSynchronize(), "passes"); }
+
   /// Between stages only: a running kernel is not interrupted.
   void progress(double fraction)
   {
