@@ -168,6 +168,9 @@ bool vtkVolumetricAmbientOcclusion::CheckParameters()
     why << "Unknown ErfApproximation " << this->ErfApproximation << " (0 Exact, 1 Winitzki).";
   else if (this->Backend < BACKEND_AUTO || this->Backend > BACKEND_CUDA)
     why << "Unknown Backend " << this->Backend << " (0 Auto, 1 CPU, 2 CUDA).";
+  else if (this->Device < -1)
+    why << "Device must be -1 (each MPI rank takes its node-local rank modulo the devices) or a device index, got "
+        << this->Device << ".";
   else if (this->NumberOfThreads < 0)
     why << vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
   else if (this->OutputArrayName.empty())
@@ -300,6 +303,7 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     vtkImageData* output = vtkImageData::GetData(outputVector);
     output->Initialize();
     this->LastBackend.clear();
+    this->LastDevice.clear();
     if (!this->CheckParameters()) // the same on every process
     {
       return 1;
@@ -389,6 +393,10 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     backend->SetName("AmbientOcclusionBackend");
     backend->InsertNextValue(this->LastBackend);
     output->GetFieldData()->AddArray(backend);
+    vtkNew<vtkStringArray> device;
+    device->SetName("AmbientOcclusionDevice");
+    device->InsertNextValue(this->LastDevice);
+    output->GetFieldData()->AddArray(device);
     // The CPU threads this process used (or would have used, on the GPU backend): under
     // MPI the cores are shared among the node's ranks.
     vtkNew<vtkIntArray> threads;
@@ -403,7 +411,8 @@ int vtkVolumetricAmbientOcclusion::RequestData(
 vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume, const vao::Region& region,
   const vao::AmbientOcclusionParameters& parameters, const vao::AmbientOcclusionOutput& arrays)
 {
-  const vao::Execution execution = vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads);
+  vao::Execution execution = vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads);
+  execution.device = this->Device;
   vao::Status status;
   // The device runs every method, with the voxel's value or an iso value as the query.
   bool onDevice = this->ChooseCuda(parameters.queryMode != vao::QueryMode::SmoothedValue,
@@ -425,6 +434,7 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
     status = vao::computeAmbientOcclusion(volume, region, parameters, arrays, execution);
   }
   this->LastBackend = onDevice ? "CUDA" : "CPU";
+  this->LastDevice = onDevice ? "CUDA " + vao::cuda::deviceStatus(this->Device).description : "CPU";
   return status;
 }
 
@@ -435,7 +445,7 @@ bool vtkVolumetricAmbientOcclusion::ChooseCuda(bool onDeviceQuery, bool exactMet
   {
     return false;
   }
-  const vao::cuda::DeviceStatus device = vao::cuda::deviceStatus();
+  const vao::cuda::DeviceStatus device = vao::cuda::deviceStatus(this->Device);
   if (this->Backend == BACKEND_AUTO)
   {
     // Below about a million voxels the CPU finishes before the transfers would, except
@@ -472,6 +482,7 @@ void vtkVolumetricAmbientOcclusion::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ComputeVariance: " << this->ComputeVariance << "\n";
   os << indent << "Component: " << this->Component << "\n";
   os << indent << "Backend: " << this->Backend << " (last run: " << this->LastBackend << ")\n";
+  os << indent << "Device: " << this->Device << " (last run: " << this->LastDevice << ")\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
   os << indent << "OutputArrayName: " << this->OutputArrayName << "\n";
 }

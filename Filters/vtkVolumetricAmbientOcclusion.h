@@ -193,6 +193,16 @@ public:
   ///@}
 
   ///@{
+  /// The CUDA device among the visible ones (CUDA_VISIBLE_DEVICES applies first). Default
+  /// -1: the process's rank on its node (from the MPI launcher) modulo the devices, so
+  /// that the ranks of a multi-GPU node share them out. The device that ran is in the
+  /// output's field data string "AmbientOcclusionDevice" ("CPU" when the CPU ran).
+  vtkSetMacro(Device, int);
+  vtkGetMacro(Device, int);
+  const char* GetLastDevice() const { return this->LastDevice.c_str(); }
+  ///@}
+
+  ///@{
   /// Threads of the CPU backend on this process; 0 (default): the cores available to the
   /// process, divided among the MPI ranks on its node. Negative values are an error.
   vtkSetMacro(NumberOfThreads, int);
@@ -229,9 +239,11 @@ protected:
   vtkTypeBool ComputeVariance = false;
   int Component = -1;
   int Backend = BACKEND_AUTO;
+  int Device = -1;
   int NumberOfThreads = 0;
   std::string OutputArrayName = "AmbientOcclusion";
   std::string LastBackend;
+  std::string LastDevice;
 
 private:
   vtkVolumetricAmbientOcclusion(const vtkVolumetricAmbientOcclusion&) = delete;

@@ -6,6 +6,8 @@
 // reason, where there is none; CudaBackend.ReportsItsStateWithoutCrashing runs everywhere.
 #include "CudaTestSupport.h"
 
+#include "../src/cpu/Parallel.h"
+
 #include "vao/HistogramCdf.h"
 
 using namespace vaotest;
@@ -55,6 +57,58 @@ TEST(CudaBackend, ReportsItsStateWithoutCrashing)
     std::cout << "[          ] built() = " << vao::cuda::built() << ", no device: " << device.description
               << "\n[          ] computeBoxStatistics says: " << statsStatus.message << std::endl;
   }
+}
+
+TEST(CudaBackend, EachRankTakesItsNodeLocalRankModuloTheDevices)
+{
+  using vao::cuda::chooseDevice;
+  EXPECT_EQ(chooseDevice(-1, 4, 0), 0);
+  EXPECT_EQ(chooseDevice(-1, 4, 3), 3);
+  EXPECT_EQ(chooseDevice(-1, 4, 6), 2);  // ranks 2 and 6 of a node with 4 devices share one
+  EXPECT_EQ(chooseDevice(-1, 1, 5), 0);
+  EXPECT_EQ(chooseDevice(-1, 3, -7), 0); // no sensible rank: the first device
+  EXPECT_EQ(chooseDevice(2, 4, 3), 2);   // an explicit device wins over the rank
+  EXPECT_EQ(chooseDevice(4, 4, 0), -1);  // not visible
+  EXPECT_EQ(chooseDevice(-1, 0, 0), -1); // no device at all
+  EXPECT_EQ(chooseDevice(0, 0, 0), -1);
+
+  // The launchers' node-local rank, first of the variables that holds one.
+  const char* names[] = { "OMPI_COMM_WORLD_LOCAL_RANK", "MPI_LOCALRANKID", "MV2_COMM_WORLD_LOCAL_RANK", "SLURM_LOCALID" };
+  std::vector<std::pair<std::string, std::string>> saved;
+  for (const char* name : names)
+  {
+    if (const char* value = std::getenv(name))
+      saved.emplace_back(name, value);
+    unsetenv(name);
+  }
+  EXPECT_EQ(vao::detail::nodeLocalRank(), 0) << "outside MPI";
+  setenv("SLURM_LOCALID", "5", 1);
+  EXPECT_EQ(vao::detail::nodeLocalRank(), 5);
+  setenv("MPI_LOCALRANKID", "3", 1);
+  EXPECT_EQ(vao::detail::nodeLocalRank(), 3) << "MPICH's variable comes before Slurm's";
+  setenv("OMPI_COMM_WORLD_LOCAL_RANK", "not a number", 1);
+  EXPECT_EQ(vao::detail::nodeLocalRank(), 3) << "a value that is no number is skipped";
+  setenv("OMPI_COMM_WORLD_LOCAL_RANK", "1", 1);
+  EXPECT_EQ(vao::detail::nodeLocalRank(), 1);
+  for (const char* name : names)
+    unsetenv(name);
+  for (const auto& [name, value] : saved)
+    setenv(name.c_str(), value.c_str(), 1);
+
+  // An index past the visible devices is refused with a reason, in every build.
+  const vao::cuda::DeviceStatus far = vao::cuda::deviceStatus(1 << 20);
+  EXPECT_FALSE(far.available);
+  EXPECT_EQ(far.index, -1);
+  EXPECT_FALSE(far.description.empty());
+  vao::Execution execution;
+  execution.device = 1 << 20;
+  const vao::Index3 dims = { 6, 5, 4 };
+  const auto v = randomVolume<float>(dims, 0, 1, 3);
+  std::vector<float> open(static_cast<size_t>(dims[0] * dims[1] * dims[2]));
+  const vao::Status status = vao::cuda::computeAmbientOcclusion(
+    viewOf(v, dims), vao::Region::whole(viewOf(v, dims)), {}, { open.data(), nullptr }, execution);
+  EXPECT_FALSE(status.ok);
+  EXPECT_TRUE(status.deviceFailure) << "a device that is not there is a device failure: the CPU may run";
 }
 
 // ---------------------------------------------------------------------------------------

@@ -106,6 +106,9 @@ TEST(VolumetricAmbientOcclusion, MatchesBruteForceWithWorldRadiusOnAnOffsetExten
     auto* backend = vtkStringArray::SafeDownCast(run.output->GetFieldData()->GetAbstractArray("AmbientOcclusionBackend"));
     ASSERT_NE(backend, nullptr);
     EXPECT_EQ(backend->GetValue(0), "CPU");
+    auto* device = vtkStringArray::SafeDownCast(run.output->GetFieldData()->GetAbstractArray("AmbientOcclusionDevice"));
+    ASSERT_NE(device, nullptr);
+    EXPECT_EQ(device->GetValue(0), "CPU");
   }
 }
 
@@ -315,6 +318,7 @@ TEST(VolumetricAmbientOcclusion, RejectsBadInputWithAClearError)
   }, "IsoValue");
   ExpectRejected(RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) { f->SetMethod(9); }, "Unknown Method");
   ExpectRejected(RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) { f->SetNumberOfThreads(-1); }, "NumberOfThreads");
+  ExpectRejected(RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) { f->SetDevice(-2); }, "Device must be -1");
   ExpectRejected(RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) { f->SetOutputArrayName(""); }, "OutputArrayName");
 }
 

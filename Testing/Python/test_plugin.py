@@ -51,8 +51,8 @@ check(ao.NumberOfBins == 64 and ao.QuerySmoothing == 1.0, "NumberOfBins defaults
 check(ao.Radius == 10, "Radius defaults to 10")
 check(ao.OutputArrayName == "AmbientOcclusion", "OutputArrayName defaults to AmbientOcclusion")
 for name in ["Scalars", "Method", "NumberOfBins", "Radius", "RadiusUnits", "QueryMode", "IsoValue",
-             "QuerySmoothing", "ErfApproximation", "ComputeVariance", "Backend", "OutputArrayName", "Component",
-             "NumberOfThreads"]:
+             "QuerySmoothing", "ErfApproximation", "ComputeVariance", "Backend", "Device", "OutputArrayName",
+             "Component", "NumberOfThreads"]:
     prop = ao.GetProperty(name)
     check(prop is not None, "property %s exists" % name)
     doc = prop.SMProperty.GetDocumentation()

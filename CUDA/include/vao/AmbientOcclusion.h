@@ -103,6 +103,7 @@ int querySmoothingHalfWidth(double sigma);
 struct Execution
 {
   int threads = 0; // 0: every hardware thread
+  int device = -1;  // CUDA device (vao/Cuda.h, deviceStatus); -1: chosen by the node-local rank
   std::function<void(double)> progress;
   std::function<bool()> abortRequested;
 };

@@ -24,11 +24,19 @@ bool built();
 struct DeviceStatus
 {
   bool available = false;
-  std::string description; // the device's name and memory, or why there is none
+  int index = -1;          // among the visible devices
+  std::string description; // which device, its name and memory; or why there is none
 };
 
-/// Whether a usable device is present (queried once, then cached).
-DeviceStatus deviceStatus();
+/// The device a call runs on among the `count` visible ones (CUDA_VISIBLE_DEVICES applies
+/// first): `requested` when it is >= 0, else the process's rank on its node modulo
+/// `count`, so that the ranks of a multi-GPU node spread over its devices. -1 when there
+/// is no device or `requested` is not below `count`.
+int chooseDevice(int requested, int count, int nodeLocalRank);
+
+/// The device that Execution::device = `requested` selects (chooseDevice with the
+/// launcher's node-local rank), and whether it is usable. The devices are queried once.
+DeviceStatus deviceStatus(int requested = -1);
 
 /// Time of one device pass, with the bytes it reads and writes, for bandwidth reports.
 struct PassTiming
@@ -50,8 +58,8 @@ struct Timing
 /// Openness (and optionally the variance) of every voxel of the region, on the GPU. A
 /// failure of the device (none, a CUDA error) has Status::deviceFailure set: the CPU
 /// function may still succeed; bad input fails here as it would there.
-/// Execution: progress and cancellation between stages (a running kernel is not
-/// interrupted); the thread count does not apply.
+/// Execution: the device (Execution::device, see deviceStatus), progress and cancellation
+/// between stages (a running kernel is not interrupted); the thread count does not apply.
 /// Every method runs here (the exact references by brute force, one thread per voxel);
 /// the smoothed query runs on the CPU only.
 Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,

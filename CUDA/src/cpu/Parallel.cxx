@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <condition_variable>
 #include <cstdlib>
+#include <initializer_list>
 #include <exception>
 #include <mutex>
 #include <system_error>
@@ -57,21 +58,29 @@ int availableCores(bool& restricted)
   return static_cast<int>(hardware);
 }
 
-/// Ranks of this job on this node, as the MPI launchers announce it (1 without one).
-int ranksOnNode()
+/// The first of the launcher's variables `names` that holds a number >= `least`, capped at
+/// 2^20, or `fallback`.
+int launcherNumber(std::initializer_list<const char*> names, int least, int fallback)
 {
-  for (const char* name : { "OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS", "MV2_COMM_WORLD_LOCAL_SIZE" })
+  for (const char* name : names)
   {
     if (const char* value = std::getenv(name))
     {
-      const long ranks = std::strtol(value, nullptr, 10);
-      if (ranks > 0)
+      char* end = nullptr;
+      const long number = std::strtol(value, &end, 10);
+      if (end != value && number >= least)
       {
-        return static_cast<int>(std::min<long>(ranks, 1 << 20));
+        return static_cast<int>(std::min<long>(number, 1 << 20));
       }
     }
   }
-  return 1;
+  return fallback;
+}
+
+/// Ranks of this job on this node, as the MPI launchers announce it (1 without one).
+int ranksOnNode()
+{
+  return launcherNumber({ "OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS", "MV2_COMM_WORLD_LOCAL_SIZE" }, 1, 1);
 }
 
 /// Persistent workers that run one team job at a time (see Parallel.h).
@@ -208,6 +217,12 @@ private:
 };
 
 } // namespace
+
+int nodeLocalRank()
+{
+  return launcherNumber(
+    { "OMPI_COMM_WORLD_LOCAL_RANK", "MPI_LOCALRANKID", "MV2_COMM_WORLD_LOCAL_RANK", "SLURM_LOCALID" }, 0, 0);
+}
 
 int resolveThreadCount(int requested)
 {

@@ -28,6 +28,11 @@ namespace vao
 namespace detail
 {
 
+/// This process's rank among the job's ranks on its node, as the MPI launchers announce it
+/// (OMPI_COMM_WORLD_LOCAL_RANK, MPI_LOCALRANKID, MV2_COMM_WORLD_LOCAL_RANK, SLURM_LOCALID),
+/// 0 without one.
+int nodeLocalRank();
+
 /// Threads a computation uses when the caller asks for `requested` (0: the default).
 /// The default is the cores this process may run on; when the process may run on every
 /// core of the node and a launcher says several ranks share the node

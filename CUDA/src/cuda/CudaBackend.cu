@@ -10,6 +10,7 @@
 #include "ExactPipeline.h"
 #include "HistogramPipeline.h"
 #include "cpu/ExactReference.h"
+#include "cpu/Parallel.h"
 #include "Pipeline.h"
 
 #include <cuda_runtime.h>
@@ -167,7 +168,7 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   {
     return status;
   }
-  const DeviceStatus device = deviceStatus();
+  const DeviceStatus device = deviceStatus(execution.device);
   if (!device.available)
   {
     return Status::device("no CUDA device: " + device.description);
@@ -179,6 +180,7 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   }
   try
   {
+    check(cudaSetDevice(device.index), "device selection");
     detail::dispatchScalarType(view.type, [&](auto tag) {
       if (host.counting)
         runCounting<decltype(tag)>(view, region, *host.counting, host.openness, execution, timing);
@@ -216,32 +218,50 @@ bool built()
   return true;
 }
 
-DeviceStatus deviceStatus()
+DeviceStatus deviceStatus(int requested)
 {
+  // The visible devices, queried once: how many, and each one's description.
   static std::once_flag once;
-  static DeviceStatus status;
+  static std::vector<std::string> devices;
+  static std::string none;
   std::call_once(once, [] {
     int count = 0;
     const cudaError_t error = cudaGetDeviceCount(&count);
     if (error != cudaSuccess || count == 0)
     {
-      status.description = std::string("no usable CUDA device (") +
-        (error != cudaSuccess ? cudaGetErrorString(error) : "none found") + ")";
+      none = std::string("no usable CUDA device (") + (error != cudaSuccess ? cudaGetErrorString(error) : "none found") + ")";
       cudaGetLastError();
       return;
     }
-    cudaDeviceProp properties;
-    if (cudaGetDeviceProperties(&properties, 0) != cudaSuccess)
+    for (int i = 0; i < count; ++i)
     {
-      status.description = "cannot query CUDA device 0";
-      return;
+      cudaDeviceProp properties;
+      std::ostringstream text;
+      if (cudaGetDeviceProperties(&properties, i) == cudaSuccess)
+        text << properties.name << " (" << properties.totalGlobalMem / (1024 * 1024) << " MiB, sm_" << properties.major
+             << properties.minor << ")";
+      else
+        text << "(cannot be queried)";
+      devices.push_back(text.str());
     }
-    std::ostringstream text;
-    text << properties.name << " (" << properties.totalGlobalMem / (1024 * 1024) << " MiB, sm_"
-         << properties.major << properties.minor << ")";
-    status.available = true;
-    status.description = text.str();
   });
+  DeviceStatus status;
+  const int count = static_cast<int>(devices.size());
+  status.index = chooseDevice(requested, count, detail::nodeLocalRank());
+  if (status.index < 0)
+  {
+    std::ostringstream why;
+    if (count == 0)
+      why << none;
+    else
+      why << "CUDA device " << requested << " requested, but " << count << " visible (CUDA_VISIBLE_DEVICES counts)";
+    status.description = why.str();
+    return status;
+  }
+  std::ostringstream text;
+  text << "device " << status.index << " of " << count << ": " << devices[static_cast<std::size_t>(status.index)];
+  status.available = true;
+  status.description = text.str();
   return status;
 }
 
@@ -300,12 +320,14 @@ Status computeBoxStatistics(const VolumeView& volume, const Region& region, cons
 
 double measureCopyBandwidth(double bytes)
 {
-  if (!deviceStatus().available || bytes <= 0)
+  const DeviceStatus device = deviceStatus();
+  if (!device.available || bytes <= 0)
   {
     return 0.0;
   }
   try
   {
+    check(cudaSetDevice(device.index), "device selection");
     const Index n = static_cast<Index>(bytes);
     DeviceBuffer<char> from(n), to(n);
     check(cudaMemcpy(to.get(), from.get(), n, cudaMemcpyDeviceToDevice), "copy"); // warm-up

@@ -11,9 +11,9 @@ bool built()
   return false;
 }
 
-DeviceStatus deviceStatus()
+DeviceStatus deviceStatus(int)
 {
-  return { false, "this build has no CUDA backend (VAO_ENABLE_CUDA off or no CUDA compiler)" };
+  return { false, -1, "this build has no CUDA backend (VAO_ENABLE_CUDA off or no CUDA compiler)" };
 }
 
 Status computeAmbientOcclusion(const VolumeView&, const Region&, const AmbientOcclusionParameters&,
