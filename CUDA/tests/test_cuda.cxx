@@ -111,6 +111,28 @@ TEST(CudaBackend, EachRankTakesItsNodeLocalRankModuloTheDevices)
   EXPECT_TRUE(status.deviceFailure) << "a device that is not there is a device failure: the CPU may run";
 }
 
+TEST(CudaBackend, AnInjectedFailureIsADeviceFailureOfOneCall)
+{
+  VAO_REQUIRE_CUDA_DEVICE();
+  const vao::Index3 dims = { 20, 18, 16 };
+  const auto v = randomVolume<std::int16_t>(dims, -1000, 1000, 31);
+  const auto view = viewOf(v, dims);
+  std::vector<float> open(static_cast<size_t>(view.voxelCount()));
+  vao::AmbientOcclusionParameters p;
+  p.radius = { 2, 2, 2 };
+  vao::cuda::injectDeviceFailures(2);
+  for (vao::Method method : { vao::Method::GaussianCdf, vao::Method::ExactBox })
+  {
+    p.method = method;
+    const vao::Status failed = vao::cuda::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
+    EXPECT_FALSE(failed.ok);
+    EXPECT_TRUE(failed.deviceFailure);
+    EXPECT_NE(failed.message.find("injected"), std::string::npos) << failed.message;
+  }
+  const vao::Status next = vao::cuda::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
+  EXPECT_TRUE(next.ok) << "the device works again after the injected failures: " << next.message;
+}
+
 // ---------------------------------------------------------------------------------------
 // Openness.
 

@@ -6,6 +6,7 @@
 #include "vtkAmbientOcclusionPhantom.h"
 #include "vtkVolumetricAmbientOcclusion.h"
 
+#include "vao/Cuda.h"
 #include "vao/Estimators.h"
 
 #include "vtkCallbackCommand.h"
@@ -245,6 +246,40 @@ TEST(VolumetricAmbientOcclusion, BackendCudaFallsBackToCpuWithAWarning)
   ASSERT_EQ(run.warnings.size(), 1u);
   EXPECT_NE(run.warnings[0].find("CPU"), std::string::npos);
   EXPECT_EQ(run.output->GetNumberOfPoints(), image->GetNumberOfPoints());
+}
+
+TEST(VolumetricAmbientOcclusion, ADeviceFailureFallsBackToTheCpuWithAWarning)
+{
+  const vao::cuda::DeviceStatus device = vao::cuda::deviceStatus();
+  if (!device.available)
+    GTEST_SKIP() << "no CUDA device: " << device.description << " (the fallback without one is tested above)";
+  auto image = RandomImage(40, 36, 30, 6);
+  auto configure = [](vtkVolumetricAmbientOcclusion* f) {
+    f->SetRadius(3);
+    f->SetMethod(vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF);
+  };
+  const FilterRun cpu = RunFilter(image, [&](vtkVolumetricAmbientOcclusion* f) {
+    configure(f);
+    f->SetBackend(vtkVolumetricAmbientOcclusion::BACKEND_CPU);
+  });
+  vao::cuda::injectDeviceFailures(1); // as an error of the device after the upload would
+  const FilterRun fallback = RunFilter(image, [&](vtkVolumetricAmbientOcclusion* f) {
+    configure(f);
+    f->SetBackend(vtkVolumetricAmbientOcclusion::BACKEND_CUDA);
+  });
+  vao::cuda::injectDeviceFailures(0);
+  EXPECT_TRUE(fallback.errors.empty());
+  ASSERT_EQ(fallback.warnings.size(), 1u);
+  EXPECT_NE(fallback.warnings[0].find("injected"), std::string::npos) << fallback.warnings[0];
+  EXPECT_NE(fallback.warnings[0].find("computing on the CPU"), std::string::npos) << fallback.warnings[0];
+  auto* backend = vtkStringArray::SafeDownCast(fallback.output->GetFieldData()->GetAbstractArray("AmbientOcclusionBackend"));
+  ASSERT_NE(backend, nullptr);
+  EXPECT_EQ(backend->GetValue(0), "CPU");
+  const auto expected = Values(cpu.output->GetPointData()->GetArray("AmbientOcclusion"));
+  const auto got = Values(fallback.output->GetPointData()->GetArray("AmbientOcclusion"));
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t i = 0; i < got.size(); ++i)
+    ASSERT_EQ(got[i], expected[i]) << "voxel " << i;
 }
 
 /// Every bad input: an error that says what is wrong, an empty output, no crash.

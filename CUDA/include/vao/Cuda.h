@@ -70,6 +70,11 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
 Status computeBoxStatistics(const VolumeView& volume, const Region& region, const Radius& radius,
   const BoxStatisticsOutput& output, const Execution& execution = {}, Timing* timing = nullptr);
 
+/// For tests of the fallback to the CPU: the next `calls` computations on the device fail
+/// once their input is on the device, as a device error would (Status::deviceFailure, a
+/// message that says it was injected). 0 clears it. No effect without a device.
+void injectDeviceFailures(int calls);
+
 /// Device-to-device copy bandwidth in GB/s over a buffer of `bytes`, counting the bytes
 /// read plus those written (as PassTiming::bytes does): the reference the passes are
 /// compared with. 0 without a device.

@@ -16,6 +16,7 @@
 #include <cuda_runtime.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <mutex>
 #include <sstream>
@@ -30,6 +31,21 @@ namespace
 {
 
 using gpu::Index;
+
+std::atomic<int> injectedFailures{ 0 };
+
+/// Throws the failure a test asked for (injectDeviceFailures), once per call.
+void failIfInjected()
+{
+  int left = injectedFailures.load();
+  while (left > 0 && !injectedFailures.compare_exchange_weak(left, left - 1))
+  {
+  }
+  if (left > 0)
+  {
+    throw CudaFailure("CUDA injected failure (injectDeviceFailures, for tests)");
+  }
+}
 
 template <class T>
 void upload(const detail::TypedVolume<T>& volume, const Region& region, const gpu::RegionGeometry& g, T* device)
@@ -78,6 +94,7 @@ void runCounting(const VolumeView& view, const Region& region, const AmbientOccl
   CudaExecutor ex(timing, execution);
   DeviceBuffer<T> input(g.block());
   upload(volume, region, g, input.get());
+  failIfInjected();
   ex.progress(0.1);
   DeviceBuffer<float> openness(g.region());
   const bool iso = p.queryMode == QueryMode::IsoValue;
@@ -119,6 +136,7 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
   CudaExecutor ex(timing, execution);
   DeviceBuffer<T> input(g.block());
   upload(volume, region, g, input.get());
+  failIfInjected();
   ex.progress(0.1);
 
   const Index n = g.region();
@@ -316,6 +334,11 @@ Status computeBoxStatistics(const VolumeView& volume, const Region& region, cons
   host.statistics = output;
   return runChecked(volume, region, radius, output.minimum || output.maximum,
     { Method::GaussianCdf, QueryMode::VoxelValue, 0.0, ErfMode::Exact }, host, execution, timing);
+}
+
+void injectDeviceFailures(int calls)
+{
+  injectedFailures.store(calls > 0 ? calls : 0);
 }
 
 double measureCopyBandwidth(double bytes)

@@ -28,6 +28,8 @@ Status computeBoxStatistics(const VolumeView&, const Region&, const Radius&, con
   return Status::device("no CUDA device: " + deviceStatus().description);
 }
 
+void injectDeviceFailures(int) {}
+
 double measureCopyBandwidth(double)
 {
   return 0.0;
