@@ -1,6 +1,6 @@
 // GPU benchmark of the CUDA backend (vao::cuda, CUDA/include/vao/Cuda.h): kernel and
 // end-to-end times of the Gaussian CDF openness and of the five box statistics (and of
-// Histogram CDF and Exact Box, CountingRows.h), the CPU
+// Histogram CDF and Exact Box, CountingRows.h; and the pyramid, PyramidRow.h), the CPU
 // time of the same calls for reference, the effective bandwidth of every device pass
 // against the device's copy bandwidth, and, measured in the same run, cupyx.scipy.ndimage
 // computing the same statistics (cupy_peer.py). It checks the bars of the issue and prints
@@ -33,6 +33,7 @@
 
 #include "CountingRows.h"
 #include "GpuBenchmarkSupport.h"
+#include "PyramidRow.h"
 
 #ifndef VAO_DEFAULT_CUPY_PEER
 #define VAO_DEFAULT_CUPY_PEER "cupy_peer.py"
@@ -456,6 +457,9 @@ int main(int argc, char* argv[])
     benchmarkVolume<float>(options, dims, "float32");
     benchmarkVolume<std::int16_t>(options, dims, "int16");
   }
+
+  const vao::Index3 cube = { 256, 256, 256 };
+  benchmarkPyramid(generateVolume<std::int16_t>(cube), cube, options.repeat);
 
   int passed = 0, failed = 0, skipped = 0;
   std::printf("\nBars of the issue:\n");

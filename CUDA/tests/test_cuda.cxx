@@ -133,6 +133,37 @@ TEST(CudaBackend, AnInjectedFailureIsADeviceFailureOfOneCall)
   EXPECT_TRUE(next.ok) << "the device works again after the injected failures: " << next.message;
 }
 
+TEST(CudaPyramid, EqualsTheCpuLevelByLevel)
+{
+  VAO_REQUIRE_CUDA_DEVICE();
+  const vao::Index3 dims = { 67, 45, 39 };
+  const auto v = randomVolume<std::int16_t>(dims, -1024, 2000, 41);
+  const std::array<double, 3> origin = { 1.0, -2.0, 3.0 }, spacing = { 0.5, 0.5, 1.25 };
+  for (const vao::PyramidParameters parameters : { vao::PyramidParameters{ 4, false }, vao::PyramidParameters{ 3, true } })
+  {
+    std::vector<vao::MomentLevel> cpu, gpu;
+    ASSERT_TRUE(vao::buildMomentPyramid(viewOf(v, dims), origin, spacing, parameters, cpu).ok);
+    const vao::Status status = vao::cuda::buildMomentPyramid(viewOf(v, dims), origin, spacing, parameters, gpu);
+    ASSERT_TRUE(status.ok) << status.message;
+    ASSERT_EQ(gpu.size(), cpu.size());
+    for (size_t l = 0; l < cpu.size(); ++l)
+    {
+      ASSERT_EQ(gpu[l].dims, cpu[l].dims);
+      EXPECT_EQ(gpu[l].spacing, cpu[l].spacing);
+      for (size_t i = 0; i < cpu[l].mean.size(); ++i)
+      {
+        ASSERT_NEAR(gpu[l].mean[i], cpu[l].mean[i], 1e-5 * std::max(1.0f, std::abs(cpu[l].mean[i])));
+        ASSERT_NEAR(gpu[l].variance[i], cpu[l].variance[i], 1e-5 * std::max(1.0f, cpu[l].variance[i]));
+      }
+    }
+  }
+  std::vector<vao::MomentLevel> bad = { vao::MomentLevel{} };
+  const vao::Status rejected = vao::cuda::buildMomentPyramid(viewOf(v, dims), origin, { 0.5, 0.0, 1.0 }, {}, bad);
+  EXPECT_FALSE(rejected.ok);
+  EXPECT_FALSE(rejected.deviceFailure) << "a zero spacing is bad input, as on the CPU";
+  EXPECT_TRUE(bad.empty());
+}
+
 // ---------------------------------------------------------------------------------------
 // Openness.
 

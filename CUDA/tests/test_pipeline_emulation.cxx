@@ -7,10 +7,13 @@
 #include "../src/VolumeAccess.h"
 #include "../src/cpu/ExactReference.h"
 #include "../src/cuda/ExactPipeline.h"
+#include "../src/cpu/PyramidPlan.h"
 #include "../src/cuda/HistogramPipeline.h"
+#include "../src/cuda/PyramidPipeline.h"
 #include "../src/cuda/Pipeline.h"
 
 #include "vao/HistogramCdf.h"
+#include "vao/VarianceOcclusionMap.h"
 
 #include <gtest/gtest.h>
 
@@ -267,7 +270,67 @@ void expectExactLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, con
     ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " method " << static_cast<int>(method);
 }
 
+/// The device's pyramid passes on the host against the CPU's buildMomentPyramid: the same
+/// levels, dims and geometry, the moments equal but for the rounding of the CPU's fused
+/// multiply-adds (1e-5 is the device's bar; they agree far closer).
+template <class T>
+void expectPyramidLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, const vao::PyramidParameters& parameters)
+{
+  const std::array<double, 3> origin = { -3.0, 2.5, 7.0 }, spacing = { 0.8, 1.1, 2.0 };
+  std::vector<vao::MomentLevel> cpu;
+  ASSERT_TRUE(vao::buildMomentPyramid(viewOf(v, dims), origin, spacing, parameters, cpu).ok);
+  vao::detail::PyramidSetup setup;
+  ASSERT_TRUE(vao::detail::preparePyramid(viewOf(v, dims), origin, spacing, parameters, setup).ok);
+  std::vector<vao::MomentLevel> gpu(static_cast<size_t>(parameters.levels));
+  HostExecutor ex;
+  const Index d[3] = { dims[0], dims[1], dims[2] };
+  vao::gpu::runPyramid<T>(ex, v.data(), d, setup.firstStep, parameters.levels, setup.shift, &vao::detail::axisWeights,
+    [&](int l, const Index out[3], const float* mean, const float* variance) {
+      vao::MomentLevel& level = gpu[static_cast<size_t>(l)];
+      level.dims = { out[0], out[1], out[2] };
+      const size_t n = static_cast<size_t>(out[0] * out[1] * out[2]);
+      level.mean.resize(n);
+      level.variance.resize(n);
+      std::copy(mean, mean + n, level.mean.data());
+      std::copy(variance, variance + n, level.variance.data());
+    });
+  vao::detail::setLevelGeometry(gpu, origin, spacing, setup);
+  ASSERT_EQ(gpu.size(), cpu.size());
+  for (size_t l = 0; l < cpu.size(); ++l)
+  {
+    ASSERT_EQ(gpu[l].dims, cpu[l].dims) << "level " << l;
+    EXPECT_EQ(gpu[l].spacing, cpu[l].spacing);
+    EXPECT_EQ(gpu[l].kernelRadius, cpu[l].kernelRadius);
+    EXPECT_EQ(gpu[l].roundingVariance, cpu[l].roundingVariance);
+    double meanScale = 1.0, varianceScale = 0.0;
+    for (size_t i = 0; i < cpu[l].mean.size(); ++i)
+    {
+      meanScale = std::max(meanScale, std::abs(static_cast<double>(cpu[l].mean[i])));
+      varianceScale = std::max(varianceScale, static_cast<double>(cpu[l].variance[i]));
+    }
+    ASSERT_GT(varianceScale, 0.0);
+    for (size_t i = 0; i < cpu[l].mean.size(); ++i)
+    {
+      ASSERT_NEAR(gpu[l].mean[i], cpu[l].mean[i], 1e-6 * meanScale) << "level " << l << " voxel " << i;
+      ASSERT_NEAR(gpu[l].variance[i], cpu[l].variance[i], 1e-6 * varianceScale + cpu[l].roundingVariance)
+        << "level " << l << " voxel " << i;
+    }
+  }
+}
+
 } // namespace
+
+TEST(GpuPipelineOnHost, MomentPyramidEqualsTheCpu)
+{
+  const vao::Index3 odd = { 19, 14, 11 }, thin = { 2, 9, 6 };
+  const auto i16 = randomVolume<std::int16_t>(odd, -1024, 2000, 321);
+  const auto u8 = randomVolume<std::uint8_t>(thin, 0, 256, 322);
+  const auto f32 = randomVolume<float>(odd, 1000, 1001, 323); // large mean, small spread
+  expectPyramidLikeTheCpu(i16, odd, { 4, false });
+  expectPyramidLikeTheCpu(i16, odd, { 3, true });
+  expectPyramidLikeTheCpu(u8, thin, { 2, false });
+  expectPyramidLikeTheCpu(f32, odd, { 5, false });
+}
 
 TEST(GpuPipelineOnHost, ExactBoxAndSphereEqualTheCpu)
 {

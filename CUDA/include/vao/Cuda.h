@@ -9,6 +9,7 @@
 #pragma once
 
 #include "vao/AmbientOcclusion.h"
+#include "vao/VarianceOcclusionMap.h"
 
 #include <string>
 #include <vector>
@@ -69,6 +70,14 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
 /// Count, mean, variance, minimum and maximum over each voxel's clipped box, on the GPU.
 Status computeBoxStatistics(const VolumeView& volume, const Region& region, const Radius& radius,
   const BoxStatisticsOutput& output, const Execution& execution = {}, Timing* timing = nullptr);
+
+/// The moment pyramid of VarianceOcclusionMap.h, built on the device: the same checks,
+/// levels and geometry as vao::buildMomentPyramid, each level's sums tap for tap the CPU's
+/// (equal to 1e-5, the CPU's fused multiply-adds aside), downloaded into `pyramid`. On a
+/// failure (Status::deviceFailure for the device's) the pyramid is left empty.
+Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters, std::vector<MomentLevel>& pyramid,
+  const Execution& execution = {}, Timing* timing = nullptr);
 
 /// For tests of the fallback to the CPU: the next `calls` computations on the device fail
 /// once their input is on the device, as a device error would (Status::deviceFailure, a

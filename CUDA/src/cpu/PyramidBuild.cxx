@@ -20,6 +20,7 @@
 #include "vao/Validation.h"
 
 #include "Parallel.h"
+#include "PyramidPlan.h"
 #include "PyramidRows.h"
 #include "VolumeAccess.h"
 
@@ -35,32 +36,6 @@ namespace
 
 using namespace detail;
 using namespace detail::pyramid;
-
-/// Normalised weights of the clipped 5-tap Gaussian for each kept output index along one
-/// axis of n input voxels: weights[o * 5 + k] for input index o * step + k - 2 (0 where
-/// that input is outside [0, n)).
-std::vector<double> axisWeights(std::int64_t n, std::int64_t outN, int step)
-{
-  static const double base[kTaps] = { std::exp(-2.0), std::exp(-0.5), 1.0, std::exp(-0.5),
-    std::exp(-2.0) };
-  std::vector<double> weights(static_cast<std::size_t>(outN * kTaps), 0.0);
-  for (std::int64_t o = 0; o < outN; ++o)
-  {
-    const std::int64_t centre = o * step;
-    double sum = 0.0;
-    for (int k = 0; k < kTaps; ++k)
-    {
-      const std::int64_t i = centre + k - kHalf;
-      sum += (i >= 0 && i < n) ? base[k] : 0.0;
-    }
-    for (int k = 0; k < kTaps; ++k)
-    {
-      const std::int64_t i = centre + k - kHalf;
-      weights[o * kTaps + k] = (i >= 0 && i < n) ? base[k] / sum : 0.0;
-    }
-  }
-  return weights;
-}
 
 /// Raw volume as a source: d = v - K, s = d^2.
 template <class T>
@@ -124,10 +99,7 @@ struct BlurPlan
     , step(keepEvery)
     , shift(k)
   {
-    for (int a = 0; a < 3; ++a)
-    {
-      out[a] = step == 1 ? n[a] : (n[a] + 1) / 2;
-    }
+    out = keptDims(n, step);
     wx = axisWeights(n[0], out[0], step);
     wy = axisWeights(n[1], out[1], step);
     wz = axisWeights(n[2], out[2], step);
@@ -221,8 +193,7 @@ private:
         sa += w[k] * pa[xo * step + k];
         sb += w[k] * pb[xo * step + k];
       }
-      mean[xo] = static_cast<float>(sa + p.shift);
-      variance[xo] = static_cast<float>(std::max(0.0, sb - sa * sa));
+      blur::levelMoments(sa, sb, p.shift, mean[xo], variance[xo]);
     };
     for (std::int64_t xo = 0; xo < interiorBegin; ++xo)
       clipped(xo);
@@ -270,8 +241,54 @@ bool blurDecimate(const Source& source, int step, double shift, MomentLevel& out
     });
 }
 
-Status checkPyramidRequest(const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const PyramidParameters& parameters)
+Status buildPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
+  std::vector<MomentLevel>& pyramid, const Execution& execution)
+{
+  PyramidSetup setup;
+  const Status status = preparePyramid(volume, origin, spacing, parameters, setup);
+  if (!status.ok)
+  {
+    pyramid.clear();
+    return status;
+  }
+  const int threads = detail::resolveThreadCount(execution.threads);
+  const double shift = setup.shift;
+  const int levels = parameters.levels;
+  // Reuse the storage of a previous build (same sizes: no allocation, no page faults).
+  std::vector<MomentLevel> result = std::move(pyramid);
+  pyramid.clear();
+  result.resize(static_cast<std::size_t>(levels));
+  const double stageWidth = 1.0 / levels;
+  const bool firstDone = detail::dispatchScalarType(volume.type, [&](auto tag) {
+    using T = decltype(tag);
+    const RawSource<T> source{ detail::TypedVolume<T>(volume), shift };
+    return blurDecimate(source, setup.firstStep, shift, result[0], detail::stageExecution(execution, 0.0, stageWidth), threads);
+  });
+  if (!firstDone)
+  {
+    return Status::cancelled();
+  }
+  for (int l = 1; l < levels; ++l)
+  {
+    const Execution stage = detail::stageExecution(execution, l * stageWidth, (l + 1) * stageWidth);
+    if (!blurDecimate(LevelSource{ &result[l - 1], shift }, 2, shift, result[l], stage, threads))
+    {
+      return Status::cancelled();
+    }
+  }
+  setLevelGeometry(result, origin, spacing, setup);
+  pyramid = std::move(result);
+  return Status::success();
+}
+
+} // namespace
+
+namespace detail
+{
+
+Status preparePyramid(const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters, PyramidSetup& setup)
 {
   Status status = checkVolume(volume, 2, "the variance occlusion map");
   if (status.ok)
@@ -284,19 +301,6 @@ Status checkPyramidRequest(const VolumeView& volume, const std::array<double, 3>
     why << "the number of pyramid levels must be in [1, 16], got " << parameters.levels;
     status = Status::failure(why.str());
   }
-  return status;
-}
-
-} // namespace
-
-namespace
-{
-
-Status buildPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
-  std::vector<MomentLevel>& pyramid, const Execution& execution)
-{
-  Status status = checkPyramidRequest(volume, origin, spacing, parameters);
   const ValueScan scan = status.ok ? scanValues(volume) : ValueScan{};
   if (status.ok)
     status = finiteStatus(scan);
@@ -304,61 +308,72 @@ Status buildPyramid(const VolumeView& volume, const std::array<double, 3>& origi
     status = checkMomentMagnitude(scan);
   if (!status.ok)
   {
-    pyramid.clear();
     return status;
   }
-  const int threads = detail::resolveThreadCount(execution.threads);
-  const double shift = detail::dispatchScalarType(volume.type, [&](auto tag) {
-    return detail::sampledMean(detail::TypedVolume<decltype(tag)>(volume));
+  setup.shift = dispatchScalarType(volume.type, [&](auto tag) {
+    return sampledMean(TypedVolume<decltype(tag)>(volume));
   });
-  const double roundingVariance =
-    sumRoundingVariance(std::max(std::abs(scan.maximum - shift), std::abs(scan.minimum - shift)));
-  const int levels = parameters.levels;
-  // Reuse the storage of a previous build (same sizes: no allocation, no page faults).
-  std::vector<MomentLevel> result = std::move(pyramid);
-  pyramid.clear();
-  result.resize(static_cast<std::size_t>(levels));
-  const double stageWidth = 1.0 / levels;
-  const int firstStep = parameters.startAtHalfResolution ? 2 : 1;
-  const bool firstDone = detail::dispatchScalarType(volume.type, [&](auto tag) {
-    using T = decltype(tag);
-    const RawSource<T> source{ detail::TypedVolume<T>(volume), shift };
-    return blurDecimate(source, firstStep, shift, result[0], detail::stageExecution(execution, 0.0, stageWidth), threads);
-  });
-  if (!firstDone)
-  {
-    return Status::cancelled();
-  }
-  result[0].origin = origin;
-  for (int a = 0; a < 3; ++a)
-  {
-    result[0].spacing[a] = spacing[a] * firstStep;
-  }
-  for (int l = 1; l < levels; ++l)
-  {
-    const Execution stage = detail::stageExecution(execution, l * stageWidth, (l + 1) * stageWidth);
-    if (!blurDecimate(LevelSource{ &result[l - 1], shift }, 2, shift, result[l], stage, threads))
-    {
-      return Status::cancelled();
-    }
-    result[l].origin = result[l - 1].origin;
-    for (int a = 0; a < 3; ++a)
-    {
-      result[l].spacing[a] = result[l - 1].spacing[a] * 2.0;
-    }
-  }
-  for (MomentLevel& level : result)
-  {
-    // r_l: the 5-tap half-width (2 voxels) of the level's own grid, largest axis; it
-    // doubles with every level.
-    level.kernelRadius = 2.0 * std::max(level.spacing[0], std::max(level.spacing[1], level.spacing[2]));
-    level.roundingVariance = roundingVariance;
-  }
-  pyramid = std::move(result);
+  setup.roundingVariance =
+    sumRoundingVariance(std::max(std::abs(scan.maximum - setup.shift), std::abs(scan.minimum - setup.shift)));
+  setup.firstStep = parameters.startAtHalfResolution ? 2 : 1;
   return Status::success();
 }
 
-} // namespace
+Index3 keptDims(const Index3& in, int step)
+{
+  Index3 out;
+  for (int a = 0; a < 3; ++a)
+  {
+    out[a] = step == 1 ? in[a] : (in[a] + 1) / 2;
+  }
+  return out;
+}
+
+/// Normalised weights of the clipped 5-tap Gaussian for each kept output index along one
+/// axis of n input voxels: weights[o * 5 + k] for input index o * step + k - 2 (0 where
+/// that input is outside [0, n)).
+std::vector<double> axisWeights(std::int64_t n, std::int64_t outN, int step)
+{
+  static const double base[kTaps] = { std::exp(-2.0), std::exp(-0.5), 1.0, std::exp(-0.5),
+    std::exp(-2.0) };
+  std::vector<double> weights(static_cast<std::size_t>(outN * kTaps), 0.0);
+  for (std::int64_t o = 0; o < outN; ++o)
+  {
+    const std::int64_t centre = o * step;
+    double sum = 0.0;
+    for (int k = 0; k < kTaps; ++k)
+    {
+      const std::int64_t i = centre + k - kHalf;
+      sum += (i >= 0 && i < n) ? base[k] : 0.0;
+    }
+    for (int k = 0; k < kTaps; ++k)
+    {
+      const std::int64_t i = centre + k - kHalf;
+      weights[o * kTaps + k] = (i >= 0 && i < n) ? base[k] / sum : 0.0;
+    }
+  }
+  return weights;
+}
+
+void setLevelGeometry(std::vector<MomentLevel>& levels, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const PyramidSetup& setup)
+{
+  for (std::size_t l = 0; l < levels.size(); ++l)
+  {
+    MomentLevel& level = levels[l];
+    level.origin = origin;
+    for (int a = 0; a < 3; ++a)
+    {
+      level.spacing[a] = l == 0 ? spacing[a] * setup.firstStep : levels[l - 1].spacing[a] * 2.0;
+    }
+    // r_l: the 5-tap half-width (2 voxels) of the level's own grid, largest axis; it
+    // doubles with every level.
+    level.kernelRadius = 2.0 * std::max(level.spacing[0], std::max(level.spacing[1], level.spacing[2]));
+    level.roundingVariance = setup.roundingVariance;
+  }
+}
+
+} // namespace detail
 
 Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const PyramidParameters& parameters,

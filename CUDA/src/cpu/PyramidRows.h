@@ -7,6 +7,7 @@
 // Both accumulate in double.
 #pragma once
 
+#include "../BlurTaps.h"
 #include "CpuDispatch.h"
 
 #include <cstdint>
@@ -18,17 +19,9 @@ namespace detail
 namespace pyramid
 {
 
-constexpr int kTaps = 5;
-constexpr int kHalf = 2;
-
-/// sum_k w[k] v[k] in tap order (the rounding of w0 v0 + w1 v1 + ... written out).
-VAO_ALWAYS_INLINE double tapSum(const double* w, const double* v)
-{
-  double sum = w[0] * v[0];
-  for (int k = 1; k < kTaps; ++k)
-    sum += w[k] * v[k];
-  return sum;
-}
+constexpr int kTaps = blur::kTaps;
+constexpr int kHalf = blur::kHalf;
+using blur::tapSum;
 
 /// d[k] = rows[k][i] - shift for the five taps.
 template <class T>
@@ -51,10 +44,7 @@ struct RawRows
       double d[kTaps];
       shiftedTaps(r, Unit ? x : x * stride, shift, d);
       a[x] = tapSum(w, d);
-      double sum = w[0] * d[0] * d[0];
-      for (int k = 1; k < kTaps; ++k)
-        sum += w[k] * d[k] * d[k];
-      b[x] = sum;
+      b[x] = blur::squareSum(w, d);
     }
   }
 };
@@ -104,11 +94,7 @@ struct InteriorRow
   {
     for (std::int64_t xo = begin; xo < end; ++xo)
     {
-      const double sa = tapSum(w, pa + Step * xo);
-      const double sb = tapSum(w, pb + Step * xo);
-      mean[xo] = static_cast<float>(sa + shift);
-      const double var = sb - sa * sa;
-      variance[xo] = static_cast<float>(var > 0.0 ? var : 0.0);
+      blur::levelMoments(tapSum(w, pa + Step * xo), tapSum(w, pb + Step * xo), shift, mean[xo], variance[xo]);
     }
   }
 };

@@ -9,7 +9,9 @@
 #include "CudaExecutor.h"
 #include "ExactPipeline.h"
 #include "HistogramPipeline.h"
+#include "PyramidPipeline.h"
 #include "cpu/ExactReference.h"
+#include "cpu/PyramidPlan.h"
 #include "cpu/Parallel.h"
 #include "Pipeline.h"
 
@@ -166,26 +168,11 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
   ex.progress(1.0);
 }
 
-Status runChecked(const VolumeView& view, const Region& region, const Radius& radius, bool withExtrema,
-  const gpu::EstimatorSetting& estimator, const HostOutputs& host, const Execution& execution, Timing* timing)
+/// Runs work() on the device that execution.device selects: the device errors, Abort and
+/// a host allocation failure come back as a Status; the wall-clock total goes to timing.
+template <class Work>
+Status onDevice(const Execution& execution, Timing* timing, const Work& work)
 {
-  ValueScan scan;
-  Status status;
-  if (host.counting)
-  {
-    // Counts, not moments: no magnitude limit, only finite values.
-    status = validate(view, region, radius);
-    if (status.ok && needsValueScan(view.type))
-      status = finiteStatus(scanValues(view));
-  }
-  else
-  {
-    status = validateMomentRequest(view, region, radius, scan);
-  }
-  if (!status.ok)
-  {
-    return status;
-  }
   const DeviceStatus device = deviceStatus(execution.device);
   if (!device.available)
   {
@@ -199,12 +186,7 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   try
   {
     check(cudaSetDevice(device.index), "device selection");
-    detail::dispatchScalarType(view.type, [&](auto tag) {
-      if (host.counting)
-        runCounting<decltype(tag)>(view, region, *host.counting, host.openness, execution, timing);
-      else
-        run<decltype(tag)>(view, region, radius, withExtrema, estimator, scan, host, execution, timing);
-    });
+    work();
     check(cudaDeviceSynchronize(), "synchronize");
   }
   catch (const CudaFailure& failure)
@@ -227,6 +209,36 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
   return Status::success();
+}
+
+Status runChecked(const VolumeView& view, const Region& region, const Radius& radius, bool withExtrema,
+  const gpu::EstimatorSetting& estimator, const HostOutputs& host, const Execution& execution, Timing* timing)
+{
+  ValueScan scan;
+  Status status;
+  if (host.counting)
+  {
+    // Counts, not moments: no magnitude limit, only finite values.
+    status = validate(view, region, radius);
+    if (status.ok && needsValueScan(view.type))
+      status = finiteStatus(scanValues(view));
+  }
+  else
+  {
+    status = validateMomentRequest(view, region, radius, scan);
+  }
+  if (!status.ok)
+  {
+    return status;
+  }
+  return onDevice(execution, timing, [&] {
+    detail::dispatchScalarType(view.type, [&](auto tag) {
+      if (host.counting)
+        runCounting<decltype(tag)>(view, region, *host.counting, host.openness, execution, timing);
+      else
+        run<decltype(tag)>(view, region, radius, withExtrema, estimator, scan, host, execution, timing);
+    });
+  });
 }
 
 } // namespace
@@ -334,6 +346,54 @@ Status computeBoxStatistics(const VolumeView& volume, const Region& region, cons
   host.statistics = output;
   return runChecked(volume, region, radius, output.minimum || output.maximum,
     { Method::GaussianCdf, QueryMode::VoxelValue, 0.0, ErfMode::Exact }, host, execution, timing);
+}
+
+Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters, std::vector<MomentLevel>& pyramid,
+  const Execution& execution, Timing* timing)
+{
+  detail::PyramidSetup setup;
+  Status status = detail::preparePyramid(volume, origin, spacing, parameters, setup);
+  std::vector<MomentLevel> levels;
+  if (status.ok)
+  {
+    status = onDevice(execution, timing, [&] {
+      detail::dispatchScalarType(volume.type, [&](auto tag) {
+        using T = decltype(tag);
+        const Region whole = Region::whole(volume);
+        const gpu::RegionGeometry g = gpu::geometryFor(volume.dims, whole, { 0, 0, 0 });
+        CudaExecutor ex(timing, execution);
+        DeviceBuffer<T> input(g.block());
+        upload(detail::TypedVolume<T>(volume), whole, g, input.get());
+        failIfInjected();
+        ex.progress(0.1);
+        levels.resize(static_cast<std::size_t>(parameters.levels));
+        const Index dims[3] = { volume.dims[0], volume.dims[1], volume.dims[2] };
+        gpu::runPyramid<T>(ex, input.get(), dims, setup.firstStep, parameters.levels, setup.shift, &detail::axisWeights,
+          [&](int l, const Index out[3], const float* mean, const float* variance) {
+            MomentLevel& level = levels[static_cast<std::size_t>(l)];
+            level.dims = { out[0], out[1], out[2] };
+            const std::size_t n = static_cast<std::size_t>(out[0] * out[1] * out[2]);
+            level.mean.resize(n);
+            level.variance.resize(n);
+            check(cudaMemcpy(level.mean.data(), mean, n * sizeof(float), cudaMemcpyDeviceToHost), "download");
+            check(cudaMemcpy(level.variance.data(), variance, n * sizeof(float), cudaMemcpyDeviceToHost), "download");
+          });
+        if (timing)
+        {
+          ex.finish();
+        }
+      });
+    });
+  }
+  pyramid.clear();
+  if (!status.ok)
+  {
+    return status;
+  }
+  detail::setLevelGeometry(levels, origin, spacing, setup);
+  pyramid = std::move(levels);
+  return status;
 }
 
 void injectDeviceFailures(int calls)

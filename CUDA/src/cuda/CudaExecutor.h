@@ -54,6 +54,16 @@ public:
   }
   ~DeviceBuffer() { cudaFree(this->Data); }
   DeviceBuffer(DeviceBuffer&& other) noexcept : Data(other.Data) { other.Data = nullptr; }
+  DeviceBuffer& operator=(DeviceBuffer&& other) noexcept
+  {
+    if (this != &other)
+    {
+      cudaFree(this->Data);
+      this->Data = other.Data;
+      other.Data = nullptr;
+    }
+    return *this;
+  }
   DeviceBuffer(const DeviceBuffer&) = delete;
   DeviceBuffer& operator=(const DeviceBuffer&) = delete;
   T* get() const { return this->Data; }

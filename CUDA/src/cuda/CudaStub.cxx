@@ -28,6 +28,13 @@ Status computeBoxStatistics(const VolumeView&, const Region&, const Radius&, con
   return Status::device("no CUDA device: " + deviceStatus().description);
 }
 
+Status buildMomentPyramid(const VolumeView&, const std::array<double, 3>&, const std::array<double, 3>&,
+  const PyramidParameters&, std::vector<MomentLevel>& pyramid, const Execution&, Timing*)
+{
+  pyramid.clear();
+  return Status::device("no CUDA device: " + deviceStatus().description);
+}
+
 void injectDeviceFailures(int) {}
 
 double measureCopyBandwidth(double)
