@@ -1,5 +1,5 @@
 """pvpython's UpdatePipeline against the VTK filter's own Update, in one process (issue 14's
-"pvpython time / kernel time" ratio), best of 3 each:
+"pvpython time / kernel time" ratio), best of 5 each (this machine is shared and noisy):
 
 - Volumetric AO, R = 10, on the generated 256x256x415 phantom, and the peer in the same
   process: scipy.ndimage's box statistics of that volume (Benchmarks/scipy_peer.py);
@@ -35,7 +35,7 @@ def measure(name, make):
     """A fresh proxy per repeat: UpdatePipeline, then the same filter's Update again.
     Returns the pvpython time."""
     through_paraview, filter_only = 1e9, 1e9
-    for repeat in range(3):
+    for repeat in range(5):
         proxy = make()
         through_paraview = min(through_paraview, seconds(proxy.UpdatePipeline))
         vtk_filter = proxy.GetClientSideObject()
@@ -81,7 +81,7 @@ shaded = IsosurfaceAmbientOcclusion(Input=bone, Volume=head, IsoValue=400.0, Com
 shaded.UpdatePipeline()  # builds the pyramid once
 vtk_filter = shaded.GetClientSideObject()
 through_paraview, filter_only = 1e9, 1e9
-for repeat, light in enumerate([[0.0, -1.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0], [-1.0, 0.0, 1.0]]):
+for repeat, light in enumerate([[0.0, -1.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0], [-1.0, 0.0, 1.0], [1.0, 1.0, 1.0]]):
     shaded.LightDirection = light
     through_paraview = min(through_paraview, seconds(shaded.UpdatePipeline))
     vtk_filter.Modified()  # the same light again: the shading only, the pyramid cached
