@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <type_traits>
 #include <new>
 #include <sstream>
 
@@ -137,20 +138,33 @@ ValueScan scanValues(const VolumeView& view)
     total.firstNonFinite = n;
     bool anyFinite = false;
     const int threads = detail::resolveThreadCount(0);
+    const std::int64_t stride = view.voxelStride;
     detail::parallelFor(n, 4 * threads, threads, [&](std::int64_t begin, std::int64_t end) {
       std::int64_t count = 0, first = n;
       // The range of the finite values: +-infinity start values, so no branch on the
-      // first one (the loop vectorises).
+      // first one. The count of non-finite values and the range come first, in a loop
+      // without a data-dependent index (it vectorises; integers are all finite); the first
+      // non-finite value is looked for only where there is one.
       T lo = std::numeric_limits<T>::has_infinity ? std::numeric_limits<T>::infinity() : std::numeric_limits<T>::max();
       T hi = std::numeric_limits<T>::has_infinity ? -std::numeric_limits<T>::infinity() : std::numeric_limits<T>::lowest();
-      for (std::int64_t i = begin; i < end; ++i)
+      auto scan = [&](auto unit) {
+        const std::int64_t step = decltype(unit)::value ? 1 : stride;
+        for (std::int64_t i = begin; i < end; ++i)
+        {
+          const T v = data[i * step];
+          const bool bad = !std::is_integral<T>::value && !(v - v == v - v); // NaN or infinite
+          count += bad;
+          lo = bad || !(v < lo) ? lo : v;
+          hi = bad || !(hi < v) ? hi : v;
+        }
+      };
+      if (stride == 1)
+        scan(std::true_type{});
+      else
+        scan(std::false_type{});
+      for (std::int64_t i = begin; count > 0 && i < end && first == n; ++i)
       {
-        const T v = data[i * view.voxelStride];
-        const bool bad = !std::isfinite(static_cast<double>(v));
-        count += bad;
-        first = bad && first == n ? i : first;
-        lo = bad || !(v < lo) ? lo : v;
-        hi = bad || !(hi < v) ? hi : v;
+        first = std::isfinite(static_cast<double>(data[i * stride])) ? n : i;
       }
       std::lock_guard<std::mutex> lock(merge);
       total.nonFiniteCount += count;
