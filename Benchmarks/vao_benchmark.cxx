@@ -9,21 +9,21 @@
 // Usage: vao_benchmark [--shared DIR] [--scipy PATH/TO/scipy_peer.py] [--repeat N]
 //                      [--exact] [--threads N] [--volumetric | --sweeping | --penner | --relight]
 //                      (one table only; --relight: the surface query rates alone)
-// Last, the variance occlusion maps: pyramid builds and the surface query rates (AO, soft
-// shadows) on the CT heads' bone surfaces.
+// Last, the variance occlusion maps (PennerRows.cxx): pyramid builds against their floor
+// and scipy's level-0 blur, and the surface query rates (AO, soft shadows) on the CT heads'
+// bone surfaces.
 // Exact Box and Exact Sphere are O(R^3) references: by default they are timed on a
 // 32-slice slab and the whole-volume time is extrapolated (marked "~"); --exact times
 // them on the whole volume (minutes).
 #include "vtkAmbientOcclusionPhantom.h"
 #include "vtkVolumetricAmbientOcclusion.h"
 
+#include "BenchmarkSupport.h"
+#include "PennerRows.h"
 #include "SweepScene.h"
 #include "vao/AmbientOcclusion.h"
 #include "vao/OcclusionSweeping.h"
-#include "vao/VarianceOcclusionMap.h"
 
-#include "vtkFlyingEdges3D.h"
-#include "vtkPolyData.h"
 
 #include "vtkExtractVOI.h"
 #include "vtkImageData.h"
@@ -46,29 +46,7 @@
 namespace
 {
 
-int ResolvedThreads(int requested)
-{
-  return requested > 0 ? requested : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-}
-
-double Seconds(const std::chrono::steady_clock::time_point& start)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-struct Options
-{
-  std::string shared = VAO_DEFAULT_SHARED_DATA_DIR;
-  std::string scipy = VAO_DEFAULT_SCIPY_PEER;
-  std::string scipyEdt = VAO_DEFAULT_SCIPY_EDT_PEER;
-  bool sweepingOnly = false;
-  bool pennerOnly = false;
-  bool relightOnly = false; // --relight: the surface query rates of --penner alone
-  bool volumetricOnly = false;
-  int repeat = 3;
-  bool exact = false;
-  int threads = 0;
-};
+using namespace vaobench;
 
 /// Best of `repeat` wall-clock times of one filter update on an in-memory image.
 double TimeFilter(vtkImageData* image, int method, int radius, int repeat, int threads)
@@ -348,80 +326,6 @@ void BenchmarkSweeping(const Options& options, vtkImageData* ct)
   std::ofstream(raw, std::ios::binary).write(reinterpret_cast<const char*>(asFloat.data()), asFloat.size() * sizeof(float));
   SweepRow("CT head skin (-300 HU)", view, { h[0], h[1], h[2] }, -300.0, raw, options);
   std::remove(raw.c_str());
-}
-
-/// Penner & Mitchell: the pyramid build on generated volumes of the paper's Table 1 sizes.
-void BenchmarkPyramid(const Options& options)
-{
-  std::printf("\nVariance occlusion maps: pyramid build (4 levels, best of %d; paper Table 1: 170 / 678 / "
-              "1524 ms CPU)\n", options.repeat);
-  const int sizes[][3] = { { 256, 256, 256 }, { 512, 512, 256 }, { 512, 512, 512 } };
-  for (const auto& size : sizes)
-  {
-    vtkNew<vtkAmbientOcclusionPhantom> phantom;
-    phantom->SetDimensions(size[0], size[1], size[2]);
-    phantom->Update();
-    vao::VolumeView view;
-    view.data = phantom->GetOutput()->GetScalarPointer();
-    view.type = vao::ScalarType::Int16;
-    view.dims = { size[0], size[1], size[2] };
-    std::vector<vao::MomentLevel> pyramid;
-    double best = 1e300;
-    for (int r = 0; r < options.repeat; ++r)
-    {
-      const auto start = std::chrono::steady_clock::now();
-      vao::buildMomentPyramid(view, { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid);
-      best = std::min(best, Seconds(start));
-    }
-    std::printf("  %4d x %4d x %4d int16   %8.0f ms\n", size[0], size[1], size[2], 1e3 * best);
-  }
-}
-
-/// The surface query rates (what a light move costs once the pyramid is cached) on the
-/// bone surface (400 HU) of a CT head: default parameters, light (0, -1, 1).
-void BenchmarkRelighting(const Options& options, const char* name, vtkImageData* ct)
-{
-  vtkNew<vtkFlyingEdges3D> contour;
-  contour->SetInputData(ct);
-  contour->SetValue(0, 400.0);
-  contour->ComputeNormalsOn();
-  contour->Update();
-  vtkPolyData* bone = contour->GetOutput();
-  const vtkIdType n = bone->GetNumberOfPoints();
-  std::vector<double> points(3 * n), normals(3 * n);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    bone->GetPoint(i, &points[3 * i]);
-    bone->GetPointData()->GetNormals()->GetTuple(i, &normals[3 * i]);
-  }
-  vao::VolumeView view;
-  view.data = ct->GetScalarPointer();
-  view.type = vao::ScalarType::Int16;
-  const int* d = ct->GetDimensions();
-  view.dims = { d[0], d[1], d[2] };
-  const double* o = ct->GetOrigin();
-  const double* h = ct->GetSpacing();
-  std::vector<vao::MomentLevel> pyramid;
-  vao::Execution execution;
-  execution.threads = options.threads;
-  vao::buildMomentPyramid(view, { o[0], o[1], o[2] }, { h[0], h[1], h[2] }, {}, pyramid, execution);
-  std::vector<float> ao(n), shadow(n);
-  auto rate = [&](bool occlusion, bool shadows) {
-    double best = 1e300;
-    for (int r = 0; r < options.repeat; ++r)
-    {
-      const auto start = std::chrono::steady_clock::now();
-      if (occlusion)
-        vao::surfaceAmbientOcclusion(pyramid, view, { o[0], o[1], o[2] }, { h[0], h[1], h[2] }, points.data(),
-          normals.data(), n, {}, ao.data(), execution);
-      if (shadows)
-        vao::surfaceShadow(pyramid, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 }, {}, shadow.data(), execution);
-      best = std::min(best, Seconds(start));
-    }
-    return n / best / 1e6;
-  };
-  std::printf("  %s bone surface (400 HU, %lld points): AO %.1f, shadows %.1f, AO + shadows %.1f M points/s\n",
-    name, static_cast<long long>(n), rate(true, false), rate(false, true), rate(true, true));
 }
 
 } // namespace

@@ -1,0 +1,181 @@
+// The Penner & Mitchell tables of the benchmark: the pyramid build against its floor and
+// scipy's level-0 blur, and the surface query rates (AO, soft shadows) on a CT head's bone
+// surface once the pyramid is cached.
+#include "PennerRows.h"
+
+#include "vtkAmbientOcclusionPhantom.h"
+#include "vtkFlyingEdges3D.h"
+#include "vtkImageData.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+
+#include "vao/VarianceOcclusionMap.h"
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <thread>
+#include <vector>
+
+namespace vaobench
+{
+namespace
+{
+
+/// The floor of a pyramid build: one pass, on the same threads, that reads the int16
+/// volume once and writes as many floats as the levels hold (mean and variance of each)
+/// into arrays kept from one repeat to the next, as the pyramid's storage is.
+double TimePyramidFloor(const short* in, std::int64_t n, const std::vector<vao::MomentLevel>& levels, int repeat,
+  int threads)
+{
+  std::int64_t coarse = 0; // voxels of the levels after the first
+  for (std::size_t l = 1; l < levels.size(); ++l)
+    coarse += levels[l].dims[0] * levels[l].dims[1] * levels[l].dims[2];
+  std::vector<float> mean(static_cast<std::size_t>(n)), variance(mean.size());
+  std::vector<float> coarseMean(static_cast<std::size_t>(coarse)), coarseVariance(coarseMean.size());
+  const int team = ResolvedThreads(threads);
+  double best = 1e300;
+  for (int r = 0; r < repeat; ++r)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::thread> workers;
+    for (int t = 0; t < team; ++t)
+    {
+      workers.emplace_back([&, t] {
+        const std::int64_t begin = n * t / team, end = n * (t + 1) / team;
+        for (std::int64_t i = begin; i < end; ++i)
+        {
+          const float v = static_cast<float>(in[i]);
+          mean[i] = v;
+          variance[i] = v * v;
+          if (i < coarse)
+          {
+            coarseMean[i] = v;
+            coarseVariance[i] = v * v;
+          }
+        }
+      });
+    }
+    for (auto& w : workers)
+      w.join();
+    best = std::min(best, Seconds(start));
+  }
+  return best;
+}
+
+/// scipy.ndimage's level-0 blur of v and v^2 on a raw volume (scipy_blur_peer.py);
+/// seconds, or a negative value when it cannot run.
+double RunScipyBlur(const Options& options, const std::string& volumeFile)
+{
+  const std::string command = "/usr/bin/python3 '" + options.scipyBlur + "' '" + volumeFile + "'";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe)
+    return -1.0;
+  char line[256];
+  double seconds = -1.0;
+  while (std::fgets(line, sizeof(line), pipe))
+    if (std::sscanf(line, "scipy_blur %lf", &seconds) == 1)
+      break;
+  pclose(pipe);
+  return seconds;
+}
+
+} // namespace
+
+/// Penner & Mitchell: the pyramid build on generated volumes of the paper's Table 1 sizes,
+/// each against its floor, and on 256^3 against scipy.ndimage's level-0 blur.
+void BenchmarkPyramid(const Options& options)
+{
+  std::printf("\nVariance occlusion maps: pyramid build (4 levels, best of %d, ms; paper Table 1: 170 / 678 / "
+              "1524 ms CPU); the floor reads the volume once and writes the levels' floats once\n",
+    options.repeat);
+  std::printf("  %-22s %8s %10s %8s %14s\n", "volume", "build", "floor", "x floor", "scipy level 0");
+  const int sizes[][3] = { { 256, 256, 256 }, { 512, 512, 256 }, { 512, 512, 512 } };
+  for (const auto& size : sizes)
+  {
+    vtkNew<vtkAmbientOcclusionPhantom> phantom;
+    phantom->SetDimensions(size[0], size[1], size[2]);
+    phantom->Update();
+    vao::VolumeView view;
+    view.data = phantom->GetOutput()->GetScalarPointer();
+    view.type = vao::ScalarType::Int16;
+    view.dims = { size[0], size[1], size[2] };
+    vao::Execution execution;
+    execution.threads = options.threads;
+    std::vector<vao::MomentLevel> pyramid;
+    double best = 1e300;
+    for (int r = 0; r < options.repeat; ++r)
+    {
+      const auto start = std::chrono::steady_clock::now();
+      vao::buildMomentPyramid(view, { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid, execution);
+      best = std::min(best, Seconds(start));
+    }
+    const double floor = TimePyramidFloor(static_cast<const short*>(view.data), view.voxelCount(), pyramid,
+      std::max(3, options.repeat), options.threads);
+    std::printf("  %4d x %4d x %4d int16 %8.1f %10.1f %7.1fx", size[0], size[1], size[2], 1e3 * best, 1e3 * floor,
+      best / floor);
+    if (size[2] == 256 && size[0] == 256)
+    {
+      const std::string raw = "/tmp/vao_pyramid_256x256x256_int16.raw";
+      std::ofstream(raw, std::ios::binary)
+        .write(static_cast<const char*>(view.data), static_cast<std::streamsize>(2 * view.voxelCount()));
+      const double peer = RunScipyBlur(options, raw);
+      std::remove(raw.c_str());
+      if (peer > 0)
+        std::printf(" %9.1f: ours %.1fx faster, the floor %.1fx", 1e3 * peer, peer / best, peer / floor);
+      else
+        std::printf("   (scipy blur peer could not run)");
+    }
+    std::printf("\n");
+  }
+}
+
+/// The surface query rates (what a light move costs once the pyramid is cached) on the
+/// bone surface (400 HU) of a CT head: default parameters, light (0, -1, 1).
+void BenchmarkRelighting(const Options& options, const char* name, vtkImageData* ct)
+{
+  vtkNew<vtkFlyingEdges3D> contour;
+  contour->SetInputData(ct);
+  contour->SetValue(0, 400.0);
+  contour->ComputeNormalsOn();
+  contour->Update();
+  vtkPolyData* bone = contour->GetOutput();
+  const vtkIdType n = bone->GetNumberOfPoints();
+  std::vector<double> points(3 * n), normals(3 * n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    bone->GetPoint(i, &points[3 * i]);
+    bone->GetPointData()->GetNormals()->GetTuple(i, &normals[3 * i]);
+  }
+  vao::VolumeView view;
+  view.data = ct->GetScalarPointer();
+  view.type = vao::ScalarType::Int16;
+  const int* d = ct->GetDimensions();
+  view.dims = { d[0], d[1], d[2] };
+  const double* o = ct->GetOrigin();
+  const double* h = ct->GetSpacing();
+  std::vector<vao::MomentLevel> pyramid;
+  vao::Execution execution;
+  execution.threads = options.threads;
+  vao::buildMomentPyramid(view, { o[0], o[1], o[2] }, { h[0], h[1], h[2] }, {}, pyramid, execution);
+  std::vector<float> ao(n), shadow(n);
+  auto rate = [&](bool occlusion, bool shadows) {
+    double best = 1e300;
+    for (int r = 0; r < options.repeat; ++r)
+    {
+      const auto start = std::chrono::steady_clock::now();
+      if (occlusion)
+        vao::surfaceAmbientOcclusion(pyramid, view, { o[0], o[1], o[2] }, { h[0], h[1], h[2] }, points.data(),
+          normals.data(), n, {}, ao.data(), execution);
+      if (shadows)
+        vao::surfaceShadow(pyramid, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 }, {}, shadow.data(), execution);
+      best = std::min(best, Seconds(start));
+    }
+    return n / best / 1e6;
+  };
+  std::printf("  %s bone surface (400 HU, %lld points): AO %.1f, shadows %.1f, AO + shadows %.1f M points/s\n",
+    name, static_cast<long long>(n), rate(true, false), rate(false, true), rate(true, true));
+}
+
+} // namespace vaobench
