@@ -53,6 +53,12 @@ public:
     return buffer;
   }
 
+  template <class U>
+  void download(U* host, const U* buffer, Index count)
+  {
+    std::copy(buffer, buffer + count, host);
+  }
+
   template <class Kernel>
   void launch(const Kernel& kernel, const char*, double)
   {
@@ -257,14 +263,10 @@ void expectExactLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, con
   ASSERT_TRUE(vao::computeAmbientOcclusion(view, region, p, { cpu.data(), nullptr }).ok);
   const auto g = vao::gpu::geometryFor(dims, region, radius);
   const std::vector<T> block = blockOf(v, dims, region, g);
-  const auto rows = vao::detail::neighbourhoodRowHalfWidths(radius, method == vao::Method::ExactSphere);
-  const std::vector<Index> widths(rows.begin(), rows.end());
-  Index neighbourhood = 0;
-  for (const Index w : widths)
-    neighbourhood += w >= 0 ? 2 * w + 1 : 0;
   std::vector<float> gpu(region.voxelCount(), -1.0f);
   HostExecutor ex;
-  vao::gpu::runExactPasses<T>(ex, block.data(), g, widths.data(), neighbourhood, iso, isoValue, gpu.data(), 0.0,
+  vao::gpu::runExactPasses<T>(ex, block.data(), g,
+    vao::detail::neighbourhoodRowHalfWidths(radius, method == vao::Method::ExactSphere), iso, isoValue, gpu.data(), 0.0,
     1.0, visitsPerLaunch);
   for (size_t i = 0; i < cpu.size(); ++i)
     ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " method " << static_cast<int>(method);
@@ -281,19 +283,9 @@ void expectPyramidLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, c
   ASSERT_TRUE(vao::buildMomentPyramid(viewOf(v, dims), origin, spacing, parameters, cpu).ok);
   vao::detail::PyramidSetup setup;
   ASSERT_TRUE(vao::detail::preparePyramid(viewOf(v, dims), origin, spacing, parameters, setup).ok);
-  std::vector<vao::MomentLevel> gpu(static_cast<size_t>(parameters.levels));
+  std::vector<vao::MomentLevel> gpu;
   HostExecutor ex;
-  const Index d[3] = { dims[0], dims[1], dims[2] };
-  vao::gpu::runPyramid<T>(ex, v.data(), d, setup.firstStep, parameters.levels, setup.shift, &vao::detail::axisWeights,
-    [&](int l, const Index out[3], const float* mean, const float* variance) {
-      vao::MomentLevel& level = gpu[static_cast<size_t>(l)];
-      level.dims = { out[0], out[1], out[2] };
-      const size_t n = static_cast<size_t>(out[0] * out[1] * out[2]);
-      level.mean.resize(n);
-      level.variance.resize(n);
-      std::copy(mean, mean + n, level.mean.data());
-      std::copy(variance, variance + n, level.variance.data());
-    });
+  vao::gpu::runPyramid<T>(ex, v.data(), dims, setup, parameters.levels, gpu);
   vao::detail::setLevelGeometry(gpu, origin, spacing, setup);
   ASSERT_EQ(gpu.size(), cpu.size());
   for (size_t l = 0; l < cpu.size(); ++l)

@@ -107,13 +107,8 @@ void runCounting(const VolumeView& view, const Region& region, const AmbientOccl
   }
   else
   {
-    const std::vector<std::int64_t> rows = detail::neighbourhoodRowHalfWidths(p.radius, p.method == Method::ExactSphere);
-    const std::vector<Index> widths(rows.begin(), rows.end());
-    Index neighbourhood = 0;
-    for (const Index w : widths)
-      neighbourhood += w >= 0 ? 2 * w + 1 : 0;
-    const DeviceBuffer<Index> deviceWidths = ex.upload(widths.data(), static_cast<Index>(widths.size()));
-    gpu::runExactPasses<T>(ex, input.get(), g, deviceWidths.get(), neighbourhood, iso, p.isoValue, openness.get(),
+    gpu::runExactPasses<T>(ex, input.get(), g,
+      detail::neighbourhoodRowHalfWidths(p.radius, p.method == Method::ExactSphere), iso, p.isoValue, openness.get(),
       0.1, 0.95);
   }
   if (timing)
@@ -367,18 +362,7 @@ Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>&
         upload(detail::TypedVolume<T>(volume), whole, g, input.get());
         failIfInjected();
         ex.progress(0.1);
-        levels.resize(static_cast<std::size_t>(parameters.levels));
-        const Index dims[3] = { volume.dims[0], volume.dims[1], volume.dims[2] };
-        gpu::runPyramid<T>(ex, input.get(), dims, setup.firstStep, parameters.levels, setup.shift, &detail::axisWeights,
-          [&](int l, const Index out[3], const float* mean, const float* variance) {
-            MomentLevel& level = levels[static_cast<std::size_t>(l)];
-            level.dims = { out[0], out[1], out[2] };
-            const std::size_t n = static_cast<std::size_t>(out[0] * out[1] * out[2]);
-            level.mean.resize(n);
-            level.variance.resize(n);
-            check(cudaMemcpy(level.mean.data(), mean, n * sizeof(float), cudaMemcpyDeviceToHost), "download");
-            check(cudaMemcpy(level.variance.data(), variance, n * sizeof(float), cudaMemcpyDeviceToHost), "download");
-          });
+        gpu::runPyramid<T>(ex, input.get(), volume.dims, setup, parameters.levels, levels);
         if (timing)
         {
           ex.finish();

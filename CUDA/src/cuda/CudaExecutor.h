@@ -148,6 +148,12 @@ public:
     return buffer;
   }
 
+  template <class U>
+  void download(U* host, const U* device, Index count)
+  {
+    check(cudaMemcpy(host, device, count * sizeof(U), cudaMemcpyDeviceToHost), "download");
+  }
+
   template <class Kernel>
   void launch(const Kernel& kernel, const char* name, double bytes)
   {

@@ -12,6 +12,9 @@
 
 #include "Pipeline.h"
 
+#include <cstdint>
+#include <vector>
+
 namespace vao
 {
 namespace gpu
@@ -59,19 +62,23 @@ struct ExactCount
   }
 };
 
-/// The exact openness of every region voxel into `openness` (neighbourhood: the voxels of
-/// an unclipped neighbourhood), in launches of whole slices and about `visitsPerLaunch`
-/// value visits; progress moves from `from` to `to` between them.
+/// The exact openness of every region voxel into `openness`, over the neighbourhood rows
+/// `rows` (neighbourhoodRowHalfWidths, on the host), in launches of whole slices and about
+/// `visitsPerLaunch` value visits; progress moves from `from` to `to` between them.
 template <class T, class Executor>
-void runExactPasses(Executor& ex, const T* block, const RegionGeometry& g, const Index* halfWidths,
-  Index neighbourhood, bool iso, double isoValue, float* openness, double from, double to,
-  double visitsPerLaunch = 1 << 30)
+void runExactPasses(Executor& ex, const T* block, const RegionGeometry& g, const std::vector<std::int64_t>& rows,
+  bool iso, double isoValue, float* openness, double from, double to, double visitsPerLaunch = 1 << 30)
 {
+  const std::vector<Index> widths(rows.begin(), rows.end());
+  Index neighbourhood = 0; // voxels of an unclipped neighbourhood
+  for (const Index w : widths)
+    neighbourhood += w >= 0 ? 2 * w + 1 : 0;
+  const auto halfWidths = ex.upload(widths.data(), static_cast<Index>(widths.size()));
   const double perSlice = static_cast<double>(g.rx * g.ry) * static_cast<double>(greater<Index>(neighbourhood, 1));
   const Index depth = greater<Index>(1, lower<Index>(g.rz, static_cast<Index>(visitsPerLaunch / perSlice)));
   for (Index z = 0; z < g.rz; z += depth)
   {
-    const ExactCount<T> kernel{ block, g, halfWidths, iso, isoValue, z, lower<Index>(depth, g.rz - z), openness };
+    const ExactCount<T> kernel{ block, g, halfWidths.get(), iso, isoValue, z, lower<Index>(depth, g.rz - z), openness };
     // Bytes: the slab's rows from memory once, the openness written once.
     const double bytes = static_cast<double>(kernel.threads()) * (sizeof(float) + sizeof(T));
     ex.launch(kernel, "exact count", bytes);

@@ -9,7 +9,10 @@
 #pragma once
 
 #include "../BlurTaps.h"
+#include "../cpu/PyramidPlan.h"
 #include "Pipeline.h"
+
+#include <vector>
 
 namespace vao
 {
@@ -153,48 +156,54 @@ void runBlurLevel(Executor& ex, const ZPass& z, const Index in[3], const Index o
   ex.launch(x, "pyramid x", static_cast<double>(x.threads()) * 8.0 + static_cast<double>(y.threads()) * 16.0);
 }
 
-/// Every level of the pyramid from the raw volume `v` (dims, x fastest), as
-/// PyramidBuild.cxx builds it: level 0 keeps every `firstStep`-th voxel, the next ones
-/// every second. `weights(n, outN, step)` gives an axis's clipped weights (axisWeights);
-/// `store(level, outDims, mean, variance)` takes each level's arrays, which then serve as
-/// the next level's source.
-template <class T, class Executor, class Weights, class Store>
-void runPyramid(Executor& ex, const T* v, const Index dims[3], int firstStep, int levels, double shift,
-  const Weights& weights, const Store& store)
+/// Every level of the pyramid from the raw volume `v` (dims, x fastest) into `out`'s
+/// dims, means and variances, as PyramidBuild.cxx builds it (PyramidPlan.h's kept voxels
+/// and clipped weights; the geometry is setLevelGeometry's): level 0 keeps every
+/// setup.firstStep-th voxel, the next ones every second, each built from the one before.
+template <class T, class Executor>
+void runPyramid(Executor& ex, const T* v, const Index3& dims, const detail::PyramidSetup& setup, int levels,
+  std::vector<MomentLevel>& out)
 {
-  Index in[3] = { dims[0], dims[1], dims[2] };
+  out.resize(static_cast<std::size_t>(levels));
+  Index3 in = dims;
   auto sourceMean = ex.template allocate<float>(0);
   auto sourceVariance = ex.template allocate<float>(0);
   for (int l = 0; l < levels; ++l)
   {
-    const int step = l == 0 ? firstStep : 2;
-    Index out[3];
-    for (int a = 0; a < 3; ++a)
-      out[a] = step == 1 ? in[a] : (in[a] + 1) / 2;
-    const auto hx = weights(in[0], out[0], step), hy = weights(in[1], out[1], step), hz = weights(in[2], out[2], step);
+    const int step = l == 0 ? setup.firstStep : 2;
+    const Index3 kept = detail::keptDims(in, step);
+    const Index i[3] = { in[0], in[1], in[2] }, o[3] = { kept[0], kept[1], kept[2] };
+    const auto hx = detail::axisWeights(i[0], o[0], step), hy = detail::axisWeights(i[1], o[1], step),
+               hz = detail::axisWeights(i[2], o[2], step);
     const auto wx = ex.upload(hx.data(), static_cast<Index>(hx.size()));
     const auto wy = ex.upload(hy.data(), static_cast<Index>(hy.size()));
     const auto wz = ex.upload(hz.data(), static_cast<Index>(hz.size()));
-    auto za = ex.template allocate<double>(in[0] * in[1] * out[2]);
-    auto zb = ex.template allocate<double>(in[0] * in[1] * out[2]);
-    auto ya = ex.template allocate<double>(in[0] * out[1] * out[2]);
-    auto yb = ex.template allocate<double>(in[0] * out[1] * out[2]);
-    auto mean = ex.template allocate<float>(out[0] * out[1] * out[2]);
-    auto variance = ex.template allocate<float>(out[0] * out[1] * out[2]);
+    auto za = ex.template allocate<double>(i[0] * i[1] * o[2]);
+    auto zb = ex.template allocate<double>(i[0] * i[1] * o[2]);
+    auto ya = ex.template allocate<double>(i[0] * o[1] * o[2]);
+    auto yb = ex.template allocate<double>(i[0] * o[1] * o[2]);
+    const Index count = o[0] * o[1] * o[2];
+    auto mean = ex.template allocate<float>(count);
+    auto variance = ex.template allocate<float>(count);
+    const double shift = setup.shift;
     if (l == 0)
-      runBlurLevel(ex, BlurRawZ<T>{ v, in[0], in[1], in[2], out[2], step, wz.get(), shift, za.get(), zb.get() }, in,
-        out, step, wy.get(), wx.get(), shift, ya.get(), yb.get(), mean.get(), variance.get());
+      runBlurLevel(ex, BlurRawZ<T>{ v, i[0], i[1], i[2], o[2], step, wz.get(), shift, za.get(), zb.get() }, i, o,
+        step, wy.get(), wx.get(), shift, ya.get(), yb.get(), mean.get(), variance.get());
     else
       runBlurLevel(ex,
-        BlurLevelZ{ sourceMean.get(), sourceVariance.get(), in[0], in[1], in[2], out[2], step, wz.get(), shift, za.get(),
+        BlurLevelZ{ sourceMean.get(), sourceVariance.get(), i[0], i[1], i[2], o[2], step, wz.get(), shift, za.get(),
           zb.get() },
-        in, out, step, wy.get(), wx.get(), shift, ya.get(), yb.get(), mean.get(), variance.get());
-    store(l, out, mean.get(), variance.get());
+        i, o, step, wy.get(), wx.get(), shift, ya.get(), yb.get(), mean.get(), variance.get());
+    MomentLevel& level = out[static_cast<std::size_t>(l)];
+    level.dims = kept;
+    level.mean.resize(static_cast<std::size_t>(count));
+    level.variance.resize(static_cast<std::size_t>(count));
+    ex.download(level.mean.data(), mean.get(), count);
+    ex.download(level.variance.data(), variance.get(), count);
     ex.progress(0.1 + 0.9 * (l + 1) / levels);
-    sourceMean = std::move(mean);
+    sourceMean = std::move(mean); // the next level's source
     sourceVariance = std::move(variance);
-    for (int a = 0; a < 3; ++a)
-      in[a] = out[a];
+    in = kept;
   }
 }
 
