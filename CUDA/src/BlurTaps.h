@@ -39,12 +39,15 @@ VAO_BLUR_INLINE double squareSum(const double* w, const double* d)
 }
 
 /// A level's stored mean and variance from the blurred moments a = E[d], b = E[d^2] about
-/// the shift: mean = a + shift, variance = max(0, b - a^2), as float.
+/// the shift: mean = a + shift, variance = max(0, b - a^2), as float. The clamp follows
+/// the conversion (the same float for every double): a conversion inside a condition can
+/// raise a floating-point exception only on one side, so GCC would keep the branch and
+/// the row loops would not vectorise.
 VAO_BLUR_INLINE void levelMoments(double a, double b, double shift, float& mean, float& variance)
 {
   mean = static_cast<float>(a + shift);
-  const double var = b - a * a;
-  variance = static_cast<float>(var > 0.0 ? var : 0.0);
+  const float var = static_cast<float>(b - a * a);
+  variance = var > 0.0f ? var : 0.0f;
 }
 
 } // namespace blur

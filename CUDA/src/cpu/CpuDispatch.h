@@ -1,10 +1,15 @@
-// Run-time choice between the baseline and an AVX2 + FMA build of one hot loop.
+// Run-time choice between the baseline, an AVX2 + FMA and an AVX-512 build of one hot
+// loop.
 //
 // How: the loop is the always-inlined static run() of a small struct; runRows<Kernel>
-// instantiates it inside a function with the baseline target and inside one with
-// target("avx2,fma"), where the inlined loop is vectorised for that target. Only those
-// leaf functions carry the target, so no inline function of the standard library is ever
-// compiled for AVX2 (which could reach a machine without it through the linker).
+// instantiates it inside a function with the baseline target, one with target("avx2,fma")
+// and one with the AVX-512 subsets of x86-64-v4, where the inlined loop is vectorised for
+// that target (four or eight doubles a vector). Only those leaf functions carry the
+// target, so no inline function of the standard library is ever compiled for AVX2 or
+// AVX-512 (which could reach a machine without it through the linker). The loops have no
+// reductions across lanes and both vector tiers contract the same multiply-adds, so AVX2
+// and AVX-512 give the same numbers bit for bit; the baseline has no FMA and may differ in
+// the last bit (test_simd_tiers.cxx checks both, through limitSimdTier).
 #pragma once
 
 #if defined(__GNUC__) || defined(__clang__)
@@ -31,6 +36,35 @@ namespace vao
 namespace detail
 {
 
+/// The instruction sets a row loop can be built for, in order.
+enum class SimdTier : int
+{
+  Baseline = 0,
+  Avx2 = 1,   // AVX2 + FMA
+  Avx512 = 2, // AVX-512 F, VL, DQ, BW (x86-64-v4)
+};
+
+/// The best tier this processor runs, lowered to the limit set by limitSimdTier.
+SimdTier cpuSimdTier();
+
+/// Caps the tier every later row loop uses (tests: each tier against the others);
+/// SimdTier::Avx512 lifts the cap.
+void limitSimdTier(SimdTier limit);
+
+/// cpuSimdTier(), at most `ceiling`: loops that measured no faster (or slower) in AVX-512
+/// stay on AVX2, which also keeps their code smaller.
+inline SimdTier cpuSimdTierUpTo(SimdTier ceiling)
+{
+  const SimdTier tier = cpuSimdTier();
+  return tier < ceiling ? tier : ceiling;
+}
+
+/// True when the processor runs the AVX2 + FMA versions (the hand-written intrinsics).
+inline bool cpuHasAvx2()
+{
+  return cpuSimdTier() >= SimdTier::Avx2;
+}
+
 template <class Kernel, class... Args>
 void runBaseline(Args... args)
 {
@@ -43,31 +77,41 @@ __attribute__((target("avx2,fma"))) void runAvx2(Args... args)
 {
   Kernel::run(args...);
 }
-#endif
 
-/// True when the processor runs the AVX2 + FMA versions (checked once).
-inline bool cpuHasAvx2()
-{
-#if VAO_HAVE_AVX2_TARGET
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
+// GCC vectorises for 256 bits on AVX-512 unless told to use the full width; Clang takes
+// min_vector_width for the same.
+#if defined(__clang__)
+#define VAO_AVX512_TARGET                                                                                    \
+  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"), min_vector_width(512)))
 #else
-  return false;
+#define VAO_AVX512_TARGET                                                                                    \
+  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma,prefer-vector-width=512")))
 #endif
-}
 
-/// Kernel::run(args...) in the version for this processor.
 template <class Kernel, class... Args>
-void runRows(bool avx2, Args... args)
+VAO_AVX512_TARGET void runAvx512(Args... args)
+{
+  Kernel::run(args...);
+}
+#endif
+
+/// Kernel::run(args...) in the version of `tier` (from cpuSimdTier).
+template <class Kernel, class... Args>
+void runRows(SimdTier tier, Args... args)
 {
 #if VAO_HAVE_AVX2_TARGET
-  if (avx2)
+  if (tier == SimdTier::Avx512)
+  {
+    runAvx512<Kernel>(args...);
+    return;
+  }
+  if (tier == SimdTier::Avx2)
   {
     runAvx2<Kernel>(args...);
     return;
   }
 #endif
-  (void)avx2;
+  (void)tier;
   runBaseline<Kernel>(args...);
 }
 

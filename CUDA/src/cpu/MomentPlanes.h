@@ -181,9 +181,9 @@ private:
     const auto slide = [&](std::int64_t row, std::int64_t in, std::int64_t out) {
       Acc* plane1 = row < 0 ? nullptr : this->Sum.data() + row * nx;
       Acc* plane2 = row < 0 ? nullptr : this->SumSquares.data() + row * nx;
-      runRows<SlideColumns<Acc>>(this->Avx2, plane1, this->Run1.data(), in < 0 ? zeros : this->xbox1(in),
+      runRows<SlideColumns<Acc>>(this->Simd, plane1, this->Run1.data(), in < 0 ? zeros : this->xbox1(in),
         out < 0 ? zeros : this->xbox1(out), nx);
-      runRows<SlideColumns<Acc>>(this->Avx2, plane2, this->Run2.data(), in < 0 ? zeros : this->xbox2(in),
+      runRows<SlideColumns<Acc>>(this->Simd, plane2, this->Run2.data(), in < 0 ? zeros : this->xbox2(in),
         out < 0 ? zeros : this->xbox2(out), nx);
     };
     for (std::int64_t y = std::max<std::int64_t>(0, y0 - r); y <= std::min(ny - 1, y0 + r); ++y)
@@ -218,7 +218,7 @@ private:
     const T* out = leaving >= 0 ? this->Volume.row(y, leaving) + this->Geo.xs.lo * stride : nullptr;
     // The differences of the two rows (a vector loop), then their prefix sums:
     // p[i] = sum of the first i values.
-    runRows<RowDifferences<T, Acc>>(this->Avx2, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
+    runRows<RowDifferences<T, Acc>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
     p1[0] = 0;
     p2[0] = 0;
     for (std::int64_t i = 0; i < span; ++i)
@@ -242,7 +242,7 @@ private:
     };
     for (std::int64_t i = 0; i < first; ++i)
       clamped(i);
-    runRows<WindowDifferences<Acc>>(this->Avx2, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+    runRows<WindowDifferences<Acc>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
     for (std::int64_t i = end; i < nx; ++i)
       clamped(i);
   }
@@ -256,7 +256,7 @@ private:
   std::vector<Acc> XBox1, XBox2;
   std::vector<Acc> Run1, Run2;
   std::vector<Acc> Zeros; // a row outside the volume
-  bool Avx2 = cpuHasAvx2();
+  SimdTier Simd = cpuSimdTierUpTo(SimdTier::Avx2); // AVX-512: no faster (integer sums)
 };
 
 /// Per-slice view handed to the consumer of the moments: everything needed to turn the

@@ -47,7 +47,7 @@ struct RawSource
   Index3 dims() const { return volume.dims; }
   /// a[x] = sum_k w[k] d(x, y, z_k), b[x] = sum_k w[k] s(x, y, z_k) over the 5 rows
   /// (y, z[k]); a clipped tap has weight 0 and a valid (clamped) row.
-  void blurRows(std::int64_t y, const std::int64_t* z, const double* w, double* a, double* b, bool avx2) const
+  void blurRows(std::int64_t y, const std::int64_t* z, const double* w, double* a, double* b, SimdTier simd) const
   {
     const T* rows[kTaps];
     for (int k = 0; k < kTaps; ++k)
@@ -56,9 +56,9 @@ struct RawSource
     }
     const std::int64_t nx = volume.dims[0];
     if (volume.stride == 1)
-      runRows<RawRows<T, true>>(avx2, &rows[0], w, shift, std::int64_t(1), nx, a, b);
+      runRows<RawRows<T, true>>(simd, &rows[0], w, shift, std::int64_t(1), nx, a, b);
     else
-      runRows<RawRows<T, false>>(avx2, &rows[0], w, shift, volume.stride, nx, a, b);
+      runRows<RawRows<T, false>>(simd, &rows[0], w, shift, volume.stride, nx, a, b);
   }
 };
 
@@ -69,7 +69,7 @@ struct LevelSource
   double shift;
 
   Index3 dims() const { return level->dims; }
-  void blurRows(std::int64_t y, const std::int64_t* z, const double* w, double* a, double* b, bool avx2) const
+  void blurRows(std::int64_t y, const std::int64_t* z, const double* w, double* a, double* b, SimdTier simd) const
   {
     const float* means[kTaps];
     const float* variances[kTaps];
@@ -79,7 +79,7 @@ struct LevelSource
       means[k] = level->mean.data() + offset;
       variances[k] = level->variance.data() + offset;
     }
-    runRows<LevelRows>(avx2, &means[0], &variances[0], w, shift, level->dims[0], a, b);
+    runRows<LevelRows>(simd, &means[0], &variances[0], w, shift, level->dims[0], a, b);
   }
 };
 
@@ -92,7 +92,7 @@ struct BlurPlan
   double shift;
   std::vector<double> wx, wy, wz; // clipped weights per kept index (axisWeights)
   double kernel[kTaps];           // the unclipped weights
-  bool avx2 = cpuHasAvx2();
+  SimdTier simd = cpuSimdTier();
 
   BlurPlan(const Index3& n, int keepEvery, double k)
     : in(n)
@@ -152,7 +152,7 @@ public:
         ia[k] = &this->RingA[slot * nx];
         ib[k] = &this->RingB[slot * nx];
       }
-      runRows<ColumnRows>(p.avx2, &ia[0], &ib[0], &p.wy[yo * kTaps], nx, this->RowA.data() + kHalf,
+      runRows<ColumnRows>(p.simd, &ia[0], &ib[0], &p.wy[yo * kTaps], nx, this->RowA.data() + kHalf,
         this->RowB.data() + kHalf);
       const std::int64_t o = (zo * p.out[1] + yo) * p.out[0];
       this->xPass(mean + o, variance + o);
@@ -168,7 +168,7 @@ private:
     {
       const std::int64_t nx = this->Plan.in[0];
       this->Src.blurRows(y, this->ZRows, &this->Plan.wz[zo * kTaps], &this->RingA[slot * nx],
-        &this->RingB[slot * nx], this->Plan.avx2);
+        &this->RingB[slot * nx], this->Plan.simd);
       this->Tags[slot] = y;
     }
     return slot;
@@ -198,9 +198,9 @@ private:
     for (std::int64_t xo = 0; xo < interiorBegin; ++xo)
       clipped(xo);
     if (step == 1)
-      runRows<InteriorRow<1>>(p.avx2, pa, pb, &p.kernel[0], p.shift, interiorBegin, interiorEnd, mean, variance);
+      runRows<InteriorRow<1>>(p.simd, pa, pb, &p.kernel[0], p.shift, interiorBegin, interiorEnd, mean, variance);
     else
-      runRows<InteriorRow<2>>(p.avx2, pa, pb, &p.kernel[0], p.shift, interiorBegin, interiorEnd, mean, variance);
+      runRows<InteriorRow<2>>(p.simd, pa, pb, &p.kernel[0], p.shift, interiorBegin, interiorEnd, mean, variance);
     for (std::int64_t xo = interiorEnd; xo < m; ++xo)
       clipped(xo);
   }

@@ -1,0 +1,136 @@
+// The row loops built for several instruction sets (CpuDispatch.h). The AVX2 and AVX-512
+// builds both contract multiply-adds, so they must give the same numbers bit for bit, on
+// sizes that leave every remainder of a 4- or 8-wide vector; the baseline build has no
+// FMA and rounds a little differently, so it is held to the brute-force reference (and
+// the integer loops to bit equality). On a processor without AVX2 or AVX-512 the higher
+// tiers fall back to the ones below, and the comparisons still run.
+#include "PyramidTestSupport.h"
+
+#include "cpu/CpuDispatch.h"
+
+#include "vao/HistogramCdf.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+using namespace vaotest;
+using vao::detail::SimdTier;
+
+namespace
+{
+
+const SimdTier kTiers[] = { SimdTier::Baseline, SimdTier::Avx2, SimdTier::Avx512 };
+
+/// Lifts the cap again when a test ends, whatever it asserted.
+struct TierCap
+{
+  explicit TierCap(SimdTier limit) { vao::detail::limitSimdTier(limit); }
+  ~TierCap() { vao::detail::limitSimdTier(SimdTier::Avx512); }
+};
+
+template <class T>
+bool sameBits(const std::vector<T>& a, const std::vector<T>& b)
+{
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+template <class T>
+std::vector<vao::MomentLevel> pyramidAtTier(SimdTier tier, const std::vector<T>& v, const vao::Index3& d, bool half)
+{
+  const TierCap cap(tier);
+  vao::PyramidParameters p;
+  p.levels = 3;
+  p.startAtHalfResolution = half;
+  std::vector<vao::MomentLevel> pyramid;
+  const vao::Status s = vao::buildMomentPyramid(viewOf(v, d), { 0, 0, 0 }, { 1, 1, 1 }, p, pyramid);
+  EXPECT_TRUE(s.ok) << s.message;
+  return pyramid;
+}
+
+template <class T>
+void expectPyramidTiersEqual(const vao::Index3& d, double lo, double hi)
+{
+  const auto v = randomVolume<T>(d, lo, hi, 23u);
+  for (bool half : { false, true })
+  {
+    const auto ref = refPyramid(v, d, 3, half, 0.0);
+    for (SimdTier tier : kTiers)
+    {
+      expectLevelsMatch(pyramidAtTier(tier, v, d, half), ref, 0.0, 1e-5, 1e-4, 1e-6);
+    }
+    const auto avx2 = pyramidAtTier(SimdTier::Avx2, v, d, half);
+    const auto avx512 = pyramidAtTier(SimdTier::Avx512, v, d, half);
+    ASSERT_EQ(avx2.size(), 3u);
+    ASSERT_EQ(avx512.size(), avx2.size());
+    for (std::size_t l = 0; l < avx2.size(); ++l)
+    {
+      const auto bits = [](const vao::LevelArray& a) { return std::vector<float>(a.begin(), a.end()); };
+      EXPECT_TRUE(sameBits(bits(avx512[l].mean), bits(avx2[l].mean))) << "mean, level " << l << ", half " << half;
+      EXPECT_TRUE(sameBits(bits(avx512[l].variance), bits(avx2[l].variance)))
+        << "variance, level " << l << ", half " << half;
+    }
+  }
+}
+
+std::vector<float> opennessAtTier(SimdTier tier, const vao::VolumeView& view, vao::Method method,
+  const std::vector<double>& thresholds)
+{
+  const TierCap cap(tier);
+  vao::AmbientOcclusionParameters p;
+  p.method = method;
+  p.radius = { 3, 2, 4 };
+  p.thresholds = thresholds;
+  const vao::Region region = vao::Region::whole(view);
+  std::vector<float> out(static_cast<std::size_t>(region.voxelCount()), -1.0f);
+  const vao::Status s = vao::computeAmbientOcclusion(view, region, p, { out.data(), nullptr });
+  EXPECT_TRUE(s.ok) << s.message;
+  return out;
+}
+
+} // namespace
+
+TEST(SimdTiers, CapLowersTheTier)
+{
+  const SimdTier best = vao::detail::cpuSimdTier();
+  {
+    const TierCap cap(SimdTier::Baseline);
+    EXPECT_EQ(vao::detail::cpuSimdTier(), SimdTier::Baseline);
+    EXPECT_FALSE(vao::detail::cpuHasAvx2());
+  }
+  {
+    const TierCap cap(SimdTier::Avx2);
+    EXPECT_LE(vao::detail::cpuSimdTier(), SimdTier::Avx2);
+    EXPECT_EQ(vao::detail::cpuHasAvx2(), best >= SimdTier::Avx2);
+  }
+  EXPECT_EQ(vao::detail::cpuSimdTier(), best);
+}
+
+TEST(SimdTiers, PyramidLevelsOfEveryTier)
+{
+  // x = 37 and 18: interiors of odd length after the clipped ends, and an x pass with
+  // fewer voxels than one AVX-512 vector at level 2.
+  expectPyramidTiersEqual<std::int16_t>({ 37, 11, 9 }, -1200.0, 3000.0);
+  expectPyramidTiersEqual<std::uint8_t>({ 18, 13, 7 }, 0.0, 255.0);
+  expectPyramidTiersEqual<float>({ 29, 6, 10 }, -3.0, 7.0);
+}
+
+TEST(SimdTiers, BoxEstimatorsAndHistogramEqualTheBaselineBitForBit)
+{
+  const vao::Index3 d = { 27, 14, 11 };
+  const auto v = randomVolume<std::int16_t>(d, -1000.0, 2000.0, 5u);
+  const vao::VolumeView view = viewOf(v, d);
+  std::vector<double> thresholds;
+  ASSERT_TRUE(vao::volumeThresholds(view, 16, thresholds).ok);
+  // The box sums and the histogram's channels are integer loops; the estimators that run
+  // on those tiers take them and must agree.
+  for (vao::Method method : { vao::Method::Chebyshev, vao::Method::HistogramCdf })
+  {
+    const auto baseline = opennessAtTier(SimdTier::Baseline, view, method, thresholds);
+    for (SimdTier tier : kTiers)
+    {
+      EXPECT_TRUE(sameBits(opennessAtTier(tier, view, method, thresholds), baseline))
+        << "method " << int(method) << ", tier " << int(tier);
+    }
+  }
+}
