@@ -88,6 +88,33 @@ std::vector<float> opennessAtTier(SimdTier tier, const vao::VolumeView& view, va
   return out;
 }
 
+/// The box statistics (with the extrema: van Herk rows on vectors) at one tier.
+template <class T>
+std::vector<std::vector<double>> boxStatisticsAtTier(SimdTier tier, const std::vector<T>& v, const vao::Index3& d)
+{
+  const TierCap cap(tier);
+  const vao::Region region{ { 1, 2, 0 }, { d[0] - 2, d[1] - 3, d[2] - 1 } };
+  std::vector<std::vector<double>> fields(5, std::vector<double>(static_cast<std::size_t>(region.voxelCount())));
+  const vao::BoxStatisticsOutput out{ fields[0].data(), fields[1].data(), fields[2].data(), fields[3].data(),
+    fields[4].data() };
+  const vao::Status s = vao::computeBoxStatistics(viewOf(v, d), region, { 4, 2, 3 }, out);
+  EXPECT_TRUE(s.ok) << s.message;
+  return fields;
+}
+
+template <class T>
+void expectBoxStatisticsTiersEqual(const vao::Index3& d, double lo, double hi)
+{
+  const auto v = randomVolume<T>(d, lo, hi, 31u);
+  const auto baseline = boxStatisticsAtTier(SimdTier::Baseline, v, d);
+  for (SimdTier tier : kTiers)
+  {
+    const auto fields = boxStatisticsAtTier(tier, v, d);
+    for (std::size_t f = 0; f < fields.size(); ++f)
+      EXPECT_TRUE(sameBits(fields[f], baseline[f])) << "field " << f << ", tier " << int(tier);
+  }
+}
+
 } // namespace
 
 TEST(SimdTiers, CapLowersTheTier)
@@ -113,6 +140,15 @@ TEST(SimdTiers, PyramidLevelsOfEveryTier)
   expectPyramidTiersEqual<std::int16_t>({ 37, 11, 9 }, -1200.0, 3000.0);
   expectPyramidTiersEqual<std::uint8_t>({ 18, 13, 7 }, 0.0, 255.0);
   expectPyramidTiersEqual<float>({ 29, 6, 10 }, -3.0, 7.0);
+}
+
+TEST(SimdTiers, BoxStatisticsAndExtremaEqualTheBaselineBitForBit)
+{
+  // 37 rows: two groups of 16 in the x pass of the extrema and a remainder of 5.
+  expectBoxStatisticsTiersEqual<std::int16_t>({ 29, 40, 9 }, -1200.0, 3000.0);
+  expectBoxStatisticsTiersEqual<std::uint8_t>({ 18, 21, 7 }, 0.0, 255.0);
+  expectBoxStatisticsTiersEqual<float>({ 23, 19, 6 }, -3.0, 7.0);
+  expectBoxStatisticsTiersEqual<double>({ 9, 35, 5 }, -1e6, 1e6);
 }
 
 TEST(SimdTiers, BoxEstimatorsAndHistogramEqualTheBaselineBitForBit)

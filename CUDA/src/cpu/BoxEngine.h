@@ -30,6 +30,9 @@ struct BoxExtrema
   T maximum(std::int64_t regionIndex) const { return this->maximumPlanes[this->offset + regionIndex]; }
 };
 
+/// Rows of a slice whose x passes run together (one AVX2 vector of 16-bit values).
+constexpr std::int64_t kExtremumRows = 16;
+
 /// Three van Herk passes: x then y within each slice the region reads (into planes of
 /// region width), then z along each region row, written back in place. Progress: slices,
 /// then rows.
@@ -53,23 +56,39 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
       const std::int64_t span = geometry.xs.size();
       const std::int64_t rows = geometry.ys.size();
-      std::vector<T> row(static_cast<std::size_t>(span));
+      // The x pass takes kExtremumRows rows at once, transposed so that the rows are the
+      // lanes: the recurrence runs along x on vectors instead of one value at a time.
+      std::vector<T> lanes(static_cast<std::size_t>(span * kExtremumRows));
+      std::vector<T> lanesMin(static_cast<std::size_t>(nx * kExtremumRows));
+      std::vector<T> lanesMax(lanesMin.size());
       std::vector<T> xMin(static_cast<std::size_t>(rows * nx));
       std::vector<T> xMax(static_cast<std::size_t>(rows * nx));
       ExtremumScratch<T> scratch;
+      const std::int64_t x0 = region.begin[0] - geometry.xs.lo;
       for (std::int64_t s = begin; s < end && !progress.stopped(); ++s)
       {
         const std::int64_t z = geometry.zs.lo + s;
-        for (std::int64_t j = 0; j < rows; ++j)
+        for (std::int64_t j0 = 0; j0 < rows; j0 += kExtremumRows)
         {
-          const T* src = volume.row(geometry.ys.lo + j, z) + geometry.xs.lo * volume.stride;
-          for (std::int64_t i = 0; i < span; ++i)
+          const std::int64_t m = std::min(kExtremumRows, rows - j0);
+          for (std::int64_t k = 0; k < m; ++k)
           {
-            row[i] = src[i * volume.stride];
+            const T* src = volume.row(geometry.ys.lo + j0 + k, z) + geometry.xs.lo * volume.stride;
+            for (std::int64_t i = 0; i < span; ++i)
+            {
+              lanes[i * m + k] = src[i * volume.stride];
+            }
           }
-          const std::int64_t x0 = region.begin[0] - geometry.xs.lo;
-          slidingMinMax(row.data(), row.data(), span, 1, geometry.radius.x, x0, nx, &xMin[j * nx],
-            &xMax[j * nx], scratch);
+          slidingMinMax(lanes.data(), lanes.data(), span, m, geometry.radius.x, x0, nx, lanesMin.data(),
+            lanesMax.data(), scratch);
+          for (std::int64_t k = 0; k < m; ++k)
+          {
+            for (std::int64_t o = 0; o < nx; ++o)
+            {
+              xMin[(j0 + k) * nx + o] = lanesMin[o * m + k];
+              xMax[(j0 + k) * nx + o] = lanesMax[o * m + k];
+            }
+          }
         }
         // y pass: whole rows are the lanes.
         const std::int64_t y0 = region.begin[1] - geometry.ys.lo;
@@ -85,30 +104,16 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
 
   return parallelFor(region.size[1], threads, threads, stageExecution(execution, double(slices) / work, 1.0),
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
-      std::vector<T> lanesMin(static_cast<std::size_t>(slices * nx));
-      std::vector<T> lanesMax(static_cast<std::size_t>(slices * nx));
-      std::vector<T> outMin(static_cast<std::size_t>(region.size[2] * nx));
-      std::vector<T> outMax(static_cast<std::size_t>(region.size[2] * nx));
       ExtremumScratch<T> scratch;
       const std::int64_t z0 = region.begin[2] - geometry.zs.lo;
       for (std::int64_t y = begin; y < end && !progress.stopped(); ++y)
       {
-        // z pass: row y of every slice, gathered, is a sequence of lane vectors.
-        for (std::int64_t s = 0; s < slices; ++s)
-        {
-          const std::int64_t from = s * plane + y * nx;
-          std::copy(&planeMin[from], &planeMin[from] + nx, &lanesMin[s * nx]);
-          std::copy(&planeMax[from], &planeMax[from] + nx, &lanesMax[s * nx]);
-        }
-        slidingMinMax(lanesMin.data(), lanesMax.data(), slices, nx, geometry.radius.z, z0,
-          region.size[2], outMin.data(), outMax.data(), scratch);
-        // In place: this row of every slice was gathered above.
-        for (std::int64_t k = 0; k < region.size[2]; ++k)
-        {
-          const std::int64_t to = result.offset + k * plane + y * nx;
-          std::copy(&outMin[k * nx], &outMin[k * nx] + nx, &planeMin[to]);
-          std::copy(&outMax[k * nx], &outMax[k * nx] + nx, &planeMax[to]);
-        }
+        // z pass: row y of every slice is a sequence of lane vectors, a plane apart; the
+        // results go back in place (the pass reads all of its input first).
+        T* rowMin = &planeMin[y * nx];
+        T* rowMax = &planeMax[y * nx];
+        slidingMinMax(rowMin, rowMax, slices, nx, geometry.radius.z, z0, region.size[2], rowMin + result.offset,
+          rowMax + result.offset, scratch, plane, plane);
         progress.advance();
       }
     });
