@@ -74,13 +74,15 @@ void expectPyramidTiersEqual(const vao::Index3& d, double lo, double hi)
 }
 
 std::vector<float> opennessAtTier(SimdTier tier, const vao::VolumeView& view, vao::Method method,
-  const std::vector<double>& thresholds)
+  const std::vector<double>& thresholds, vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0.0)
 {
   const TierCap cap(tier);
   vao::AmbientOcclusionParameters p;
   p.method = method;
   p.radius = { 3, 2, 4 };
   p.thresholds = thresholds;
+  p.queryMode = query;
+  p.isoValue = iso;
   const vao::Region region = vao::Region::whole(view);
   std::vector<float> out(static_cast<std::size_t>(region.voxelCount()), -1.0f);
   const vao::Status s = vao::computeAmbientOcclusion(view, region, p, { out.data(), nullptr });
@@ -151,6 +153,18 @@ TEST(SimdTiers, BoxStatisticsAndExtremaEqualTheBaselineBitForBit)
   expectBoxStatisticsTiersEqual<double>({ 9, 35, 5 }, -1e6, 1e6);
 }
 
+/// The openness of `method` at every tier equals the baseline's, bit for bit.
+void expectOpennessTiersEqual(const vao::VolumeView& view, vao::Method method, const std::vector<double>& thresholds,
+  vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0.0)
+{
+  const auto baseline = opennessAtTier(SimdTier::Baseline, view, method, thresholds, query, iso);
+  for (SimdTier tier : kTiers)
+  {
+    EXPECT_TRUE(sameBits(opennessAtTier(tier, view, method, thresholds, query, iso), baseline))
+      << "method " << int(method) << ", query " << int(query) << ", iso " << iso << ", tier " << int(tier);
+  }
+}
+
 TEST(SimdTiers, BoxEstimatorsAndHistogramEqualTheBaselineBitForBit)
 {
   const vao::Index3 d = { 27, 14, 11 };
@@ -160,13 +174,22 @@ TEST(SimdTiers, BoxEstimatorsAndHistogramEqualTheBaselineBitForBit)
   ASSERT_TRUE(vao::volumeThresholds(view, 16, thresholds).ok);
   // The box sums and the histogram's channels are integer loops; the estimators that run
   // on those tiers take them and must agree.
-  for (vao::Method method : { vao::Method::Chebyshev, vao::Method::HistogramCdf })
-  {
-    const auto baseline = opennessAtTier(SimdTier::Baseline, view, method, thresholds);
-    for (SimdTier tier : kTiers)
-    {
-      EXPECT_TRUE(sameBits(opennessAtTier(tier, view, method, thresholds), baseline))
-        << "method " << int(method) << ", tier " << int(tier);
-    }
-  }
+  expectOpennessTiersEqual(view, vao::Method::Chebyshev, thresholds);
+  expectOpennessTiersEqual(view, vao::Method::HistogramCdf, thresholds);
+}
+
+TEST(SimdTiers, HistogramCdfOfEveryQueryCaseEqualsTheBaselineBitForBit)
+{
+  // Iso queries below the first threshold, on one, between two, on and past the last;
+  // the smoothed query lands anywhere in between.
+  const vao::Index3 d = { 23, 9, 8 };
+  const auto v = randomVolume<std::int16_t>(d, -500.0, 900.0, 9u);
+  const vao::VolumeView view = viewOf(v, d);
+  std::vector<double> thresholds;
+  ASSERT_TRUE(vao::volumeThresholds(view, 16, thresholds).ok);
+  const double isoValues[] = { thresholds.front() - 1.0, thresholds[3], 0.5 * (thresholds[5] + thresholds[6]),
+    thresholds.back(), thresholds.back() + 1.0 };
+  for (double iso : isoValues)
+    expectOpennessTiersEqual(view, vao::Method::HistogramCdf, thresholds, vao::QueryMode::IsoValue, iso);
+  expectOpennessTiersEqual(view, vao::Method::HistogramCdf, thresholds, vao::QueryMode::SmoothedValue);
 }
