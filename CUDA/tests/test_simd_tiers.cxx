@@ -153,6 +153,22 @@ TEST(SimdTiers, BoxStatisticsAndExtremaEqualTheBaselineBitForBit)
   expectBoxStatisticsTiersEqual<double>({ 9, 35, 5 }, -1e6, 1e6);
 }
 
+/// A random int16 volume of `d` and its Histogram CDF thresholds (16 bins).
+struct ScanWithThresholds
+{
+  std::vector<std::int16_t> values;
+  vao::VolumeView view;
+  std::vector<double> thresholds;
+
+  ScanWithThresholds(const vao::Index3& d, double lo, double hi, unsigned seed)
+    : values(randomVolume<std::int16_t>(d, lo, hi, seed))
+    , view(viewOf(values, d))
+  {
+    const vao::Status s = vao::volumeThresholds(this->view, 16, this->thresholds);
+    EXPECT_TRUE(s.ok) << s.message;
+  }
+};
+
 /// The openness of `method` at every tier equals the baseline's, bit for bit.
 void expectOpennessTiersEqual(const vao::VolumeView& view, vao::Method method, const std::vector<double>& thresholds,
   vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0.0)
@@ -167,29 +183,23 @@ void expectOpennessTiersEqual(const vao::VolumeView& view, vao::Method method, c
 
 TEST(SimdTiers, BoxEstimatorsAndHistogramEqualTheBaselineBitForBit)
 {
-  const vao::Index3 d = { 27, 14, 11 };
-  const auto v = randomVolume<std::int16_t>(d, -1000.0, 2000.0, 5u);
-  const vao::VolumeView view = viewOf(v, d);
-  std::vector<double> thresholds;
-  ASSERT_TRUE(vao::volumeThresholds(view, 16, thresholds).ok);
+  const ScanWithThresholds scan({ 27, 14, 11 }, -1000.0, 2000.0, 5u);
+  ASSERT_FALSE(scan.thresholds.empty());
   // The box sums and the histogram's channels are integer loops; the estimators that run
   // on those tiers take them and must agree.
-  expectOpennessTiersEqual(view, vao::Method::Chebyshev, thresholds);
-  expectOpennessTiersEqual(view, vao::Method::HistogramCdf, thresholds);
+  expectOpennessTiersEqual(scan.view, vao::Method::Chebyshev, scan.thresholds);
+  expectOpennessTiersEqual(scan.view, vao::Method::HistogramCdf, scan.thresholds);
 }
 
 TEST(SimdTiers, HistogramCdfOfEveryQueryCaseEqualsTheBaselineBitForBit)
 {
   // Iso queries below the first threshold, on one, between two, on and past the last;
   // the smoothed query lands anywhere in between.
-  const vao::Index3 d = { 23, 9, 8 };
-  const auto v = randomVolume<std::int16_t>(d, -500.0, 900.0, 9u);
-  const vao::VolumeView view = viewOf(v, d);
-  std::vector<double> thresholds;
-  ASSERT_TRUE(vao::volumeThresholds(view, 16, thresholds).ok);
-  const double isoValues[] = { thresholds.front() - 1.0, thresholds[3], 0.5 * (thresholds[5] + thresholds[6]),
-    thresholds.back(), thresholds.back() + 1.0 };
+  const ScanWithThresholds scan({ 23, 9, 8 }, -500.0, 900.0, 9u);
+  const std::vector<double>& t = scan.thresholds;
+  ASSERT_EQ(t.size(), 16u);
+  const double isoValues[] = { t.front() - 1.0, t[3], 0.5 * (t[5] + t[6]), t.back(), t.back() + 1.0 };
   for (double iso : isoValues)
-    expectOpennessTiersEqual(view, vao::Method::HistogramCdf, thresholds, vao::QueryMode::IsoValue, iso);
-  expectOpennessTiersEqual(view, vao::Method::HistogramCdf, thresholds, vao::QueryMode::SmoothedValue);
+    expectOpennessTiersEqual(scan.view, vao::Method::HistogramCdf, t, vao::QueryMode::IsoValue, iso);
+  expectOpennessTiersEqual(scan.view, vao::Method::HistogramCdf, t, vao::QueryMode::SmoothedValue);
 }

@@ -52,7 +52,7 @@ SimdTier cpuSimdTier();
 void limitSimdTier(SimdTier limit);
 
 /// cpuSimdTier(), at most `ceiling`: loops that measured no faster (or slower) in AVX-512
-/// stay on AVX2, which also keeps their code smaller.
+/// stay on AVX2.
 inline SimdTier cpuSimdTierUpTo(SimdTier ceiling)
 {
   const SimdTier tier = cpuSimdTier();
