@@ -65,7 +65,9 @@ time.sleep(86400)' "$1" 2>/dev/null &
 start_xvfb() {
   rm -f "$tmp/displayfd"
   mkfifo "$tmp/displayfd"
-  Xvfb -displayfd 3 -nolisten tcp -screen 0 "$screen" 3>"$tmp/displayfd" 2>"$tmp/xvfb.log" &
+  # -noreset: by default Xvfb resets when its last client leaves, as the probe below does;
+  # a client connecting during that reset (slower under load) is refused.
+  Xvfb -displayfd 3 -nolisten tcp -noreset -screen 0 "$screen" 3>"$tmp/displayfd" 2>"$tmp/xvfb.log" &
   xvfb_pid=$!
   display=""
   # The read ends at Xvfb's newline, or empty at EOF if Xvfb exits first.
