@@ -23,6 +23,7 @@
 #include "SweepScene.h"
 #include "vao/AmbientOcclusion.h"
 #include "vao/OcclusionSweeping.h"
+#include "vao/Storage.h"
 
 
 #include "vtkExtractVOI.h"
@@ -95,7 +96,8 @@ double TimeStatistics(vtkImageData* image, int radius, int repeat, int threads)
 }
 
 /// The floor: one pass that reads the int16 input once and writes a fresh float32 array
-/// once (first touch included, as the filter's output), on the same number of threads.
+/// once (first touch included, in the storage the filter's output gets), on the same
+/// number of threads.
 double TimeFloor(vtkImageData* image, int repeat, int threads)
 {
   const auto* in = static_cast<const short*>(image->GetScalarPointer());
@@ -105,7 +107,8 @@ double TimeFloor(vtkImageData* image, int repeat, int threads)
   for (int r = 0; r < repeat; ++r)
   {
     const auto start = std::chrono::steady_clock::now();
-    std::unique_ptr<float[]> out(new float[static_cast<size_t>(n)]); // untouched, like a new array
+    vao::StorageArray<float> out; // untouched, like a new output array
+    out.resize(static_cast<std::size_t>(n));
     std::vector<std::thread> workers;
     for (int t = 0; t < team; ++t)
     {

@@ -5,6 +5,8 @@
 #include "vtkDataObject.h"
 #include "vtkObject.h"
 
+#include "vao/Storage.h"
+
 #include <cstdlib>
 #include <iomanip>
 #include <new>
@@ -16,7 +18,8 @@ namespace vtkAmbientOcclusionMemory
 void Allocate(vtkDataArray* array, vtkIdType tuples, const std::string& what)
 {
   // Not SetNumberOfTuples: a VTK built without NDEBUG (Debian's) aborts when that fails.
-  // The block is ours to allocate, then the array's (freed with free()).
+  // The block is ours to allocate (vao/Storage.h: huge pages where large), then the
+  // array's, freed with freeStorage.
   const vtkIdType values = tuples * array->GetNumberOfComponents();
   if (values <= 0)
   {
@@ -24,12 +27,13 @@ void Allocate(vtkDataArray* array, vtkIdType tuples, const std::string& what)
     return;
   }
   const double bytes = static_cast<double>(values) * array->GetDataTypeSize();
-  void* block = bytes < 9e18 ? std::malloc(static_cast<std::size_t>(bytes)) : nullptr;
+  void* block = bytes < 9e18 ? vao::detail::allocateStorage(static_cast<std::size_t>(bytes)) : nullptr;
   if (!block)
   {
     throw Shortage{ bytes, what };
   }
-  array->SetVoidArray(block, values, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+  array->SetVoidArray(block, values, 0, vtkAbstractArray::VTK_DATA_ARRAY_USER_DEFINED);
+  array->SetArrayFreeFunction(&vao::detail::freeStorage);
 }
 
 void Reserve(double bytes, const std::string& what)

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "vao/AmbientOcclusion.h"
+#include "vao/Storage.h"
 
 #include <array>
 #include <cstddef>
@@ -18,91 +19,11 @@
 namespace vao
 {
 
-namespace detail
-{
-/// Storage of the level arrays: large blocks are aligned to 2 MiB and, on Linux, advised
-/// to use transparent huge pages (a 512^3 level 0 is 1 GiB: 4 KiB page faults alone would
-/// cost more than the blur). Freed with freeLevelStorage.
-void* allocateLevelStorage(std::size_t bytes);
-void freeLevelStorage(void* block) noexcept;
-
-} // namespace detail
-
 /// The value of a bound that is not set (MomentLevel::wholeBounds).
 constexpr double kUnsetBound = std::numeric_limits<double>::quiet_NaN();
 
-/// A level's array of floats in level storage. resize leaves the elements uninitialised:
-/// the pyramid builder writes every one, in parallel, so a fresh array is first touched by
-/// the threads that fill it instead of by one serial zero-fill. release() hands the block
-/// to a new owner (a vtkFloatArray, without a copy), who frees it with freeLevelStorage.
-class LevelArray
-{
-public:
-  LevelArray() = default;
-  LevelArray(const LevelArray& other) { *this = other; }
-  LevelArray(LevelArray&& other) noexcept { this->swap(other); }
-  ~LevelArray() { detail::freeLevelStorage(this->Data); }
-  LevelArray& operator=(const LevelArray& other)
-  {
-    if (this != &other)
-    {
-      this->resize(other.Size);
-      for (std::size_t i = 0; i < other.Size; ++i)
-        this->Data[i] = other.Data[i];
-    }
-    return *this;
-  }
-  LevelArray& operator=(LevelArray&& other) noexcept
-  {
-    LevelArray moved(std::move(other));
-    this->swap(moved);
-    return *this;
-  }
-  void swap(LevelArray& other) noexcept
-  {
-    std::swap(this->Data, other.Data);
-    std::swap(this->Size, other.Size);
-  }
-  /// Keeps the block when the size is unchanged (a rebuild of the same pyramid).
-  void resize(std::size_t n)
-  {
-    if (n == this->Size)
-      return;
-    float* block = n > 0 ? static_cast<float*>(detail::allocateLevelStorage(n * sizeof(float))) : nullptr;
-    if (n > 0 && !block)
-      throw std::bad_alloc();
-    detail::freeLevelStorage(this->Data);
-    this->Data = block;
-    this->Size = n;
-  }
-  void assign(std::size_t n, float value)
-  {
-    this->resize(n);
-    for (std::size_t i = 0; i < n; ++i)
-      this->Data[i] = value;
-  }
-  float* release() noexcept
-  {
-    float* block = this->Data;
-    this->Data = nullptr;
-    this->Size = 0;
-    return block;
-  }
-  std::size_t size() const noexcept { return this->Size; }
-  bool empty() const noexcept { return this->Size == 0; }
-  float* data() noexcept { return this->Data; }
-  const float* data() const noexcept { return this->Data; }
-  float& operator[](std::size_t i) noexcept { return this->Data[i]; }
-  const float& operator[](std::size_t i) const noexcept { return this->Data[i]; }
-  float* begin() noexcept { return this->Data; }
-  float* end() noexcept { return this->Data + this->Size; }
-  const float* begin() const noexcept { return this->Data; }
-  const float* end() const noexcept { return this->Data + this->Size; }
-
-private:
-  float* Data = nullptr;
-  std::size_t Size = 0;
-};
+/// A level's floats, in storage (vao/Storage.h): filled by the pyramid builder's threads.
+using LevelArray = StorageArray<float>;
 
 /// One level of the pyramid: blurred first moment (the mean) and variance, x fastest.
 struct MomentLevel

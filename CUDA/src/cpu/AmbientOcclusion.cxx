@@ -6,6 +6,7 @@
 #include "ExactReference.h"
 #include "HistogramChannels.h"
 #include "SmoothedQuery.h"
+#include "vao/Storage.h"
 
 #include "vao/Validation.h"
 
@@ -108,7 +109,7 @@ Status ambientOcclusion(const VolumeView& volume, const Region& region,
   const bool separate = output.openness && !isSeparableMethod(parameters.method);
   const double queryEnd = smoothed ? 0.2 : 0.0;
   const double opennessEnd = separate ? (output.variance ? 0.9 : 1.0) : queryEnd;
-  std::vector<double> query;
+  StorageArray<double> query; // computeSmoothedQuery writes every voxel
   if (smoothed && output.openness)
   {
     query.resize(static_cast<std::size_t>(region.voxelCount()));

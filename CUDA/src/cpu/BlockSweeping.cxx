@@ -81,7 +81,7 @@ struct BlockSweeper::State
   double maskCount = 0.0;
   bool initialised = false;
   bool surfaceFound = false;
-  std::vector<float> distance; // storage-sized, ghosts included
+  StorageArray<float> distance; // storage-sized, ghosts included
   FixedMask fixed;
   VisibilityStore vis; // all eight octants, kept
 

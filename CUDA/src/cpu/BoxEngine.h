@@ -7,6 +7,7 @@
 #include "MomentPlanes.h"
 #include "MomentRows.h"
 #include "SlidingExtremum.h"
+#include "vao/Storage.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -22,8 +23,8 @@ namespace detail
 template <class T>
 struct BoxExtrema
 {
-  std::vector<T> minimumPlanes;
-  std::vector<T> maximumPlanes;
+  StorageArray<T> minimumPlanes; // uninitialised: the y pass writes every plane whole
+  StorageArray<T> maximumPlanes;
   std::int64_t offset = 0;
 
   T minimum(std::int64_t regionIndex) const { return this->minimumPlanes[this->offset + regionIndex]; }
@@ -44,8 +45,8 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
   const std::int64_t nx = region.size[0];
   const std::int64_t plane = geometry.planeSize();
   const std::int64_t slices = geometry.zs.size();
-  std::vector<T>& planeMin = result.minimumPlanes;
-  std::vector<T>& planeMax = result.maximumPlanes;
+  StorageArray<T>& planeMin = result.minimumPlanes;
+  StorageArray<T>& planeMax = result.maximumPlanes;
   planeMin.resize(static_cast<std::size_t>(slices * plane));
   planeMax.resize(static_cast<std::size_t>(slices * plane));
   result.offset = (region.begin[2] - geometry.zs.lo) * plane;

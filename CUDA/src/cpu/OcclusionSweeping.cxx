@@ -74,7 +74,7 @@ Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& 
   const SweepLayout layout = SweepLayout::wholeVolume(volume.dims, inSweepUnits(spacing));
   const Grid& grid = layout.storage;
   const int threads = detail::resolveThreadCount(execution.threads);
-  std::vector<float> ownDistance;
+  StorageArray<float> ownDistance; // initialiseDistance writes every voxel
   float* distance = out.signedDistance;
   if (!distance)
   {

@@ -1,8 +1,9 @@
-// Storage of the pyramid levels: large blocks aligned to 2 MiB and advised to use
-// transparent huge pages (see allocateLevelStorage in vao/VarianceOcclusionMap.h).
-#include "vao/VarianceOcclusionMap.h"
+// Storage of the large arrays: blocks aligned to 2 MiB and advised to use transparent huge
+// pages (see vao/Storage.h).
+#include "vao/Storage.h"
 
 #include <cstdlib>
+#include <limits>
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -16,9 +17,13 @@ namespace vao
 namespace detail
 {
 
-void* allocateLevelStorage(std::size_t bytes)
+void* allocateStorage(std::size_t bytes)
 {
   constexpr std::size_t kHugePage = std::size_t(2) << 20;
+  if (bytes > std::numeric_limits<std::size_t>::max() - kHugePage)
+  {
+    return nullptr; // no such block; rounding it up to whole huge pages would wrap
+  }
 #if defined(_WIN32)
   return _aligned_malloc(bytes > 0 ? bytes : 1, bytes < kHugePage ? 64 : kHugePage);
 #else
@@ -38,7 +43,7 @@ void* allocateLevelStorage(std::size_t bytes)
 #endif
 }
 
-void freeLevelStorage(void* block) noexcept
+void freeStorage(void* block) noexcept
 {
 #if defined(_WIN32)
   _aligned_free(block);

@@ -342,8 +342,11 @@ Status runPasses(const SweepLayout& layout, const SweepParameters& p, float* dis
   {
     if (vis.sum)
     {
-      // V is recomputed in every pass
-      std::fill(vis.sum, vis.sum + layout.storage.count, 0.0f);
+      // V is recomputed in every pass. The workers zero it: in the first pass this is the
+      // output's first touch.
+      detail::parallelFor(layout.storage.count, 4 * threads, threads, [&](std::int64_t begin, std::int64_t end) {
+        std::fill(vis.sum + begin, vis.sum + end, 0.0f);
+      });
     }
     RowResult total;
     for (int s = 0; s < 8; ++s)

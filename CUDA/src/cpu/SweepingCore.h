@@ -12,6 +12,7 @@
 #pragma once
 
 #include "vao/OcclusionSweeping.h"
+#include "vao/Storage.h"
 
 #include <array>
 #include <cmath>
@@ -77,7 +78,7 @@ struct VisibilityStore
 {
   std::array<bool, 8> computed{};
   std::array<float*, 8> field{}; // when kept, storage-sized
-  std::vector<float> storage;
+  StorageArray<float> storage; // uninitialised: every sweep writes all of its field
   // When not kept, a ring of planes. Plane k of a sweep overwrites the slot of plane
   // k - ringPlanes, which must be finished and no longer read (as the upwind plane of
   // k - ringPlanes + 1). With T threads the planes in flight are at most the last T (thread

@@ -1,0 +1,107 @@
+// The storage of the large arrays (vao/Storage.h): uninitialised arrays that keep their
+// block, hand it over, refuse sizes they cannot hold, and ask Linux for huge pages.
+#include "vao/Storage.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <fstream>
+#include <limits>
+#include <new>
+#include <sstream>
+#include <string>
+
+namespace
+{
+
+constexpr std::size_t kHugePage = std::size_t(2) << 20;
+
+TEST(Storage, LargeBlocksAreAlignedToAHugePage)
+{
+  vao::StorageArray<float> a;
+  a.resize(3 * kHugePage / sizeof(float) + 5);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(a.data()) % kHugePage, 0u);
+  vao::StorageArray<double> small;
+  small.resize(3);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % alignof(double), 0u);
+}
+
+TEST(Storage, ResizeKeepsTheBlockOfTheSameSizeAndCopiesAreDeep)
+{
+  vao::StorageArray<int> a;
+  a.assign(1000, 7);
+  const int* block = a.data();
+  a.resize(1000);
+  EXPECT_EQ(a.data(), block);
+  vao::StorageArray<int> b(a);
+  ASSERT_EQ(b.size(), 1000u);
+  EXPECT_NE(b.data(), a.data());
+  b[999] = 8;
+  EXPECT_EQ(a[999], 7);
+  vao::StorageArray<int> c(std::move(b));
+  EXPECT_TRUE(b.empty());
+  EXPECT_EQ(c[999], 8);
+  EXPECT_EQ(c[0], 7);
+  int* owned = c.release();
+  EXPECT_TRUE(c.empty());
+  EXPECT_EQ(owned[1], 7);
+  vao::detail::freeStorage(owned);
+  c.resize(0);
+  EXPECT_EQ(c.data(), nullptr);
+}
+
+TEST(Storage, SizesBeyondMemoryThrowAndLeaveTheArray)
+{
+  vao::StorageArray<double> a;
+  a.assign(4, 1.5);
+  // n * sizeof(double) overflows size_t, and the block rounded up to whole huge pages
+  // would: neither may wrap to a small block. (Both are refused before the allocator,
+  // which AddressSanitizer would stop on a request this large.)
+  EXPECT_THROW(a.resize(std::numeric_limits<std::size_t>::max() / 4), std::bad_alloc);
+  ASSERT_EQ(a.size(), 4u);
+  EXPECT_EQ(a[3], 1.5);
+  EXPECT_EQ(vao::detail::allocateStorage(std::numeric_limits<std::size_t>::max() - 4096), nullptr);
+}
+
+#if defined(__linux__)
+/// The "THPeligible" line of the mapping that holds `address` in /proc/self/smaps
+/// (-1 when the kernel does not report it).
+int hugePageEligible(const void* address)
+{
+  std::ifstream smaps("/proc/self/smaps");
+  const auto at = reinterpret_cast<std::uintptr_t>(address);
+  std::string line;
+  bool inside = false;
+  while (std::getline(smaps, line))
+  {
+    std::uintptr_t lo = 0, hi = 0;
+    char dash = 0;
+    std::istringstream head(line);
+    if (head >> std::hex >> lo >> dash >> hi && dash == '-')
+    {
+      inside = at >= lo && at < hi;
+      continue;
+    }
+    if (inside && line.rfind("THPeligible:", 0) == 0)
+      return std::stoi(line.substr(12));
+  }
+  return -1;
+}
+
+TEST(Storage, LargeBlocksAskForTransparentHugePages)
+{
+  std::ifstream mode("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string modes;
+  std::getline(mode, modes);
+  if (modes.empty() || modes.find("[never]") != std::string::npos)
+    GTEST_SKIP() << "transparent huge pages are off on this kernel ('" << modes << "')";
+  vao::StorageArray<float> a;
+  a.resize(8 * kHugePage / sizeof(float));
+  const int eligible = hugePageEligible(a.data() + a.size() / 2);
+  if (eligible < 0)
+    GTEST_SKIP() << "this kernel's smaps does not report THPeligible";
+  EXPECT_EQ(eligible, 1) << "THP mode " << modes << ": the block was not advised";
+}
+#endif
+
+} // namespace
