@@ -1,4 +1,5 @@
 #include "vtkAmbientOcclusionMemory.h"
+#include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkAlgorithm.h"
 #include "vtkDataArray.h"
@@ -51,7 +52,9 @@ int Guard(vtkAlgorithm* algorithm, vtkDataObject* output, const char* hint, cons
   std::ostringstream why;
   try
   {
-    return body();
+    const int result = body();
+    vtkAmbientOcclusionRanges::CacheOutput(output);
+    return result;
   }
   catch (const Shortage& shortage)
   {

@@ -1,0 +1,97 @@
+// The ranges of an output array (vao/ValueRanges.h) against a plain scan, and the cases
+// it leaves to VTK (no tuple, a NaN, an infinity).
+#include "vao/ValueRanges.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+namespace
+{
+
+TEST(ValueRanges, EqualAPlainScanPerComponentAndOfTheNorm)
+{
+  std::mt19937 random(5);
+  for (int components : { 1, 3, 8 })
+  {
+    for (std::int64_t tuples : { 1, 7, 1000, 100003 })
+    {
+      std::vector<float> values(static_cast<std::size_t>(tuples * components));
+      for (std::size_t i = 0; i < values.size(); ++i)
+      {
+        const int c = static_cast<int>(i % components);
+        // Component c spans a range of its own: a wrong component index shows.
+        values[i] = std::uniform_real_distribution<float>(-10.0f * c - 1.0f, 100.0f * c + 0.5f)(random);
+      }
+      for (int threads : { 1, 2, 3 })
+      {
+        SCOPED_TRACE(::testing::Message() << components << " components, " << tuples << " tuples, " << threads
+                                          << " threads");
+        vao::ValueRanges ranges;
+        ASSERT_TRUE(vao::computeFiniteValueRanges(values.data(), tuples, components, ranges, threads));
+        ASSERT_EQ(ranges.components.size(), static_cast<std::size_t>(2 * components));
+        double lowestSquare = std::numeric_limits<double>::max(), highestSquare = 0.0;
+        for (std::int64_t t = 0; t < tuples; ++t)
+        {
+          double square = 0.0;
+          for (int c = 0; c < components; ++c)
+          {
+            const double v = values[static_cast<std::size_t>(t * components + c)];
+            square += v * v;
+          }
+          lowestSquare = std::min(lowestSquare, square);
+          highestSquare = std::max(highestSquare, square);
+        }
+        for (int c = 0; c < components; ++c)
+        {
+          float lo = values[c], hi = values[c];
+          for (std::int64_t t = 1; t < tuples; ++t)
+          {
+            lo = std::min(lo, values[static_cast<std::size_t>(t * components + c)]);
+            hi = std::max(hi, values[static_cast<std::size_t>(t * components + c)]);
+          }
+          EXPECT_EQ(ranges.components[2 * c], lo) << "component " << c;
+          EXPECT_EQ(ranges.components[2 * c + 1], hi) << "component " << c;
+        }
+        if (components > 1)
+        {
+          EXPECT_EQ(ranges.norm[0], std::sqrt(lowestSquare));
+          EXPECT_EQ(ranges.norm[1], std::sqrt(highestSquare));
+        }
+        else
+        {
+          EXPECT_TRUE(std::isnan(ranges.norm[0]) && std::isnan(ranges.norm[1]));
+        }
+      }
+    }
+  }
+}
+
+TEST(ValueRanges, LeaveNoTuplesNaNAndInfinityToTheCaller)
+{
+  vao::ValueRanges ranges;
+  std::vector<float> values(3000, 1.0f);
+  EXPECT_FALSE(vao::computeFiniteValueRanges(values.data(), 0, 3, ranges));
+  EXPECT_FALSE(vao::computeFiniteValueRanges(nullptr, 10, 3, ranges));
+  for (float bad : { std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+         -std::numeric_limits<float>::infinity() })
+  {
+    for (std::size_t at : { std::size_t(0), std::size_t(1501), values.size() - 1 })
+    {
+      std::vector<float> spoiled = values;
+      spoiled[at] = bad;
+      EXPECT_FALSE(vao::computeFiniteValueRanges(spoiled.data(), 1000, 3, ranges, 2)) << bad << " at " << at;
+    }
+  }
+  // The largest finite floats square to finite doubles: still a range.
+  values[4] = std::numeric_limits<float>::max();
+  values[5] = -std::numeric_limits<float>::max();
+  EXPECT_TRUE(vao::computeFiniteValueRanges(values.data(), 1000, 3, ranges, 2));
+  EXPECT_EQ(ranges.components[3], static_cast<double>(std::numeric_limits<float>::max()));
+}
+
+} // namespace
