@@ -296,7 +296,8 @@ void SweepRow(const std::string& label, const vao::VolumeView& view, const std::
   const double eight = TimeSweeping(view, spacing, iso, 2, options.repeat, distance, ao, octants);
   const EdtPeer edt = rawForPeer.empty() ? EdtPeer{} : RunScipyEdt(options, rawForPeer, iso);
   std::printf("  %-28s %10.0f %10.0f %10.0f %10.0f %10.0f %9.1fx\n", label.c_str(), 1e3 * sdf, 1e3 * combined,
-    1e3 * eight, 1e3 * edt.unsignedSeconds, 1e3 * edt.signedSeconds, edt.signedSeconds / eight);
+    1e3 * eight, edt.unsignedSeconds > 0 ? 1e3 * edt.unsignedSeconds : -1.0,
+    edt.signedSeconds > 0 ? 1e3 * edt.signedSeconds : -1.0, edt.signedSeconds > 0 ? edt.signedSeconds / eight : -1.0);
 }
 
 /// The sweeping table: the sizes of Singh et al.'s Table 2 (generated Fig. 3 scenes) and

@@ -37,7 +37,7 @@ struct ChunkRanges
     const float* v = values + begin * components;
     const std::int64_t tuples = end - begin;
     std::int64_t t = 0;
-    if (NC > 0)
+    if constexpr (NC > 0)
     {
       // kBlock tuples at a time: the extremes in lanes of kBlock values (lane k holds
       // component k % NC).
@@ -64,7 +64,7 @@ struct ChunkRanges
       }
       for (int k = 0; k < kBlock; ++k)
       {
-        const int c = NC > 0 ? k % NC : 0;
+        const int c = k % NC;
         this->lo[c] = std::min(this->lo[c], blockLo[k]);
         this->hi[c] = std::max(this->hi[c], blockHi[k]);
         this->finite = this->finite && zero[k] == 0.0f;
