@@ -154,6 +154,7 @@ Status BlockSweeper::initialise()
     s.distance.assign(static_cast<std::size_t>(count), kInfinity); // ghosts: the open sky
     s.vis = VisibilityStore();
     s.vis.kept = true;
+    s.vis.rowPitch = s.layout.storage.nx;
     s.vis.storage.assign(static_cast<std::size_t>(8 * count), 1.0f);
     for (int o = 0; o < 8; ++o)
     {

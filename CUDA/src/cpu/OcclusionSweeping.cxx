@@ -34,17 +34,9 @@ VisibilityStore planVisibility(
     vis.computed[s] = out.octantVisibility || (out.ambientOcclusion && p.octantMask[s]);
     computedCount += vis.computed[s];
   }
-  vis.kept = out.octantVisibility || (out.ambientOcclusion && p.useGeometryTerm);
-  if (vis.kept)
+  if (out.octantVisibility || (out.ambientOcclusion && p.useGeometryTerm))
   {
-    vis.storage.resize(static_cast<std::size_t>(computedCount * grid.count));
-    float* next = vis.storage.data();
-    for (int s = 0; s < 8; ++s)
-      if (vis.computed[s])
-      {
-        vis.field[s] = next;
-        next += grid.count;
-      }
+    vis.keep(grid, out.octantVisibility);
   }
   else if (computedCount > 0)
   {

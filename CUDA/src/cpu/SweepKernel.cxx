@@ -266,7 +266,7 @@ private:
       if (state.visibility && !this->Visibility.kept)
       {
         float* sum = this->Visibility.sum + g.index(this->Layout.offset[0], y, z);
-        const float* v = this->Visibility.plane(state.octant, z, g) + y * g.nx + this->Layout.offset[0];
+        const float* v = this->Visibility.row(state.octant, y, z, g) + this->Layout.offset[0];
         for (std::int64_t x = 0; x < n[0]; ++x)
         {
           sum[x] += v[x];
@@ -294,11 +294,10 @@ private:
       nullptr, nullptr, ghosted ? this->Distance[i - state.dir[0]] : kInfinity, 1.0f };
     if (state.visibility)
     {
-      const std::int64_t inPlane = y * g.nx + x0;
-      row.v = this->Visibility.plane(state.octant, z, g) + inPlane;
-      row.vy = hasUpwindRow ? row.v - rowStep : this->SkyVisibility.data() + sky0;
-      row.vz = hasUpwindPlane ? this->Visibility.plane(state.octant, z - state.dir[2], g) + inPlane
-                              : this->SkyVisibility.data() + sky0;
+      VisibilityStore& vis = this->Visibility;
+      row.v = vis.row(state.octant, y, z, g) + x0;
+      row.vy = hasUpwindRow ? row.v - state.dir[1] * vis.pitch(g) : this->SkyVisibility.data() + sky0;
+      row.vz = hasUpwindPlane ? vis.row(state.octant, y, z - state.dir[2], g) + x0 : this->SkyVisibility.data() + sky0;
       row.startV = ghosted ? row.v[-state.dir[0]] : 1.0f;
     }
     return row;

@@ -227,48 +227,54 @@ struct Combiner
   const VisibilityStore& vis;
   double maskCount;
 
-  /// The unclamped A of own voxel (x, y, z), storage index i.
-  double occlusion(std::int64_t i, std::int64_t x, std::int64_t y, std::int64_t z) const
+  /// The unclamped A of own voxel (x, y, z), storage index i, whose octants' V are v.
+  double occlusion(const float* v, std::int64_t i, std::int64_t x, std::int64_t y, std::int64_t z) const
   {
-    if (!this->p.useGeometryTerm)
+    if (!this->vis.kept)
     {
-      if (!this->vis.kept)
-      {
-        return this->vis.sum[i] / this->maskCount;
-      }
-      double sum = 0.0;
-      for (int s = 0; s < 8; ++s)
-        if (this->p.octantMask[s])
-          sum += this->vis.field[s][i];
-      return sum / this->maskCount;
+      return this->vis.sum[i] / this->maskCount;
     }
+    const bool geometry = this->p.useGeometryTerm;
     const bool twoSided = this->p.opacity < 1.0;
     double g[8];
-    allGeometryTerms(distanceNormal(this->distance, this->layout, x, y, z), twoSided, g);
+    if (geometry)
+      allGeometryTerms(distanceNormal(this->distance, this->layout, x, y, z), twoSided, g);
     double sum = 0.0;
     for (int s = 0; s < 8; ++s)
       if (this->p.octantMask[s])
-        sum += this->vis.field[s][i] * g[s];
-    return sum / (twoSided ? 2.0 * kPi : kPi);
+        sum += geometry ? v[s] * g[s] : v[s];
+    return sum / (!geometry ? this->maskCount : twoSided ? 2.0 * kPi : kPi);
   }
 
-  void plane(std::int64_t z) const
+  /// Own plane z. `rows` holds a row of the eight fields while the row-interleaved output
+  /// (VisibilityStore::inOutput) is transposed in place.
+  void plane(std::int64_t z, std::vector<float>& rows) const
   {
     const double exponent = 1.0 / this->p.gamma;
     const Index3& n = this->layout.size;
+    float v[8] = {};
     for (std::int64_t y = 0; y < n[1]; ++y)
+    {
+      const std::int64_t first = this->layout.index(0, y, z);
+      if (this->vis.inOutput)
+      {
+        const float* block = this->vis.field[0] + (z * n[1] + y) * this->vis.rowPitch; // whole volume
+        rows.assign(block, block + 8 * n[0]);
+      }
       for (std::int64_t x = 0; x < n[0]; ++x)
       {
-        const std::int64_t i = this->layout.index(x, y, z);
+        const std::int64_t i = first + x;
         const std::int64_t o = (z * n[1] + y) * n[0] + x;
+        for (int s = 0; s < 8 && this->vis.kept; ++s)
+          v[s] = this->vis.inOutput ? rows[s * n[0] + x] : this->vis.field[s] ? this->vis.field[s][i] : 0.0f;
         if (this->out.octantVisibility)
         {
           for (int s = 0; s < 8; ++s)
-            this->out.octantVisibility[8 * o + s] = this->vis.field[s][i];
+            this->out.octantVisibility[8 * o + s] = v[s];
         }
         if (this->out.ambientOcclusion)
         {
-          double a = std::min(1.0, std::max(0.0, this->occlusion(i, x, y, z)));
+          double a = std::min(1.0, std::max(0.0, this->occlusion(v, i, x, y, z)));
           if (exponent != 1.0)
           {
             a = exponent == 0.5 ? std::sqrt(a) : std::pow(a, exponent); // the paper's gamma 2, fast
@@ -276,6 +282,7 @@ struct Combiner
           this->out.ambientOcclusion[o] = static_cast<float>(a);
         }
       }
+    }
   }
 };
 
@@ -289,7 +296,11 @@ void fillWithoutSurface(
   const float v = allInside ? 0.0f : 1.0f;
   const std::int64_t count = layout.storage.count;
   std::fill(distance, distance + count, d);
-  if (vis.kept)
+  if (vis.inOutput)
+  {
+    std::fill(vis.field[0], vis.field[0] + 8 * count, v);
+  }
+  else if (vis.kept)
   {
     for (float* field : vis.field)
       if (field)
@@ -311,9 +322,10 @@ Status combine(const SweepLayout& layout, const SweepParameters& p, const SweepO
   const Combiner combiner{ layout, p, out, distance, vis, maskCount };
   const bool finished = detail::parallelFor(layout.size[2], threads, threads, execution,
     [&](std::int64_t z0, std::int64_t z1, detail::ChunkProgress& progress) {
+      std::vector<float> rows;
       for (std::int64_t z = z0; z < z1 && !progress.stopped(); ++z)
       {
-        combiner.plane(z);
+        combiner.plane(z, rows);
         progress.advance();
       }
     });

@@ -79,6 +79,13 @@ struct VisibilityStore
   std::array<bool, 8> computed{};
   std::array<float*, 8> field{}; // when kept, storage-sized
   StorageArray<float> storage; // uninitialised: every sweep writes all of its field
+  // Elements from one row of a kept field to the next: the storage's nx, or 8 nx when the
+  // fields are the rows of the OctantVisibility output itself (row-interleaved: the eight
+  // fields' rows (y, z) lie one after another where the output keeps that row's voxels;
+  // combine transposes each row in place). Writing there saves a second volume of eight
+  // floats per voxel, and its first touch.
+  std::int64_t rowPitch = 0;
+  bool inOutput = false;
   // When not kept, a ring of planes. Plane k of a sweep overwrites the slot of plane
   // k - ringPlanes, which must be finished and no longer read (as the upwind plane of
   // k - ringPlanes + 1). With T threads the planes in flight are at most the last T (thread
@@ -90,10 +97,35 @@ struct VisibilityStore
   float* sum = nullptr; // sum of m_s V_s, when not kept (the whole volume only)
   bool kept = false;
 
-  float* plane(int s, std::int64_t z, const Grid& grid)
+  /// Elements between rows y and y + 1 of a plane.
+  std::int64_t pitch(const Grid& grid) const { return this->kept ? this->rowPitch : grid.nx; }
+
+  /// Row (y, z) of octant s's field (the ring's slot of plane z when not kept).
+  float* row(int s, std::int64_t y, std::int64_t z, const Grid& grid)
   {
-    return this->kept ? this->field[s] + z * grid.plane
-                      : this->ring.data() + (z % this->ringPlanes) * grid.plane;
+    return this->kept ? this->field[s] + (z * grid.ny + y) * this->rowPitch
+                      : this->ring.data() + (z % this->ringPlanes) * grid.plane + y * grid.nx;
+  }
+
+  /// Keeps every computed octant's field: in `output` (whole-volume sweeps, 8 floats per
+  /// voxel, row-interleaved as above), else in storage of its own.
+  void keep(const Grid& grid, float* output)
+  {
+    this->kept = true;
+    this->inOutput = output != nullptr;
+    this->rowPitch = this->inOutput ? 8 * grid.nx : grid.nx;
+    int count = 0;
+    for (bool c : this->computed)
+      count += c;
+    if (!this->inOutput)
+      this->storage.resize(static_cast<std::size_t>(count * grid.count));
+    float* next = this->inOutput ? output : this->storage.data();
+    for (int s = 0; s < 8; ++s)
+      if (this->computed[s])
+      {
+        this->field[s] = next;
+        next += this->inOutput ? grid.nx : grid.count;
+      }
   }
 };
 
