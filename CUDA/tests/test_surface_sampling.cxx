@@ -242,3 +242,65 @@ TEST(Shadow, ZeroLightDirectionFailsWithMessage)
   EXPECT_FALSE(s.ok);
   EXPECT_FALSE(s.message.empty());
 }
+
+// ---------------------------------------------------------------------------------------
+// Float points and normals
+
+TEST(SurfacePoints, FloatPointsGiveTheBitsOfTheirDoubles)
+{
+  // A sphere inside a box shell, its points rounded to float (as vtkPoints holds them) and
+  // off the grid; the double calls get the same values widened, so every output must match
+  // bit for bit, AO and shadows, with both queries and the estimators of both levels' paths.
+  const vao::Index3 d = { 40, 36, 44 };
+  const Vec3 c = { 19.3, 17.6, 21.1 };
+  const Field f = makeField(d, [&](double x, double y, double z) {
+    const double sphere = std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) - 5.5;
+    const double m = std::max(std::fabs(x - c[0]), std::max(std::fabs(y - c[1]), std::fabs(z - c[2])));
+    return std::min(sphere, std::max(11.0 - m, m - 14.0));
+  });
+  const auto pyramid = pyramidOf(f);
+  std::vector<double> points, normals;
+  spherePoints(c, 5.5, 333, points, normals); // 333: the last batch of lanes is partial
+  for (std::size_t i = 0; i < normals.size(); ++i)
+    normals[i] *= 0.5 + (i % 5); // not unit
+  std::vector<float> pointsF(points.begin(), points.end()), normalsF(normals.begin(), normals.end());
+  const std::vector<double> widenedPoints(pointsF.begin(), pointsF.end());
+  const std::vector<double> widenedNormals(normalsF.begin(), normalsF.end());
+  const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
+  for (vao::Method estimator : { vao::Method::Chebyshev, vao::Method::GaussianCdf })
+    for (vao::SurfaceQuery query : { vao::SurfaceQuery::HalfVoxelInside, vao::SurfaceQuery::IsoValue })
+    {
+      vao::SurfaceOcclusionParameters p;
+      p.estimator = estimator;
+      p.query = query;
+      p.isoValue = 0.5;
+      std::vector<float> fromFloat(n, -1.0f), fromDouble(n, -2.0f), shadowFloat(n, -1.0f), shadowDouble(n, -2.0f);
+      ASSERT_TRUE(vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing, pointsF.data(),
+        normalsF.data(), n, p, fromFloat.data()).ok);
+      ASSERT_TRUE(vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing, widenedPoints.data(),
+        widenedNormals.data(), n, p, fromDouble.data()).ok);
+      ASSERT_TRUE(vao::surfaceShadow(pyramid, pointsF.data(), normalsF.data(), n, { 0.2, -0.5, 1 }, p,
+        shadowFloat.data()).ok);
+      ASSERT_TRUE(vao::surfaceShadow(pyramid, widenedPoints.data(), widenedNormals.data(), n, { 0.2, -0.5, 1 }, p,
+        shadowDouble.data()).ok);
+      for (std::int64_t i = 0; i < n; ++i)
+      {
+        ASSERT_EQ(fromFloat[i], fromDouble[i]) << "AO, point " << i;
+        ASSERT_EQ(shadowFloat[i], shadowDouble[i]) << "shadow, point " << i;
+      }
+      EXPECT_GT(average(fromFloat), 0.05); // open and shadowed points both
+      EXPECT_LT(average(fromFloat), 0.95);
+      const auto range = std::minmax_element(shadowFloat.begin(), shadowFloat.end()); // inside the shell
+      EXPECT_GT(*range.second - *range.first, 0.05f);
+    }
+  // Bad float input is named as with doubles.
+  const float bad[3] = { 8, std::numeric_limits<float>::quiet_NaN(), 8 }, up[3] = { 0, 0, 1 }, zero[3] = { 0, 0, 0 };
+  const float tiny[3] = { 0, 0, 1e-30f }; // its square is 0 in float, not in double
+  float out = 0;
+  vao::Status s = vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing, bad, up, 1, {}, &out);
+  EXPECT_FALSE(s.ok);
+  EXPECT_NE(s.message.find("point 0"), std::string::npos) << s.message;
+  s = vao::surfaceShadow(pyramid, up, zero, 1, { 0, 0, 1 }, {}, &out);
+  EXPECT_NE(s.message.find("zero normal"), std::string::npos) << s.message;
+  EXPECT_TRUE(vao::surfaceShadow(pyramid, up, tiny, 1, { 0, 0, 1 }, {}, &out).ok);
+}

@@ -100,6 +100,12 @@ Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const Vo
   const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
   const Execution& execution = {});
 
+/// The same with float points and normals (vtkPoints' usual type), read in place.
+Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const float* points,
+  const float* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
+  const Execution& execution = {});
+
 /// Soft shadow (1 = lit) of surface points towards the light direction L (need not be
 /// unit; must be finite and not zero): a march along L starting at p + r_0 n (off the
 /// surface); at distance t it samples level l = clamp(floor(log2(1 + t / r_0)), 0,
@@ -109,6 +115,11 @@ Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const Vo
 /// level 0's (blurred) mean at p - h/2 n (h: level 0's smallest spacing); IsoValue gives
 /// q = c exactly. offsetFactor and combination are not used.
 Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* points, const double* normals,
+  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution = {});
+
+/// The same with float points and normals, read in place.
+Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const float* points, const float* normals,
   std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
   float* out, const Execution& execution = {});
 

@@ -3,121 +3,19 @@
 #include "vao/VarianceOcclusionMap.h"
 #include "vao/Validation.h"
 
+#include "SurfaceChecks.h"
 #include "SurfaceLanes.h"
 #include "Parallel.h"
 #include "VolumeAccess.h"
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <vector>
 
 namespace vao
 {
 namespace
 {
-
-bool finite3(const double* p)
-{
-  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
-}
-
-std::string pointMessage(const char* what, std::int64_t i)
-{
-  std::ostringstream s;
-  s << what << " " << i;
-  return s.str();
-}
-
-/// Checks the pyramid and resolves the number of levels used.
-Status checkPyramid(const std::vector<MomentLevel>& pyramid, int requested, int& levels)
-{
-  if (pyramid.empty())
-  {
-    return Status::failure("the moment pyramid is empty (build it with buildMomentPyramid)");
-  }
-  for (const MomentLevel& level : pyramid)
-  {
-    const std::int64_t n = level.dims[0] * level.dims[1] * level.dims[2];
-    if (level.dims[0] < 1 || level.dims[1] < 1 || level.dims[2] < 1 ||
-      static_cast<std::int64_t>(level.mean.size()) != n ||
-      static_cast<std::int64_t>(level.variance.size()) != n || !(level.kernelRadius > 0.0))
-    {
-      return Status::failure("a level of the moment pyramid is inconsistent (dims, arrays or radius)");
-    }
-  }
-  const int available = static_cast<int>(pyramid.size());
-  if (requested == -1)
-  {
-    levels = available;
-  }
-  else if (requested < 1 || requested > available)
-  {
-    std::ostringstream s;
-    s << "levels must be -1 (all) or in [1, " << available << "], got " << requested;
-    return Status::failure(s.str());
-  }
-  else
-  {
-    levels = requested;
-  }
-  return Status::success();
-}
-
-Status checkParameters(const SurfaceOcclusionParameters& p)
-{
-  if (!std::isfinite(p.offsetFactor) || p.offsetFactor < 0.0)
-  {
-    return Status::failure("offsetFactor must be finite and >= 0");
-  }
-  if (p.query == SurfaceQuery::IsoValue && !std::isfinite(p.isoValue))
-  {
-    return Status::failure("isoValue must be finite");
-  }
-  if (p.query != SurfaceQuery::IsoValue && p.query != SurfaceQuery::HalfVoxelInside)
-  {
-    return Status::failure("unknown surface query mode");
-  }
-  if (p.estimator != Method::Chebyshev && p.estimator != Method::GaussianCdf)
-  {
-    return Status::failure("the surface estimator must be Chebyshev or Gaussian CDF");
-  }
-  if (p.combination != LevelCombination::MaximumOcclusion && p.combination != LevelCombination::Mean)
-  {
-    return Status::failure("unknown level combination");
-  }
-  return Status::success();
-}
-
-/// Validates points (finite) and normals (finite, non-zero).
-Status checkPoints(const double* points, const double* normals, std::int64_t count)
-{
-  if (count < 0)
-  {
-    return Status::failure("the point count must be >= 0");
-  }
-  if (count > 0 && (!points || !normals))
-  {
-    return Status::failure("points and normals must not be null");
-  }
-  for (std::int64_t i = 0; i < count; ++i)
-  {
-    if (!finite3(points + 3 * i))
-    {
-      return Status::failure(pointMessage("non-finite coordinate at point", i));
-    }
-    const double* nn = normals + 3 * i;
-    if (!finite3(nn))
-    {
-      return Status::failure(pointMessage("non-finite normal at point", i));
-    }
-    if (!(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2] > 0.0))
-    {
-      return Status::failure(pointMessage("zero normal at point", i));
-    }
-  }
-  return Status::success();
-}
 
 /// The grid cell around a world position, clamped to the grid: lower and upper corner
 /// indices and the fractions towards the upper one, per axis.
@@ -242,21 +140,6 @@ void sampleLevel(const MomentLevel& level, const std::array<double, 3>& position
 namespace
 {
 
-/// The checks both surface queries share: the pyramid and the levels used, the
-/// parameters, the points and normals, and somewhere to write.
-Status checkQuery(const std::vector<MomentLevel>& pyramid, const SurfaceOcclusionParameters& parameters,
-  const double* points, const double* normals, std::int64_t count, const float* out, int& levels)
-{
-  Status status = checkPyramid(pyramid, parameters.levels, levels);
-  if (status.ok)
-    status = checkParameters(parameters);
-  if (status.ok)
-    status = checkPoints(points, normals, count);
-  if (status.ok && count > 0 && !out)
-    status = Status::failure("the output array must not be null");
-  return status;
-}
-
 /// kLanes points at a time (the last batch padded with copies of its last point): their
 /// positions, unit normals and queries, structure of arrays.
 struct PointLanes
@@ -267,15 +150,18 @@ struct PointLanes
   double nx[detail::kLanes], ny[detail::kLanes], nz[detail::kLanes];
   double query[detail::kLanes];
 
-  PointLanes(const double* points, const double* normals, std::int64_t count, std::int64_t batch)
+  template <class P>
+  PointLanes(const P* points, const P* normals, std::int64_t count, std::int64_t batch)
     : first(batch * detail::kLanes)
     , used(static_cast<int>(std::min<std::int64_t>(detail::kLanes, count - batch * detail::kLanes)))
   {
     for (int k = 0; k < detail::kLanes; ++k)
     {
       const std::int64_t i = this->first + std::min(k, this->used - 1);
-      const double* p = points + 3 * i;
-      const double* n = normals + 3 * i;
+      const double p[3] = { static_cast<double>(points[3 * i]), static_cast<double>(points[3 * i + 1]),
+        static_cast<double>(points[3 * i + 2]) };
+      const double n[3] = { static_cast<double>(normals[3 * i]), static_cast<double>(normals[3 * i + 1]),
+        static_cast<double>(normals[3 * i + 2]) };
       const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
       this->x[k] = p[0];
       this->y[k] = p[1];
@@ -295,8 +181,8 @@ struct PointLanes
 
 /// f(lanes) for every batch of kLanes points, on every thread, reporting progress every
 /// 64 batches. Returns false when cancelled.
-template <class PerBatch>
-bool forEachBatch(const double* points, const double* normals, std::int64_t count, const Execution& execution,
+template <class P, class PerBatch>
+bool forEachBatch(const P* points, const P* normals, std::int64_t count, const Execution& execution,
   PerBatch&& f)
 {
   constexpr int kProgressBatches = 64;
@@ -402,15 +288,13 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int l
   }
 }
 
-} // namespace
-
-Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
-  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const double* points,
-  const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution)
+template <class P>
+Status occlusionOf(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const P* points, const P* normals,
+  std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
   int levels = 0;
-  Status status = checkQuery(pyramid, parameters, points, normals, count, out, levels);
+  Status status = detail::checkQuery(pyramid, parameters, points, normals, count, out, levels);
   const bool half = parameters.query == SurfaceQuery::HalfVoxelInside;
   if (status.ok && half)
   {
@@ -446,12 +330,13 @@ Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const Vo
   return finished ? Status::success() : Status::cancelled();
 }
 
-Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* points, const double* normals,
-  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
-  float* out, const Execution& execution)
+template <class P>
+Status shadowOf(const std::vector<MomentLevel>& pyramid, const P* points, const P* normals, std::int64_t count,
+  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
+  const Execution& execution)
 {
   int levels = 0;
-  Status status = checkQuery(pyramid, parameters, points, normals, count, out, levels);
+  Status status = detail::checkQuery(pyramid, parameters, points, normals, count, out, levels);
   if (status.ok)
     status = checkFinitePoint(lightDirection, "the light direction");
   if (!status.ok)
@@ -491,6 +376,38 @@ Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* poin
     }
   });
   return finished ? Status::success() : Status::cancelled();
+}
+
+} // namespace
+
+Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const double* points,
+  const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
+  const Execution& execution)
+{
+  return occlusionOf(pyramid, volume, origin, spacing, points, normals, count, parameters, out, execution);
+}
+
+Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const float* points,
+  const float* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
+  const Execution& execution)
+{
+  return occlusionOf(pyramid, volume, origin, spacing, points, normals, count, parameters, out, execution);
+}
+
+Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* points, const double* normals,
+  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution)
+{
+  return shadowOf(pyramid, points, normals, count, lightDirection, parameters, out, execution);
+}
+
+Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const float* points, const float* normals,
+  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution)
+{
+  return shadowOf(pyramid, points, normals, count, lightDirection, parameters, out, execution);
 }
 
 } // namespace vao
