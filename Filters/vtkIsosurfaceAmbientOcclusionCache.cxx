@@ -237,11 +237,15 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
   const SurfaceKey key(surface, parameters, this->PyramidBuilds);
   const bool newOcclusion = !cache.occlusion || !(cache.occlusionKey == key);
   // The points and normals as the kernels read them, only when a kernel runs (with the AO
-  // kept and shadows off there is nothing to compute).
+  // kept and shadows off there is nothing to compute): float arrays in place (what
+  // contours give), anything else as a double copy.
   const vtkIdType n = surface->GetNumberOfPoints();
+  vtkFloatArray* floatPoints = vtkFloatArray::SafeDownCast(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr);
+  vtkFloatArray* floatNormals = vtkFloatArray::SafeDownCast(vtkAmbientOcclusionArrayInput::GivenNormals(surface));
+  const bool inPlace = floatPoints && floatNormals;
   std::vector<double> points, normals;
   std::string error;
-  if (newOcclusion || this->ComputeShadows)
+  if (!inPlace && (newOcclusion || this->ComputeShadows))
   {
     points.resize(static_cast<size_t>(3 * n));
     for (vtkIdType i = 0; i < n; ++i)
@@ -255,6 +259,12 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
       return false;
     }
   }
+  // One call for either form of the points.
+  const auto run = [&](auto&& kernel) {
+    return inPlace ? kernel(static_cast<const float*>(floatPoints->GetPointer(0)),
+                       static_cast<const float*>(floatNormals->GetPointer(0)))
+                   : kernel(static_cast<const double*>(points.data()), static_cast<const double*>(normals.data()));
+  };
   vao::Status status = vao::Status::success();
   if (newOcclusion)
   {
@@ -262,8 +272,10 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
     vtkNew<vtkFloatArray> occlusion;
     occlusion->SetName("AmbientOcclusion");
     vtkAmbientOcclusionMemory::Allocate(occlusion, n, "the AmbientOcclusion output");
-    status = vao::surfaceAmbientOcclusion(cache.levels, cache.scalars.view, cache.origin, cache.spacing,
-      points.data(), normals.data(), n, parameters, occlusion->GetPointer(0), execution);
+    status = run([&](auto p, auto nn) {
+      return vao::surfaceAmbientOcclusion(cache.levels, cache.scalars.view, cache.origin, cache.spacing, p, nn, n,
+        parameters, occlusion->GetPointer(0), execution);
+    });
     if (status.ok)
     {
       cache.occlusion = occlusion;
@@ -276,8 +288,10 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
     shadow->SetName("Shadow");
     vtkAmbientOcclusionMemory::Allocate(shadow, n, "the Shadow output");
     const double* l = this->LightDirection;
-    status = vao::surfaceShadow(cache.levels, points.data(), normals.data(), n, { l[0], l[1], l[2] }, parameters,
-      shadow->GetPointer(0), execution);
+    status = run([&](auto p, auto nn) {
+      return vao::surfaceShadow(
+        cache.levels, p, nn, n, { l[0], l[1], l[2] }, parameters, shadow->GetPointer(0), execution);
+    });
   }
   if (!status.ok)
   {
