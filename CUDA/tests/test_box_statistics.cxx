@@ -93,6 +93,26 @@ TYPED_TEST(BoxStatisticsTyped, AnisotropicRadiiAndRadiiLargerThanTheVolume)
   }
 }
 
+TYPED_TEST(BoxStatisticsTyped, WholeGroupsOfSixteenRowsAndTheirTails)
+{
+  // The extrema's x pass moves 16 rows at a time into lanes (16-bit voxels: 16 x 16 blocks
+  // in AVX2 registers) and back: rows and columns past the last whole group or block, and
+  // a region that starts off the first column. A y radius of 8 or more makes the bands of
+  // rows (extremaBandRows) read groups of 16; an x radius of 0 leaves the x pass the
+  // identity, so any misplaced value shows.
+  const vao::Index3 dims = { 53, 37, 4 };
+  const double lo = std::is_signed<TypeParam>::value ? -120 : 0;
+  const auto v = randomVolume<TypeParam>(dims, lo, lo + 250, 29);
+  const vao::Region whole = vao::Region::whole(viewOf(v, dims));
+  const vao::Region offset{ { 3, 1, 1 }, { 47, 34, 3 } };
+  for (const vao::Radius& r : { vao::Radius{ 0, 8, 0 }, vao::Radius{ 1, 8, 1 }, vao::Radius{ 4, 9, 0 } })
+  {
+    SCOPED_TRACE(testing::Message() << r.x << "," << r.y << "," << r.z);
+    expectStatsMatchBruteForce(v, dims, r, whole, 2);
+    expectStatsMatchBruteForce(v, dims, r, offset, 1);
+  }
+}
+
 TEST(BoxStatistics, SubRegionsAndThreadCounts)
 {
   const vao::Index3 dims = { 19, 15, 21 };

@@ -6,6 +6,7 @@
 
 #include "MomentPlanes.h"
 #include "MomentRows.h"
+#include "RowTranspose.h"
 #include "SlidingExtremum.h"
 #include "vao/Storage.h"
 
@@ -72,24 +73,20 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
         for (std::int64_t j0 = 0; j0 < rows; j0 += kExtremumRows)
         {
           const std::int64_t m = std::min(kExtremumRows, rows - j0);
+          const T* src[kExtremumRows];
+          T* minRows[kExtremumRows];
+          T* maxRows[kExtremumRows];
           for (std::int64_t k = 0; k < m; ++k)
           {
-            const T* src = volume.row(geometry.ys.lo + j0 + k, z) + geometry.xs.lo * volume.stride;
-            for (std::int64_t i = 0; i < span; ++i)
-            {
-              lanes[i * m + k] = src[i * volume.stride];
-            }
+            src[k] = volume.row(geometry.ys.lo + j0 + k, z) + geometry.xs.lo * volume.stride;
+            minRows[k] = &xMin[(j0 + k) * nx];
+            maxRows[k] = &xMax[(j0 + k) * nx];
           }
+          rowsToLanes(src, m, volume.stride, span, lanes.data());
           slidingMinMax(lanes.data(), lanes.data(), span, m, geometry.radius.x, x0, nx, lanesMin.data(),
             lanesMax.data(), scratch);
-          for (std::int64_t k = 0; k < m; ++k)
-          {
-            for (std::int64_t o = 0; o < nx; ++o)
-            {
-              xMin[(j0 + k) * nx + o] = lanesMin[o * m + k];
-              xMax[(j0 + k) * nx + o] = lanesMax[o * m + k];
-            }
-          }
+          lanesToRows(lanesMin.data(), m, nx, minRows);
+          lanesToRows(lanesMax.data(), m, nx, maxRows);
         }
         // y pass: whole rows are the lanes.
         const std::int64_t y0 = region.begin[1] - geometry.ys.lo;
