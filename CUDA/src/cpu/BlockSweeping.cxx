@@ -153,14 +153,9 @@ Status BlockSweeper::initialise()
     const std::int64_t count = s.layout.storage.count;
     s.distance.assign(static_cast<std::size_t>(count), kInfinity); // ghosts: the open sky
     s.vis = VisibilityStore();
-    s.vis.kept = true;
-    s.vis.rowPitch = s.layout.storage.nx;
-    s.vis.storage.assign(static_cast<std::size_t>(8 * count), 1.0f);
-    for (int o = 0; o < 8; ++o)
-    {
-      s.vis.computed[o] = true;
-      s.vis.field[o] = s.vis.storage.data() + o * count;
-    }
+    s.vis.computed.fill(true);
+    s.vis.keep(s.layout.storage, nullptr);
+    std::fill(s.vis.storage.begin(), s.vis.storage.end(), 1.0f); // ghosts: the open sky
   }
   catch (const std::bad_alloc&)
   {

@@ -77,7 +77,7 @@ struct SweepLayout
 struct VisibilityStore
 {
   std::array<bool, 8> computed{};
-  std::array<float*, 8> field{}; // when kept, storage-sized
+  std::array<float*, 8> field{}; // kept: row (y, z) of field s at field[s] + (z ny + y) rowPitch
   StorageArray<float> storage; // uninitialised: every sweep writes all of its field
   // Elements from one row of a kept field to the next: the storage's nx, or 8 nx when the
   // fields are the rows of the OctantVisibility output itself (row-interleaved: the eight
