@@ -240,8 +240,16 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
   // kept and shadows off there is nothing to compute): float arrays in place (what
   // contours give), anything else as a double copy.
   const vtkIdType n = surface->GetNumberOfPoints();
+  vtkDataArray* givenNormals = vtkAmbientOcclusionArrayInput::GivenNormals(surface);
+  if (givenNormals && givenNormals->GetNumberOfTuples() < n)
+  {
+    vtkErrorMacro(<< "The surface's normals (\"" << (givenNormals->GetName() ? givenNormals->GetName() : "")
+                  << "\") have " << givenNormals->GetNumberOfTuples() << " tuples for " << n
+                  << " points: give one normal per point, or none (then they come from the volume's gradient).");
+    return false;
+  }
   vtkFloatArray* floatPoints = vtkFloatArray::SafeDownCast(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr);
-  vtkFloatArray* floatNormals = vtkFloatArray::SafeDownCast(vtkAmbientOcclusionArrayInput::GivenNormals(surface));
+  vtkFloatArray* floatNormals = vtkFloatArray::SafeDownCast(givenNormals);
   const bool inPlace = floatPoints && floatNormals;
   std::vector<double> points, normals;
   std::string error;

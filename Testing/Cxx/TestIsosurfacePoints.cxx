@@ -1,5 +1,6 @@
 // Isosurface Ambient Occlusion reads float points and normals (what contours give) in
-// place and converts any other type: both must give the same bits.
+// place and converts any other type: both must give the same bits, and a normals array
+// shorter than the points is refused, whichever its type.
 #include "TestHelpers.h"
 
 #include "vtkAmbientOcclusionPhantom.h"
@@ -20,6 +21,26 @@ using namespace vaotest;
 
 namespace
 {
+
+/// The phantom's bone (400 HU): its volume and its contour, float points and normals.
+struct Bone
+{
+  vtkSmartPointer<vtkImageData> volume;
+  vtkSmartPointer<vtkPolyData> surface;
+};
+
+Bone BoneOf(int nx, int ny, int nz)
+{
+  vtkNew<vtkAmbientOcclusionPhantom> phantom;
+  phantom->SetDimensions(nx, ny, nz);
+  phantom->Update();
+  vtkNew<vtkFlyingEdges3D> contour;
+  contour->SetInputData(phantom->GetOutput());
+  contour->SetValue(0, 400.0);
+  contour->ComputeNormalsOn();
+  contour->Update();
+  return { phantom->GetOutput(), contour->GetOutput() };
+}
 
 /// AO and shadows of `surface` on `volume` (one filter each, so nothing is cached).
 std::pair<std::vector<double>, std::vector<double>> Shaded(vtkPolyData* surface, vtkImageData* volume)
@@ -42,16 +63,9 @@ std::pair<std::vector<double>, std::vector<double>> Shaded(vtkPolyData* surface,
 
 TEST(IsosurfacePoints, FloatPointsInPlaceEqualTheirDoubleCopies)
 {
-  vtkNew<vtkAmbientOcclusionPhantom> phantom;
-  phantom->SetDimensions(48, 48, 40);
-  phantom->Update();
-  vtkImageData* volume = phantom->GetOutput();
-  vtkNew<vtkFlyingEdges3D> contour;
-  contour->SetInputData(volume);
-  contour->SetValue(0, 400.0);
-  contour->ComputeNormalsOn();
-  contour->Update();
-  vtkPolyData* floats = contour->GetOutput();
+  const Bone bone = BoneOf(48, 48, 40);
+  vtkImageData* volume = bone.volume;
+  vtkPolyData* floats = bone.surface;
   ASSERT_TRUE(vtkFloatArray::SafeDownCast(floats->GetPoints()->GetData()));
   ASSERT_TRUE(vtkFloatArray::SafeDownCast(floats->GetPointData()->GetNormals()));
   ASSERT_GT(floats->GetNumberOfPoints(), 1000);
@@ -80,4 +94,44 @@ TEST(IsosurfacePoints, FloatPointsInPlaceEqualTheirDoubleCopies)
   const auto shadow = std::minmax_element(fromFloats.second.begin(), fromFloats.second.end());
   EXPECT_LT(*shadow.first, 0.5);
   EXPECT_GT(*shadow.second, 0.5);
+}
+
+TEST(IsosurfacePoints, NormalsShorterThanThePointsAreRefused)
+{
+  const Bone bone = BoneOf(32, 32, 28);
+  vtkImageData* volume = bone.volume;
+  vtkPolyData* surface = bone.surface;
+  const vtkIdType n = surface->GetNumberOfPoints();
+  ASSERT_GT(n, 100);
+  for (bool asDouble : { false, true })
+  {
+    SCOPED_TRACE(asDouble ? "double normals" : "float normals");
+    vtkSmartPointer<vtkDataArray> shortNormals;
+    if (asDouble)
+      shortNormals = vtkSmartPointer<vtkDoubleArray>::New();
+    else
+      shortNormals = vtkSmartPointer<vtkFloatArray>::New();
+    shortNormals->DeepCopy(surface->GetPointData()->GetNormals());
+    shortNormals->SetNumberOfTuples(n - 7); // a hand-made array that missed some points
+    shortNormals->SetName("Normals");
+    vtkNew<vtkPolyData> broken;
+    broken->ShallowCopy(surface);
+    vtkNew<vtkPointData> pd;
+    pd->SetNormals(shortNormals);
+    broken->GetPointData()->ShallowCopy(pd);
+
+    vtkNew<vtkIsosurfaceAmbientOcclusion> filter;
+    vtkNew<MessageCatcher> catcher;
+    catcher->Watch(filter);
+    filter->SetInputData(0, broken);
+    filter->SetVolumeData(volume);
+    filter->ComputeShadowsOn();
+    filter->Update();
+    ASSERT_FALSE(catcher->Errors.empty());
+    EXPECT_NE(catcher->Errors[0].find("normals"), std::string::npos) << catcher->Errors[0];
+    EXPECT_NE(catcher->Errors[0].find(std::to_string(n - 7) + " tuples for " + std::to_string(n) + " points"),
+      std::string::npos)
+      << catcher->Errors[0];
+    EXPECT_EQ(filter->GetOutput()->GetNumberOfPoints(), 0);
+  }
 }
