@@ -85,7 +85,7 @@ struct ColumnRows
 };
 
 /// x pass over unclipped outputs [begin, end): pa[xo * Step + k] is tap k of output xo;
-/// stores mean = A + shift and variance = max(0, B - A^2) as float.
+/// stores mean = A + shift and variance = max(0, B - A^2) as float at mean[xo - begin].
 template <int Step>
 struct InteriorRow
 {
@@ -94,7 +94,8 @@ struct InteriorRow
   {
     for (std::int64_t xo = begin; xo < end; ++xo)
     {
-      blur::levelMoments(tapSum(w, pa + Step * xo), tapSum(w, pb + Step * xo), shift, mean[xo], variance[xo]);
+      blur::levelMoments(
+        tapSum(w, pa + Step * xo), tapSum(w, pb + Step * xo), shift, mean[xo - begin], variance[xo - begin]);
     }
   }
 };
