@@ -179,6 +179,22 @@ inline void spherePoints(const Vec3& c, double r, int n, std::vector<double>& po
   }
 }
 
+/// f(p) for the surface query parameters of each estimator a level can feed (Chebyshev,
+/// Gaussian CDF) with each query (half a voxel inside, the iso value 0.5).
+template <class F>
+void forEachSurfaceQuery(F&& f)
+{
+  for (vao::Method estimator : { vao::Method::Chebyshev, vao::Method::GaussianCdf })
+    for (vao::SurfaceQuery query : { vao::SurfaceQuery::HalfVoxelInside, vao::SurfaceQuery::IsoValue })
+    {
+      vao::SurfaceOcclusionParameters p;
+      p.estimator = estimator;
+      p.query = query;
+      p.isoValue = 0.5;
+      f(p);
+    }
+}
+
 inline double average(const std::vector<float>& v)
 {
   double s = 0;

@@ -267,13 +267,7 @@ TEST(SurfacePoints, FloatPointsGiveTheBitsOfTheirDoubles)
   const std::vector<double> widenedPoints(pointsF.begin(), pointsF.end());
   const std::vector<double> widenedNormals(normalsF.begin(), normalsF.end());
   const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
-  for (vao::Method estimator : { vao::Method::Chebyshev, vao::Method::GaussianCdf })
-    for (vao::SurfaceQuery query : { vao::SurfaceQuery::HalfVoxelInside, vao::SurfaceQuery::IsoValue })
-    {
-      vao::SurfaceOcclusionParameters p;
-      p.estimator = estimator;
-      p.query = query;
-      p.isoValue = 0.5;
+  forEachSurfaceQuery([&](const vao::SurfaceOcclusionParameters& p) {
       std::vector<float> fromFloat(n, -1.0f), fromDouble(n, -2.0f), shadowFloat(n, -1.0f), shadowDouble(n, -2.0f);
       ASSERT_TRUE(vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing, pointsF.data(),
         normalsF.data(), n, p, fromFloat.data()).ok);
@@ -292,7 +286,7 @@ TEST(SurfacePoints, FloatPointsGiveTheBitsOfTheirDoubles)
       EXPECT_LT(average(fromFloat), 0.95);
       const auto range = std::minmax_element(shadowFloat.begin(), shadowFloat.end()); // inside the shell
       EXPECT_GT(*range.second - *range.first, 0.05f);
-    }
+    });
   // Bad float input is named as with doubles.
   const float bad[3] = { 8, std::numeric_limits<float>::quiet_NaN(), 8 }, up[3] = { 0, 0, 1 }, zero[3] = { 0, 0, 0 };
   const float tiny[3] = { 0, 0, 1e-30f }; // its square is 0 in float, not in double

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <new>
 #include <utility>
 #include <vector>
@@ -122,6 +123,62 @@ Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* poin
 Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const float* points, const float* normals,
   std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
   float* out, const Execution& execution = {});
+
+namespace detail
+{
+class PyramidTiles;
+}
+
+/// A moment pyramid for the surface queries that holds levels 0 and 1 only where they
+/// sample them. Those levels (96% of a whole pyramid's bytes) are kept in tiles of 8^3
+/// voxels: each query first builds the tiles its samples reach (its points' AO offsets,
+/// the half-voxel query, the shadow march's steps on those levels), so a surface holds a
+/// small part of them. Levels 2 and up are whole. Every result equals the one from
+/// buildMomentPyramid's whole pyramid bit for bit. Tiles are built from the volume: the
+/// volume the pyramid was built from must outlive it, unchanged. Queries on one pyramid
+/// may run concurrently (their builds take turns).
+class SurfacePyramid
+{
+public:
+  SurfacePyramid();
+  ~SurfacePyramid();
+  SurfacePyramid(SurfacePyramid&& other) noexcept;
+  SurfacePyramid& operator=(SurfacePyramid&& other) noexcept;
+
+  /// The levels; the tiled ones (0 and 1) have their geometry and no arrays.
+  const std::vector<MomentLevel>& levels() const { return this->Levels; }
+  bool empty() const { return this->Levels.empty(); }
+  void clear();
+  /// Level l's tiles built so far, and in all (0 for a whole level).
+  std::int64_t builtTiles(int level) const;
+  std::int64_t tileCount(int level) const;
+
+private:
+  friend struct SurfacePyramidAccess; // the builder's and the queries' way in
+  std::vector<MomentLevel> Levels;
+  std::unique_ptr<detail::PyramidTiles> Tiles;
+};
+
+/// The pyramid of buildMomentPyramid (same checks, levels 2 and up the same), levels 0
+/// and 1 left to be built in tiles by the queries. On failure the pyramid is left empty.
+Status buildSurfacePyramid(const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters, SurfacePyramid& pyramid,
+  const Execution& execution = {});
+
+/// surfaceAmbientOcclusion and surfaceShadow on a SurfacePyramid: the tiles the points
+/// reach are built first (kept for later queries).
+Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const double* points, const double* normals, std::int64_t count,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution = {});
+Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const float* points, const float* normals, std::int64_t count,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution = {});
+Status surfaceShadow(SurfacePyramid& pyramid, const double* points, const double* normals, std::int64_t count,
+  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
+  const Execution& execution = {});
+Status surfaceShadow(SurfacePyramid& pyramid, const float* points, const float* normals, std::int64_t count,
+  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
+  const Execution& execution = {});
 
 /// Trilinear sample of a level's mean and variance at a world position (clamped to the
 /// level's bounds).

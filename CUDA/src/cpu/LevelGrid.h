@@ -38,6 +38,12 @@ struct LevelGrid
   bool pairedRows = false;
   // Optional: the CellBounds below.
   const float* cellBounds = nullptr;
+  // Tiled (LevelTiles.h): voxel (i, j, k)'s index is the sum over the axes of
+  // (c >> 3) * tileStride[a] + (c & 7) * stride[a], c its coordinate; a cell's upper
+  // corner may then lie in the next tile. The variance follows its mean (variance =
+  // mean + 1, the strides in floats).
+  bool tiled = false;
+  std::int64_t tileStride[3] = { 0, 0, 0 };
 
   LevelGrid() = default;
   explicit LevelGrid(const MomentLevel& level)
@@ -115,8 +121,18 @@ inline void trilinearSample(const LevelGrid& g, double x, double y, double z, do
     const double u = std::min(std::max((p[a] - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
     const IndexT lower = static_cast<IndexT>(u); // u >= 0: truncation is the floor
     f[a] = u - static_cast<double>(lower);
-    base += lower * static_cast<IndexT>(g.stride[a]);
-    step[a] = u < g.maxIndex[a] ? static_cast<IndexT>(g.stride[a]) : IndexT(0); // upper corner, clamped
+    IndexT up = g.stride[a];
+    if (g.tiled)
+    {
+      const IndexT inTile = lower & 7;
+      base += (lower >> 3) * g.tileStride[a] + inTile * g.stride[a];
+      up = inTile == 7 ? g.tileStride[a] - 7 * g.stride[a] : g.stride[a];
+    }
+    else
+    {
+      base += lower * g.stride[a];
+    }
+    step[a] = u < g.maxIndex[a] ? up : IndexT(0); // upper corner, clamped
   }
   auto blend = [&](const float* c) {
     auto lerp = [](double a, double b, double t) { return a + t * (b - a); };

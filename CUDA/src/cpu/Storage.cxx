@@ -1,7 +1,8 @@
 // Storage of the large arrays: blocks aligned to 2 MiB and advised to use transparent huge
-// pages (see vao/Storage.h).
+// pages, and sparse reservations backed page by page (see vao/Storage.h).
 #include "vao/Storage.h"
 
+#include <cerrno>
 #include <cstdlib>
 #include <limits>
 
@@ -49,6 +50,55 @@ void freeStorage(void* block) noexcept
   _aligned_free(block);
 #else
   std::free(block);
+#endif
+}
+
+void* allocateSparseStorage(std::size_t bytes)
+{
+  if (bytes == 0)
+  {
+    bytes = 1;
+  }
+#if defined(__linux__)
+  void* block = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+  if (block == MAP_FAILED)
+  {
+    return nullptr;
+  }
+#if defined(MADV_NOHUGEPAGE)
+  madvise(block, bytes, MADV_NOHUGEPAGE);
+#endif
+  return block;
+#else
+  return std::calloc(bytes, 1); // large blocks come zeroed from the system, untouched
+#endif
+}
+
+void freeSparseStorage(void* block, std::size_t bytes) noexcept
+{
+  if (!block)
+  {
+    return;
+  }
+#if defined(__linux__)
+  munmap(block, bytes > 0 ? bytes : 1);
+#else
+  (void)bytes;
+  std::free(block);
+#endif
+}
+
+bool prepareSparseStorage(void* at, std::size_t bytes) noexcept
+{
+#if defined(__linux__)
+#if !defined(MADV_POPULATE_WRITE)
+  constexpr int MADV_POPULATE_WRITE = 23; // Linux 5.14; older kernels refuse it (EINVAL), harmlessly
+#endif
+  return madvise(at, bytes, MADV_POPULATE_WRITE) == 0 || errno != ENOMEM;
+#else
+  (void)at;
+  (void)bytes;
+  return true;
 #endif
 }
 

@@ -30,7 +30,8 @@ inline std::string pointMessage(const char* what, std::int64_t i)
 }
 
 /// Checks the pyramid and resolves the number of levels used.
-inline Status checkPyramid(const std::vector<MomentLevel>& pyramid, int requested, int& levels)
+/// `tiled`: the first levels of a SurfacePyramid, in tiles (LevelTiles.h), have no arrays.
+inline Status checkPyramid(const std::vector<MomentLevel>& pyramid, int requested, int& levels, int tiled = 0)
 {
   if (pyramid.empty())
   {
@@ -38,7 +39,7 @@ inline Status checkPyramid(const std::vector<MomentLevel>& pyramid, int requeste
   }
   for (const MomentLevel& level : pyramid)
   {
-    const std::int64_t n = level.dims[0] * level.dims[1] * level.dims[2];
+    const std::int64_t n = &level - &pyramid[0] < tiled ? 0 : level.dims[0] * level.dims[1] * level.dims[2];
     if (level.dims[0] < 1 || level.dims[1] < 1 || level.dims[2] < 1 ||
       static_cast<std::int64_t>(level.mean.size()) != n ||
       static_cast<std::int64_t>(level.variance.size()) != n || !(level.kernelRadius > 0.0))
@@ -125,9 +126,9 @@ Status checkPoints(const P* points, const P* normals, std::int64_t count)
 /// parameters, the points and normals, and somewhere to write.
 template <class P>
 Status checkQuery(const std::vector<MomentLevel>& pyramid, const SurfaceOcclusionParameters& parameters,
-  const P* points, const P* normals, std::int64_t count, const float* out, int& levels)
+  const P* points, const P* normals, std::int64_t count, const float* out, int& levels, int tiled = 0)
 {
-  Status status = checkPyramid(pyramid, parameters.levels, levels);
+  Status status = checkPyramid(pyramid, parameters.levels, levels, tiled);
   if (status.ok)
     status = checkParameters(parameters);
   if (status.ok)

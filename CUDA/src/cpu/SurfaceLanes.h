@@ -70,6 +70,33 @@ VAO_AVX2_HELPER __m256d blendPairsAvx2(const float* c, __m128i base, const __m12
   return lerpAvx2(lerpAvx2(rows[0], rows[1], f[1]), lerpAvx2(rows[2], rows[3], f[1]), f[2]);
 }
 
+/// blendAvx2 of the means and the variances of a tiled level (LevelGrid::tiled), whose
+/// (mean, variance) pairs are one 64-bit gather per corner.
+VAO_AVX2_HELPER void blendTiledAvx2(const float* c, __m128i base, const __m128i* step, const __m256d* f,
+  __m256d& mean, __m256d& variance)
+{
+  const __m128i corner[4] = { base, _mm_add_epi32(base, step[1]), _mm_add_epi32(base, step[2]),
+    _mm_add_epi32(_mm_add_epi32(base, step[2]), step[1]) };
+  const __m256i split = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+  __m256d means[4], variances[4];
+  for (int r = 0; r < 4; ++r)
+  {
+    __m256d m[2], v[2];
+    for (int side = 0; side < 2; ++side)
+    {
+      const __m128i at = side ? _mm_add_epi32(corner[r], step[0]) : corner[r];
+      const __m256i pairs = _mm256_i32gather_epi64(reinterpret_cast<const long long*>(c), at, 4);
+      const __m256 grouped = _mm256_permutevar8x32_ps(_mm256_castsi256_ps(pairs), split);
+      m[side] = _mm256_cvtps_pd(_mm256_castps256_ps128(grouped));
+      v[side] = _mm256_cvtps_pd(_mm256_extractf128_ps(grouped, 1));
+    }
+    means[r] = lerpAvx2(m[0], m[1], f[0]);
+    variances[r] = lerpAvx2(v[0], v[1], f[0]);
+  }
+  mean = lerpAvx2(lerpAvx2(means[0], means[1], f[1]), lerpAvx2(means[2], means[3], f[1]), f[2]);
+  variance = lerpAvx2(lerpAvx2(variances[0], variances[1], f[1]), lerpAvx2(variances[2], variances[3], f[1]), f[2]);
+}
+
 /// Four lanes' cells of one level: the lower corners per axis and as flat 32-bit indices,
 /// the steps to the upper corners (0 where clamped) and the fractions towards them.
 struct CellsAvx2
@@ -96,8 +123,19 @@ VAO_AVX2_HELPER CellsAvx2 cellsAvx2(const LevelGrid& g, const __m256d* position)
       lower = _mm_min_epi32(lower, _mm_set1_epi32(static_cast<int>(g.maxIndex[0]) - 1));
     c.lower[a] = lower;
     c.f[a] = _mm256_sub_pd(u, _mm256_cvtepi32_pd(lower));
-    const __m128i stride = _mm_set1_epi32(static_cast<int>(g.stride[a]));
-    c.base = _mm_add_epi32(c.base, _mm_mullo_epi32(lower, stride));
+    __m128i stride = _mm_set1_epi32(static_cast<int>(g.stride[a]));
+    if (g.tiled) // trilinearSample's tiled index; the step to the next tile where the cell crosses
+    {
+      const __m128i seven = _mm_set1_epi32(7);
+      const __m128i inTile = _mm_and_si128(lower, seven);
+      const __m128i tileStride = _mm_set1_epi32(static_cast<int>(g.tileStride[a]));
+      c.base = _mm_add_epi32(c.base, _mm_add_epi32(_mm_mullo_epi32(_mm_srli_epi32(lower, 3), tileStride),
+                                       _mm_mullo_epi32(inTile, stride)));
+      const __m128i across = _mm_sub_epi32(tileStride, _mm_mullo_epi32(seven, stride));
+      stride = _mm_blendv_epi8(stride, across, _mm_cmpeq_epi32(inTile, seven));
+    }
+    else
+      c.base = _mm_add_epi32(c.base, _mm_mullo_epi32(lower, stride));
     // The 64-bit lane masks of u < maxIndex, narrowed to 32 bits.
     const __m256i below = _mm256_castpd_si256(_mm256_cmp_pd(u, maxIndex, _CMP_LT_OQ));
     const __m128i narrow =
@@ -112,11 +150,17 @@ VAO_AVX2_HELPER CellsAvx2 cellsAvx2(const LevelGrid& g, const __m256d* position)
 /// arithmetic, one kept by a mask.
 VAO_AVX2_HELPER __m256d chebyshevCellsAvx2(const LevelGrid& g, const CellsAvx2& c, __m256d q)
 {
-  const __m256d mean =
-    g.pairedRows ? blendPairsAvx2(g.mean, c.base, c.step, c.f) : blendAvx2(g.mean, c.base, c.step, c.f);
-  const __m256d variance = _mm256_max_pd(g.pairedRows ? blendPairsAvx2(g.variance, c.base, c.step, c.f)
-                                                      : blendAvx2(g.variance, c.base, c.step, c.f),
-    _mm256_setzero_pd());
+  __m256d mean, variance;
+  if (g.tiled)
+  {
+    blendTiledAvx2(g.mean, c.base, c.step, c.f, mean, variance);
+  }
+  else
+  {
+    mean = g.pairedRows ? blendPairsAvx2(g.mean, c.base, c.step, c.f) : blendAvx2(g.mean, c.base, c.step, c.f);
+    variance = g.pairedRows ? blendPairsAvx2(g.variance, c.base, c.step, c.f) : blendAvx2(g.variance, c.base, c.step, c.f);
+  }
+  variance = _mm256_max_pd(variance, _mm256_setzero_pd());
   return _mm256_sub_pd(_mm256_set1_pd(1.0), chebyshevOpennessAvx2(q, mean, variance,
     _mm256_set1_pd(g.roundingVariance), _mm256_set1_pd(g.roundingSpread)));
 }

@@ -3,19 +3,26 @@
 #include "vao/VarianceOcclusionMap.h"
 #include "vao/Validation.h"
 
+#include "LevelTiles.h"
+#include "Parallel.h"
+#include "SurfaceBatches.h"
 #include "SurfaceChecks.h"
 #include "SurfaceLanes.h"
-#include "Parallel.h"
 #include "VolumeAccess.h"
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <vector>
 
 namespace vao
 {
 namespace
 {
+
+using detail::MarchBounds;
+using detail::PointLanes;
+using detail::forEachBatch;
 
 /// The grid cell around a world position, clamped to the grid: lower and upper corner
 /// indices and the fractions towards the upper one, per axis.
@@ -69,26 +76,29 @@ struct PreparedPyramid
   // The AVX2 march applies: the processor has it and every level's indices fit in 32 bits.
   bool vectorMarch = detail::cpuHasAvx2();
 
-  PreparedPyramid(const std::vector<MomentLevel>& pyramid, int levels)
+  /// `tiles`: a SurfacePyramid's tiled levels (read where their tiles are built).
+  PreparedPyramid(const std::vector<MomentLevel>& pyramid, int levels, const detail::PyramidTiles* tiles)
   {
     for (int l = 0; l < levels; ++l)
     {
-      this->grids.emplace_back(pyramid[l]);
+      const detail::LevelTiles* tiled = tiles ? tiles->at(l) : nullptr;
+      this->grids.push_back(tiled ? tiled->grid() : detail::LevelGrid(pyramid[l]));
       this->levels.push_back(&pyramid[l]);
       this->kernelRadius.push_back(pyramid[l].kernelRadius);
       this->vectorMarch = this->vectorMarch && this->grids.back().narrowIndices;
     }
   }
 
-  /// Cell bounds for the vector march on the levels small beside the work of marching
-  /// `count` points (building them reads the level once): the coarse levels, where most
-  /// of a march's steps fall.
+  /// Cell bounds for the vector march on the whole levels of at most one voxel a point
+  /// (building them reads the level once): the coarsest, where most of a march's steps
+  /// fall. (Those of the next level, with 8 voxels a point, made the bone surface of the
+  /// CT head no faster and cost 7 MB.)
   void boundCells(std::int64_t count)
   {
     this->bounds.reserve(this->grids.size());
     for (std::size_t l = 0; l < this->grids.size() && this->vectorMarch; ++l)
     {
-      if (this->levels[l]->mean.size() <= static_cast<std::size_t>(8 * count))
+      if (!this->grids[l].tiled && this->levels[l]->mean.size() <= static_cast<std::size_t>(count))
         this->bounds.emplace_back(*this->levels[l], this->grids[l]);
     }
   }
@@ -96,29 +106,6 @@ struct PreparedPyramid
 private:
   std::vector<const MomentLevel*> levels;
   std::vector<detail::CellBounds> bounds;
-};
-
-/// The box the shadow march stays in: level 0's bounds, or the whole volume's when the
-/// level is a distributed piece's window.
-struct MarchBounds
-{
-  double lo[3], hi[3];
-
-  explicit MarchBounds(const MomentLevel& level)
-  {
-    const bool window = std::isfinite(level.wholeBounds[0]);
-    for (int a = 0; a < 3; ++a)
-    {
-      this->lo[a] = window ? level.wholeBounds[2 * a] : level.origin[a];
-      this->hi[a] = window ? level.wholeBounds[2 * a + 1] : level.origin[a] + (level.dims[a] - 1) * level.spacing[a];
-    }
-  }
-
-  bool contains(const double* p) const
-  {
-    return p[0] >= this->lo[0] && p[0] <= this->hi[0] && p[1] >= this->lo[1] && p[1] <= this->hi[1] &&
-      p[2] >= this->lo[2] && p[2] <= this->hi[2];
-  }
 };
 
 } // namespace
@@ -139,69 +126,6 @@ void sampleLevel(const MomentLevel& level, const std::array<double, 3>& position
 
 namespace
 {
-
-/// kLanes points at a time (the last batch padded with copies of its last point): their
-/// positions, unit normals and queries, structure of arrays.
-struct PointLanes
-{
-  std::int64_t first = 0;
-  int used = 0; // real points in the batch
-  double x[detail::kLanes], y[detail::kLanes], z[detail::kLanes];
-  double nx[detail::kLanes], ny[detail::kLanes], nz[detail::kLanes];
-  double query[detail::kLanes];
-
-  template <class P>
-  PointLanes(const P* points, const P* normals, std::int64_t count, std::int64_t batch)
-    : first(batch * detail::kLanes)
-    , used(static_cast<int>(std::min<std::int64_t>(detail::kLanes, count - batch * detail::kLanes)))
-  {
-    for (int k = 0; k < detail::kLanes; ++k)
-    {
-      const std::int64_t i = this->first + std::min(k, this->used - 1);
-      const double p[3] = { static_cast<double>(points[3 * i]), static_cast<double>(points[3 * i + 1]),
-        static_cast<double>(points[3 * i + 2]) };
-      const double n[3] = { static_cast<double>(normals[3 * i]), static_cast<double>(normals[3 * i + 1]),
-        static_cast<double>(normals[3 * i + 2]) };
-      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-      this->x[k] = p[0];
-      this->y[k] = p[1];
-      this->z[k] = p[2];
-      this->nx[k] = n[0] / length;
-      this->ny[k] = n[1] / length;
-      this->nz[k] = n[2] / length;
-    }
-  }
-
-  /// The world position at distance d from point k along its normal.
-  std::array<double, 3> along(int k, double d) const
-  {
-    return { this->x[k] + d * this->nx[k], this->y[k] + d * this->ny[k], this->z[k] + d * this->nz[k] };
-  }
-};
-
-/// f(lanes) for every batch of kLanes points, on every thread, reporting progress every
-/// 64 batches. Returns false when cancelled.
-template <class P, class PerBatch>
-bool forEachBatch(const P* points, const P* normals, std::int64_t count, const Execution& execution,
-  PerBatch&& f)
-{
-  constexpr int kProgressBatches = 64;
-  const std::int64_t batches = (count + detail::kLanes - 1) / detail::kLanes;
-  const int threads = detail::resolveThreadCount(execution.threads);
-  const int chunks = static_cast<int>(std::min<std::int64_t>(std::max<std::int64_t>(batches, 1), threads * 8));
-  return detail::parallelFor(batches, chunks, threads, execution,
-    [&](std::int64_t begin, std::int64_t end, detail::ChunkProgress& progress) {
-      for (std::int64_t b = begin; b < end; ++b)
-      {
-        PointLanes lanes(points, normals, count, b);
-        f(lanes);
-        if ((b - begin) % kProgressBatches == kProgressBatches - 1 && !progress.advance(kProgressBatches))
-        {
-          return;
-        }
-      }
-    });
-}
 
 /// The occlusions of a batch of surface points from the levels used (sampled at
 /// p + k r_l n, combined by maximum or mean).
@@ -288,13 +212,33 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int l
   }
 }
 
+/// With tiled levels: marks the tiles that mark(lanes, tiles) names for every batch,
+/// builds them, and gives the execution left for the samples (progress 0.3 to 1).
+template <class P, class Mark>
+bool reachTiles(detail::PyramidTiles* tiles, const P* points, const P* normals, std::int64_t count,
+  const Execution& execution, Execution& sampling, Mark&& mark)
+{
+  sampling = execution;
+  if (!tiles)
+  {
+    return true;
+  }
+  std::lock_guard<std::mutex> lock(tiles->buildMutex());
+  sampling = detail::stageExecution(execution, 0.3, 1.0);
+  return forEachBatch(points, normals, count, detail::stageExecution(execution, 0.0, 0.1),
+           [&](PointLanes& lanes) { mark(lanes, *tiles); }) &&
+    tiles->buildMarked(detail::stageExecution(execution, 0.1, 0.3));
+}
+
+/// `tiles`: a SurfacePyramid's tiled levels; the tiles the samples reach are built first.
 template <class P>
-Status occlusionOf(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
+Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles, const VolumeView& volume,
   const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const P* points, const P* normals,
   std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
   int levels = 0;
-  Status status = detail::checkQuery(pyramid, parameters, points, normals, count, out, levels);
+  Status status =
+    detail::checkQuery(pyramid, parameters, points, normals, count, out, levels, tiles ? tiles->count() : 0);
   const bool half = parameters.query == SurfaceQuery::HalfVoxelInside;
   if (status.ok && half)
   {
@@ -311,10 +255,24 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, const VolumeView& vo
     return status;
   }
   const double h = std::min(spacing[0], std::min(spacing[1], spacing[2]));
-  const PreparedPyramid prepared(pyramid, levels);
+  // The tiled levels' samples: at p + k r_l n (batchOcclusion's positions).
+  Execution sampling;
+  if (!reachTiles(tiles, points, normals, count, execution, sampling, [&](const PointLanes& lanes, detail::PyramidTiles& t) {
+        for (int l = 0; l < std::min(levels, t.count()); ++l)
+        {
+          const double offset = parameters.offsetFactor * pyramid[l].kernelRadius;
+          for (int k = 0; k < lanes.used; ++k)
+            t.at(l)->markAround(lanes.x[k] + offset * lanes.nx[k], lanes.y[k] + offset * lanes.ny[k],
+              lanes.z[k] + offset * lanes.nz[k]);
+        }
+      }))
+  {
+    return Status::cancelled();
+  }
+  const PreparedPyramid prepared(pyramid, levels, tiles);
   const bool finished = detail::dispatchScalarType(half ? volume.type : ScalarType::Float32, [&](auto tag) {
     const detail::TypedVolume<decltype(tag)> typed(half ? volume : VolumeView{});
-    return forEachBatch(points, normals, count, execution, [&](PointLanes& lanes) {
+    return forEachBatch(points, normals, count, sampling, [&](PointLanes& lanes) {
       for (int k = 0; k < detail::kLanes; ++k)
       {
         lanes.query[k] = half ? trilinear(typed, origin, spacing, lanes.along(k, -0.5 * h)) : parameters.isoValue;
@@ -331,12 +289,13 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, const VolumeView& vo
 }
 
 template <class P>
-Status shadowOf(const std::vector<MomentLevel>& pyramid, const P* points, const P* normals, std::int64_t count,
-  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution)
+Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles, const P* points, const P* normals,
+  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution)
 {
   int levels = 0;
-  Status status = detail::checkQuery(pyramid, parameters, points, normals, count, out, levels);
+  Status status =
+    detail::checkQuery(pyramid, parameters, points, normals, count, out, levels, tiles ? tiles->count() : 0);
   if (status.ok)
     status = checkFinitePoint(lightDirection, "the light direction");
   if (!status.ok)
@@ -353,10 +312,43 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, const P* points, const 
     lightDirection[2] / lightLength };
   const MomentLevel& base = pyramid[0];
   const double h = std::min(base.spacing[0], std::min(base.spacing[1], base.spacing[2]));
-  PreparedPyramid prepared(pyramid, levels);
-  prepared.boundCells(count);
   const MarchBounds bounds(base);
-  const bool finished = forEachBatch(points, normals, count, execution, [&](PointLanes& lanes) {
+  // The tiled levels' samples: the query half a voxel inside (level 0) and the march's
+  // steps while it is on them (batchMarch's positions, whatever the occlusion met).
+  const double r0 = base.kernelRadius;
+  // Every march takes the same distances and levels: those of the tiled levels, once.
+  std::vector<std::pair<double, detail::LevelTiles*>> steps;
+  for (double s = 0.0; tiles && steps.size() < detail::kMarchMaxSteps;)
+  {
+    const int l = detail::marchLevel(s, r0, levels);
+    if (!tiles->at(l))
+      break;
+    steps.emplace_back(s, tiles->at(l));
+    s += detail::kMarchStepFraction * pyramid[l].kernelRadius;
+  }
+  Execution sampling;
+  if (!reachTiles(tiles, points, normals, count, execution, sampling, [&](const PointLanes& lanes, detail::PyramidTiles& t) {
+        for (int k = 0; k < lanes.used; ++k)
+        {
+          const std::array<double, 3> inside = lanes.along(k, -0.5 * h);
+          const std::array<double, 3> start = lanes.along(k, r0);
+          t.at(0)->markAround(inside[0], inside[1], inside[2]);
+          for (const auto& step : steps)
+          {
+            const double s = step.first;
+            const double at[3] = { start[0] + s * light[0], start[1] + s * light[1], start[2] + s * light[2] };
+            if (!bounds.contains(at))
+              break;
+            step.second->markAround(at[0], at[1], at[2]);
+          }
+        }
+      }))
+  {
+    return Status::cancelled();
+  }
+  PreparedPyramid prepared(pyramid, levels, tiles);
+  prepared.boundCells(count);
+  const bool finished = forEachBatch(points, normals, count, sampling, [&](PointLanes& lanes) {
     for (int k = 0; k < detail::kLanes; ++k)
     {
       lanes.query[k] = parameters.isoValue;
@@ -378,6 +370,29 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, const P* points, const 
   return finished ? Status::success() : Status::cancelled();
 }
 
+/// The queries on a SurfacePyramid: building tiles may run out of memory.
+template <class P>
+Status tiledOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const P* points, const P* normals, std::int64_t count,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
+{
+  return catchOutOfMemory("the tiles of the moment pyramid", [&] {
+    return occlusionOf(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), volume, origin, spacing, points,
+      normals, count, parameters, out, execution);
+  });
+}
+
+template <class P>
+Status tiledShadow(SurfacePyramid& pyramid, const P* points, const P* normals, std::int64_t count,
+  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
+  const Execution& execution)
+{
+  return catchOutOfMemory("the tiles of the moment pyramid", [&] {
+    return shadowOf(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), points, normals, count,
+      lightDirection, parameters, out, execution);
+  });
+}
+
 } // namespace
 
 Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
@@ -385,7 +400,7 @@ Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const Vo
   const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
   const Execution& execution)
 {
-  return occlusionOf(pyramid, volume, origin, spacing, points, normals, count, parameters, out, execution);
+  return occlusionOf(pyramid, nullptr, volume, origin, spacing, points, normals, count, parameters, out, execution);
 }
 
 Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
@@ -393,21 +408,49 @@ Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const Vo
   const float* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
   const Execution& execution)
 {
-  return occlusionOf(pyramid, volume, origin, spacing, points, normals, count, parameters, out, execution);
+  return occlusionOf(pyramid, nullptr, volume, origin, spacing, points, normals, count, parameters, out, execution);
 }
 
 Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* points, const double* normals,
   std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
   float* out, const Execution& execution)
 {
-  return shadowOf(pyramid, points, normals, count, lightDirection, parameters, out, execution);
+  return shadowOf(pyramid, nullptr, points, normals, count, lightDirection, parameters, out, execution);
 }
 
 Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const float* points, const float* normals,
   std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
   float* out, const Execution& execution)
 {
-  return shadowOf(pyramid, points, normals, count, lightDirection, parameters, out, execution);
+  return shadowOf(pyramid, nullptr, points, normals, count, lightDirection, parameters, out, execution);
+}
+
+Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const double* points, const double* normals, std::int64_t count,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
+{
+  return tiledOcclusion(pyramid, volume, origin, spacing, points, normals, count, parameters, out, execution);
+}
+
+Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const float* points, const float* normals, std::int64_t count,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
+{
+  return tiledOcclusion(pyramid, volume, origin, spacing, points, normals, count, parameters, out, execution);
+}
+
+Status surfaceShadow(SurfacePyramid& pyramid, const double* points, const double* normals, std::int64_t count,
+  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
+  const Execution& execution)
+{
+  return tiledShadow(pyramid, points, normals, count, lightDirection, parameters, out, execution);
+}
+
+Status surfaceShadow(SurfacePyramid& pyramid, const float* points, const float* normals, std::int64_t count,
+  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
+  const Execution& execution)
+{
+  return tiledShadow(pyramid, points, normals, count, lightDirection, parameters, out, execution);
 }
 
 } // namespace vao

@@ -1,0 +1,106 @@
+// What the surface queries (SurfaceSampling.cxx) share between marking the tiles their
+// samples reach and sampling: the points in batches of kLanes, with the same positions
+// and unit normals either way, and the box the shadow march stays in.
+#pragma once
+
+#include "LevelGrid.h"
+#include "Parallel.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+namespace vao
+{
+namespace detail
+{
+
+/// kLanes points at a time (the last batch padded with copies of its last point): their
+/// positions, unit normals and queries, structure of arrays.
+struct PointLanes
+{
+  std::int64_t first = 0;
+  int used = 0; // real points in the batch
+  double x[kLanes], y[kLanes], z[kLanes];
+  double nx[kLanes], ny[kLanes], nz[kLanes];
+  double query[kLanes];
+
+  template <class P>
+  PointLanes(const P* points, const P* normals, std::int64_t count, std::int64_t batch)
+    : first(batch * kLanes)
+    , used(static_cast<int>(std::min<std::int64_t>(kLanes, count - batch * kLanes)))
+  {
+    for (int k = 0; k < kLanes; ++k)
+    {
+      const std::int64_t i = this->first + std::min(k, this->used - 1);
+      const double p[3] = { static_cast<double>(points[3 * i]), static_cast<double>(points[3 * i + 1]),
+        static_cast<double>(points[3 * i + 2]) };
+      const double n[3] = { static_cast<double>(normals[3 * i]), static_cast<double>(normals[3 * i + 1]),
+        static_cast<double>(normals[3 * i + 2]) };
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      this->x[k] = p[0];
+      this->y[k] = p[1];
+      this->z[k] = p[2];
+      this->nx[k] = n[0] / length;
+      this->ny[k] = n[1] / length;
+      this->nz[k] = n[2] / length;
+    }
+  }
+
+  /// The world position at distance d from point k along its normal.
+  std::array<double, 3> along(int k, double d) const
+  {
+    return { this->x[k] + d * this->nx[k], this->y[k] + d * this->ny[k], this->z[k] + d * this->nz[k] };
+  }
+};
+
+/// f(lanes) for every batch of kLanes points, on every thread, reporting progress every
+/// 64 batches. Returns false when cancelled.
+template <class P, class PerBatch>
+bool forEachBatch(const P* points, const P* normals, std::int64_t count, const Execution& execution,
+  PerBatch&& f)
+{
+  constexpr int kProgressBatches = 64;
+  const std::int64_t batches = (count + kLanes - 1) / kLanes;
+  const int threads = resolveThreadCount(execution.threads);
+  const int chunks = static_cast<int>(std::min<std::int64_t>(std::max<std::int64_t>(batches, 1), threads * 8));
+  return parallelFor(batches, chunks, threads, execution,
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+      for (std::int64_t b = begin; b < end; ++b)
+      {
+        PointLanes lanes(points, normals, count, b);
+        f(lanes);
+        if ((b - begin) % kProgressBatches == kProgressBatches - 1 && !progress.advance(kProgressBatches))
+        {
+          return;
+        }
+      }
+    });
+}
+
+/// The box the shadow march stays in: level 0's bounds, or the whole volume's when the
+/// level is a distributed piece's window.
+struct MarchBounds
+{
+  double lo[3], hi[3];
+
+  explicit MarchBounds(const MomentLevel& level)
+  {
+    const bool window = std::isfinite(level.wholeBounds[0]);
+    for (int a = 0; a < 3; ++a)
+    {
+      this->lo[a] = window ? level.wholeBounds[2 * a] : level.origin[a];
+      this->hi[a] = window ? level.wholeBounds[2 * a + 1] : level.origin[a] + (level.dims[a] - 1) * level.spacing[a];
+    }
+  }
+
+  bool contains(const double* p) const
+  {
+    return p[0] >= this->lo[0] && p[0] <= this->hi[0] && p[1] >= this->lo[1] && p[1] <= this->hi[1] &&
+      p[2] >= this->lo[2] && p[2] <= this->hi[2];
+  }
+};
+
+} // namespace detail
+} // namespace vao

@@ -1,0 +1,225 @@
+// The SurfacePyramid: level 0 in tiles built where the queries sample. Its results must
+// be those of the whole pyramid bit for bit (the tiles are the same blur of the same
+// voxels), on every SIMD tier, for every query, and it must build only part of level 0.
+#include "PyramidTestSupport.h"
+
+#include "cpu/CpuDispatch.h"
+#include "cpu/LevelTiles.h"
+
+#include <random>
+
+namespace
+{
+using namespace vaotest;
+
+/// A sphere in a box shell on a grid that is no multiple of the tiles, off the origin,
+/// with unequal spacings: the tiles at the far faces are partial.
+Field shellScene(const vao::Index3& d)
+{
+  const Vec3 c = { 0.47 * d[0], 0.52 * d[1], 0.5 * d[2] };
+  Field f = makeField(d, [&](double x, double y, double z) {
+    const double sphere = std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) - 5.5;
+    const double m = std::max(std::fabs(x - c[0]), std::max(std::fabs(y - c[1]), std::fabs(z - c[2])));
+    return std::min(sphere, std::max(11.0 - m, m - 14.0));
+  });
+  f.origin = { -3.25, 1.5, 0.75 };
+  f.spacing = { 0.8, 1.1, 0.95 };
+  return f;
+}
+
+/// Surface points of the scene's sphere plus points anywhere in (and just outside) the
+/// volume, with normals of every direction and length.
+void scenePoints(const Field& f, std::vector<double>& points, std::vector<double>& normals)
+{
+  const Vec3 c = { f.origin[0] + 0.47 * f.dims[0] * f.spacing[0], f.origin[1] + 0.52 * f.dims[1] * f.spacing[1],
+    f.origin[2] + 0.5 * f.dims[2] * f.spacing[2] };
+  spherePoints(c, 5.5, 301, points, normals);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(-0.05, 1.05), direction(-1.0, 1.0);
+  for (int i = 0; i < 150; ++i)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      points.push_back(f.origin[a] + unit(random) * (f.dims[a] - 1) * f.spacing[a]);
+      normals.push_back(direction(random) + (a == 2 ? 1e-3 : 0.0));
+    }
+  }
+}
+
+vao::SurfacePyramid surfacePyramidOf(const Field& f, const vao::PyramidParameters& p)
+{
+  vao::SurfacePyramid pyramid;
+  const vao::Status s = vao::buildSurfacePyramid(f.view(), f.origin, f.spacing, p, pyramid);
+  EXPECT_TRUE(s.ok) << s.message;
+  return pyramid;
+}
+
+} // namespace
+
+TEST(SurfacePyramid, TilesHoldTheWholeLevelsVoxels)
+{
+  // Every tile of levels 0 and 1 built, read back in the layout of LevelTiles.h (tiles of
+  // 8^3 voxels x fastest, each the (mean, variance) pairs of its voxels): each voxel equals
+  // the whole level's, at full and half resolution. Level 2, blurred from the two levels
+  // streamed slice by slice, equals the whole build's level 2, and so does level 3.
+  const Field f = shellScene({ 37, 19, 26 });
+  for (bool half : { false, true })
+  {
+    vao::PyramidParameters p;
+    p.levels = 4;
+    p.startAtHalfResolution = half;
+    std::vector<vao::MomentLevel> whole;
+    ASSERT_TRUE(vao::buildMomentPyramid(f.view(), f.origin, f.spacing, p, whole).ok);
+    vao::SurfacePyramid surface = surfacePyramidOf(f, p);
+    vao::detail::PyramidTiles& tiles = *vao::SurfacePyramidAccess::tiles(surface);
+    ASSERT_EQ(tiles.count(), 2);
+    for (int l = 0; l < 2; ++l)
+    {
+      const vao::MomentLevel& level = whole[l];
+      vao::detail::LevelTiles& built = *tiles.at(l);
+      for (std::int64_t z = 0; z < level.dims[2]; ++z)
+        for (std::int64_t y = 0; y < level.dims[1]; ++y)
+          for (std::int64_t x = 0; x < level.dims[0]; ++x)
+            built.markAround(level.origin[0] + x * level.spacing[0], level.origin[1] + y * level.spacing[1],
+              level.origin[2] + z * level.spacing[2]);
+    }
+    ASSERT_TRUE(tiles.buildMarked({}));
+    for (int l = 0; l < 2; ++l)
+    {
+      const vao::MomentLevel& level = whole[l];
+      EXPECT_EQ(surface.builtTiles(l), surface.tileCount(l));
+      const vao::detail::LevelGrid grid = tiles.at(l)->grid();
+      const std::int64_t tx = (level.dims[0] + 7) / 8, ty = (level.dims[1] + 7) / 8;
+      for (std::int64_t z = 0; z < level.dims[2]; ++z)
+        for (std::int64_t y = 0; y < level.dims[1]; ++y)
+          for (std::int64_t x = 0; x < level.dims[0]; ++x)
+          {
+            const std::int64_t tile = ((z / 8) * ty + y / 8) * tx + x / 8;
+            const std::int64_t at = tile * 1024 + 2 * (((z % 8) * 8 + y % 8) * 8 + x % 8);
+            const std::int64_t i = (z * level.dims[1] + y) * level.dims[0] + x;
+            ASSERT_EQ(grid.mean[at], level.mean[i]) << "level " << l << " half " << half << " voxel " << x << " " << y << " " << z;
+            ASSERT_EQ(grid.mean[at + 1], level.variance[i])
+              << "level " << l << " half " << half << " voxel " << x << " " << y << " " << z;
+          }
+    }
+    for (int l = 2; l < 4; ++l)
+    {
+      const vao::MomentLevel& level = surface.levels()[l];
+      ASSERT_EQ(level.mean.size(), whole[l].mean.size());
+      for (std::size_t i = 0; i < level.mean.size(); ++i)
+      {
+        ASSERT_EQ(level.mean[i], whole[l].mean[i]) << "level " << l << " " << i;
+        ASSERT_EQ(level.variance[i], whole[l].variance[i]) << "level " << l << " " << i;
+      }
+    }
+  }
+}
+
+TEST(SurfacePyramid, QueriesEqualTheWholePyramidBitForBitOnEveryTier)
+{
+  // A fresh SurfacePyramid per query, so each query finds its own tiles unbuilt: a sample
+  // whose tile the marking missed would read zeros and differ.
+  const Field f = shellScene({ 45, 38, 41 });
+  std::vector<double> points, normals;
+  scenePoints(f, points, normals);
+  const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
+  const std::vector<std::array<double, 3>> lights = { { 0.2, -0.5, 1 }, { -1, 0, 0 }, { 0, 0, -1 }, { 0.7, 0.7, -0.1 } };
+  for (vao::detail::SimdTier tier :
+    { vao::detail::SimdTier::Baseline, vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
+  {
+    vao::detail::limitSimdTier(tier);
+    for (int levels : { 1, 2, 3, 4 })
+      for (bool half : { false, true })
+      {
+        vao::PyramidParameters pp;
+        pp.levels = levels;
+        pp.startAtHalfResolution = half;
+        std::vector<vao::MomentLevel> whole;
+        ASSERT_TRUE(vao::buildMomentPyramid(f.view(), f.origin, f.spacing, pp, whole).ok);
+        forEachSurfaceQuery([&](vao::SurfaceOcclusionParameters p) {
+            p.offsetFactor = levels == 2 ? 1.7 : 1.0;
+            std::vector<float> expected(n, -1.0f), got(n, -2.0f);
+            ASSERT_TRUE(vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing, points.data(),
+              normals.data(), n, p, expected.data()).ok);
+            vao::SurfacePyramid surface = surfacePyramidOf(f, pp);
+            const vao::Status s = vao::surfaceAmbientOcclusion(surface, f.view(), f.origin, f.spacing, points.data(),
+              normals.data(), n, p, got.data());
+            ASSERT_TRUE(s.ok) << s.message;
+            for (std::int64_t i = 0; i < n; ++i)
+              ASSERT_EQ(got[i], expected[i]) << "AO, tier " << int(tier) << " levels " << levels << " half " << half
+                                             << " point " << i;
+            for (const auto& light : lights)
+            {
+              ASSERT_TRUE(
+                vao::surfaceShadow(whole, points.data(), normals.data(), n, light, p, expected.data()).ok);
+              vao::SurfacePyramid fresh = surfacePyramidOf(f, pp);
+              ASSERT_TRUE(vao::surfaceShadow(fresh, points.data(), normals.data(), n, light, p, got.data()).ok);
+              for (std::int64_t i = 0; i < n; ++i)
+                ASSERT_EQ(got[i], expected[i]) << "shadow, tier " << int(tier) << " levels " << levels << " half "
+                                               << half << " light " << light[0] << " " << light[1] << " " << light[2]
+                                               << " point " << i;
+            }
+          });
+      }
+  }
+  vao::detail::limitSimdTier(vao::detail::SimdTier::Avx512);
+}
+
+TEST(SurfacePyramid, BuildsOnlyTheTilesASurfaceReachesAndKeepsThem)
+{
+  // A small sphere in a large volume: AO and a shadow reach a few of level 0's tiles; a
+  // second query of the same kind builds nothing more, another light only what it adds.
+  const vao::Index3 d = { 96, 96, 96 };
+  const Vec3 c = { 48.3, 47.6, 48.1 };
+  const Field f = makeField(d, [&](double x, double y, double z) {
+    return std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) - 9.0;
+  });
+  std::vector<double> points, normals;
+  spherePoints(c, 9.0, 2000, points, normals);
+  const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
+  vao::PyramidParameters pp;
+  vao::SurfacePyramid surface = surfacePyramidOf(f, pp);
+  EXPECT_EQ(surface.tileCount(0), 12 * 12 * 12);
+  EXPECT_EQ(surface.tileCount(1), 6 * 6 * 6);
+  EXPECT_EQ(surface.tileCount(2), 0); // whole
+  EXPECT_EQ(surface.builtTiles(0) + surface.builtTiles(1), 0);
+  std::vector<float> out(n);
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(surface, f.view(), f.origin, f.spacing, points.data(), normals.data(), n,
+    {}, out.data()).ok);
+  const std::int64_t afterAo = surface.builtTiles(0);
+  EXPECT_GT(afterAo, 0);
+  EXPECT_GT(surface.builtTiles(1), 0);
+  EXPECT_LE(afterAo, 4 * 4 * 4); // the AO samples lie on a sphere of radius 11 voxels: 4 tiles a side
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(surface, f.view(), f.origin, f.spacing, points.data(), normals.data(), n,
+    {}, out.data()).ok);
+  EXPECT_EQ(surface.builtTiles(0), afterAo);
+  ASSERT_TRUE(vao::surfaceShadow(surface, points.data(), normals.data(), n, { 0, 0, 1 }, {}, out.data()).ok);
+  const std::int64_t afterShadow = surface.builtTiles(0);
+  EXPECT_GE(afterShadow, afterAo);
+  EXPECT_LT(afterShadow, surface.tileCount(0) / 10);
+  EXPECT_LT(surface.builtTiles(1), surface.tileCount(1) / 2);
+}
+
+TEST(SurfacePyramid, BadInputFailsWithMessage)
+{
+  vao::SurfacePyramid empty;
+  const double p[3] = { 1, 1, 1 }, nrm[3] = { 0, 0, 1 };
+  float out = 0;
+  const Field f = shellScene({ 12, 12, 12 });
+  vao::Status s = vao::surfaceAmbientOcclusion(empty, f.view(), f.origin, f.spacing, p, nrm, 1, {}, &out);
+  EXPECT_FALSE(s.ok);
+  EXPECT_NE(s.message.find("empty"), std::string::npos) << s.message;
+  s = vao::surfaceShadow(empty, p, nrm, 1, { 0, 0, 1 }, {}, &out);
+  EXPECT_FALSE(s.ok);
+  vao::SurfacePyramid pyramid;
+  vao::PyramidParameters pp;
+  pp.levels = 17;
+  s = vao::buildSurfacePyramid(f.view(), f.origin, f.spacing, pp, pyramid);
+  EXPECT_FALSE(s.ok);
+  EXPECT_TRUE(pyramid.empty());
+  Field nan = f;
+  nan.values[5] = std::numeric_limits<float>::quiet_NaN();
+  s = vao::buildSurfacePyramid(nan.view(), nan.origin, nan.spacing, {}, pyramid);
+  EXPECT_FALSE(s.ok);
+  EXPECT_TRUE(pyramid.empty());
+}
