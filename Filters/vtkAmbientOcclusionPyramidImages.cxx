@@ -32,6 +32,17 @@ bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vt
   return status.ok;
 }
 
+bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vtkImageData* input,
+  const vao::PyramidParameters& parameters, const vao::Execution& execution,
+  vao::SurfacePyramid& pyramid, std::string& error)
+{
+  const double* h = input->GetSpacing();
+  const vao::Status status = vao::buildSurfacePyramid(
+    scalars.view, ExtentOrigin(input), { h[0], h[1], h[2] }, parameters, pyramid, execution);
+  error = vtkAmbientOcclusionArrayInput::KernelError(status, scalars, "The variance occlusion map failed");
+  return status.ok;
+}
+
 vao::MomentLevel WholeLevelGeometry(vtkImageData* volume, const int whole[6], int step)
 {
   vao::MomentLevel level;

@@ -29,6 +29,12 @@ bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vt
   const vao::PyramidParameters& parameters, const vao::Execution& execution,
   std::vector<vao::MomentLevel>& pyramid, std::string& error);
 
+/// The same as a SurfacePyramid (level 0 built where the surface queries reach it), which
+/// reads `scalars` again whenever a query builds tiles.
+bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vtkImageData* input,
+  const vao::PyramidParameters& parameters, const vao::Execution& execution, vao::SurfacePyramid& pyramid,
+  std::string& error);
+
 /// The geometry (dims, origin, spacing) of the whole volume's level that keeps every
 /// step-th voxel of `volume`'s grid from the start of its whole extent; no values.
 vao::MomentLevel WholeLevelGeometry(vtkImageData* volume, const int whole[6], int step);

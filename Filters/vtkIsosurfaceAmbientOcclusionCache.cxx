@@ -76,6 +76,9 @@ struct SurfaceKey
 /// rebuilt the pyramid on every light move.
 struct vtkIsosurfaceAmbientOcclusion::Cache
 {
+  // One process: level 0 kept only where the surfaces sample it. Under MPI: the whole
+  // levels of this process's piece (ShareCoarsestLevel replaces the coarsest).
+  vao::SurfacePyramid surface;
   std::vector<vao::MomentLevel> levels;
   std::array<int, 6> extent{};
   vtkDataArray* array = nullptr;
@@ -116,19 +119,20 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
   const bool fresh = chosen && cache.array == chosen && cache.arrayTime == chosen->GetMTime() && sameGrid &&
     cache.component == this->Component &&
     cache.numberOfLevels == this->NumberOfLevels && cache.halfResolution == (this->StartAtHalfResolution != 0) &&
-    !cache.levels.empty();
+    !cache.surface.empty();
   if (fresh)
   {
     return true;
   }
   cache.levels.clear();
+  cache.surface.clear();
   std::string error;
   if (!Extents::CheckWholeExtent(volume->GetExtent(), error) ||
     !PrepareScalars(this, chosen, volume, this->Component, cache.scalars, error) ||
     !PyramidImages::BuildPyramid(cache.scalars, volume, this->PyramidRequest(),
-      ExecutionOf(this, this->NumberOfThreads), cache.levels, error))
+      ExecutionOf(this, this->NumberOfThreads), cache.surface, error))
   {
-    cache.levels.clear();
+    cache.surface.clear();
     if (!error.empty())
     {
       vtkErrorMacro(<< error);
@@ -153,6 +157,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
 {
   Cache& cache = *this->Pyramid;
   cache.levels.clear();
+  cache.surface.clear();
   cache.array = nullptr; // not reused: the pieces follow the decomposition
   std::string error;
   int expected[6];
@@ -281,8 +286,11 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
     occlusion->SetName("AmbientOcclusion");
     vtkAmbientOcclusionMemory::Allocate(occlusion, n, "the AmbientOcclusion output");
     status = run([&](auto p, auto nn) {
-      return vao::surfaceAmbientOcclusion(cache.levels, cache.scalars.view, cache.origin, cache.spacing, p, nn, n,
-        parameters, occlusion->GetPointer(0), execution);
+      return cache.surface.empty()
+        ? vao::surfaceAmbientOcclusion(cache.levels, cache.scalars.view, cache.origin, cache.spacing, p, nn, n,
+            parameters, occlusion->GetPointer(0), execution)
+        : vao::surfaceAmbientOcclusion(cache.surface, cache.scalars.view, cache.origin, cache.spacing, p, nn, n,
+            parameters, occlusion->GetPointer(0), execution);
     });
     if (status.ok)
     {
@@ -297,8 +305,9 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
     vtkAmbientOcclusionMemory::Allocate(shadow, n, "the Shadow output");
     const double* l = this->LightDirection;
     status = run([&](auto p, auto nn) {
-      return vao::surfaceShadow(
-        cache.levels, p, nn, n, { l[0], l[1], l[2] }, parameters, shadow->GetPointer(0), execution);
+      return cache.surface.empty()
+        ? vao::surfaceShadow(cache.levels, p, nn, n, { l[0], l[1], l[2] }, parameters, shadow->GetPointer(0), execution)
+        : vao::surfaceShadow(cache.surface, p, nn, n, { l[0], l[1], l[2] }, parameters, shadow->GetPointer(0), execution);
     });
   }
   if (!status.ok)
