@@ -159,6 +159,21 @@ TEST(SurfacePyramid, QueriesEqualTheWholePyramidBitForBitOnEveryTier)
                                                << half << " light " << light[0] << " " << light[1] << " " << light[2]
                                                << " point " << i;
             }
+            // A query of fewer levels than the pyramid has: its march stays longer on the
+            // tiled levels (on level 0 alone to the volume's border with one level).
+            for (int used = 1; used < levels; ++used)
+            {
+              p.levels = used;
+              ASSERT_TRUE(vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing, points.data(),
+                normals.data(), n, p, expected.data()).ok);
+              vao::SurfacePyramid fresh = surfacePyramidOf(f, pp);
+              ASSERT_TRUE(vao::surfaceAmbientOcclusion(fresh, f.view(), f.origin, f.spacing, points.data(),
+                normals.data(), n, p, got.data()).ok);
+              ASSERT_EQ(got, expected) << "AO of " << used << " levels, tier " << int(tier) << " pyramid " << levels;
+              ASSERT_TRUE(vao::surfaceShadow(whole, points.data(), normals.data(), n, lights[0], p, expected.data()).ok);
+              ASSERT_TRUE(vao::surfaceShadow(fresh, points.data(), normals.data(), n, lights[0], p, got.data()).ok);
+              ASSERT_EQ(got, expected) << "shadow of " << used << " levels, tier " << int(tier) << " pyramid " << levels;
+            }
           });
       }
   }

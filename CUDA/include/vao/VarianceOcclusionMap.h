@@ -135,8 +135,9 @@ class PyramidTiles;
 /// the half-voxel query, the shadow march's steps on those levels), so a surface holds a
 /// small part of them. Levels 2 and up are whole. Every result equals the one from
 /// buildMomentPyramid's whole pyramid bit for bit. Tiles are built from the volume: the
-/// volume the pyramid was built from must outlive it, unchanged. Queries on one pyramid
-/// may run concurrently (their builds take turns).
+/// volume the pyramid was built from must outlive it, unchanged. A query builds tiles, so
+/// queries on one pyramid must not run at the same time (each runs on all the threads of
+/// its Execution already).
 class SurfacePyramid
 {
 public:

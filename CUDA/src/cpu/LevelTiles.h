@@ -19,7 +19,6 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
-#include <mutex>
 #include <vector>
 
 namespace vao
@@ -95,13 +94,8 @@ public:
   /// Level l's tiles, or nullptr when level l is whole.
   LevelTiles* at(int l) const { return l >= 0 && l < static_cast<int>(this->levels.size()) ? this->levels[l].get() : nullptr; }
   int count() const { return static_cast<int>(this->levels.size()); }
-  /// Serialises the mark-and-build phases of concurrent queries on one pyramid.
-  std::mutex& buildMutex() { return this->Mutex; }
   /// buildMarked of every tiled level.
   bool buildMarked(const Execution& execution);
-
-private:
-  std::mutex Mutex;
 };
 
 } // namespace detail

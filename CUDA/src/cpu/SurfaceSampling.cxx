@@ -12,7 +12,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <mutex>
 #include <vector>
 
 namespace vao
@@ -223,7 +222,6 @@ bool reachTiles(detail::PyramidTiles* tiles, const P* points, const P* normals, 
   {
     return true;
   }
-  std::lock_guard<std::mutex> lock(tiles->buildMutex());
   sampling = detail::stageExecution(execution, 0.3, 1.0);
   return forEachBatch(points, normals, count, detail::stageExecution(execution, 0.0, 0.1),
            [&](PointLanes& lanes) { mark(lanes, *tiles); }) &&
