@@ -18,6 +18,14 @@
  * new shallow copy of the same volume (what ParaView passes on every update) reuses it;
  * after changing values in place, call Modified() on the array. The AmbientOcclusion is
  * kept too: moving the light only computes the shadows.
+ *
+ * On one process the pyramid's two finest levels (nearly all of its bytes) are kept only
+ * where the surface samples them: each update builds the tiles of 8^3 voxels that its
+ * points, their AO offsets and their shadow rays reach and keeps them for the next (a new
+ * light reaches few more). The values are those of the whole pyramid; the CT head's bone
+ * surface with shadows needs 70% of the volume's size instead of 476%. The volume's array
+ * is read again when tiles are built. Under MPI each process keeps the whole levels of
+ * its piece.
  */
 #ifndef vtkIsosurfaceAmbientOcclusion_h
 #define vtkIsosurfaceAmbientOcclusion_h
