@@ -188,6 +188,11 @@ TEST(SurfaceReference, AmbientOcclusionAndShadowsMatchTheDefinition)
   for (int count : { 1, 5, 8, 37 })
   {
     const Scene s(count == 37 ? 4 : 3, count, 17u + count);
+    // The same queries on a SurfacePyramid (levels 0 and 1 in tiles, kept from query to
+    // query) against the same definition.
+    vao::SurfacePyramid tiled;
+    ASSERT_TRUE(
+      vao::buildSurfacePyramid(s.view(), s.origin, s.spacing, { static_cast<int>(s.pyramid.size()), false }, tiled).ok);
     for (vao::Method estimator : { vao::Method::Chebyshev, vao::Method::GaussianCdf })
       for (vao::SurfaceQuery query : { vao::SurfaceQuery::HalfVoxelInside, vao::SurfaceQuery::IsoValue })
         for (vao::LevelCombination combination : { vao::LevelCombination::MaximumOcclusion, vao::LevelCombination::Mean })
@@ -203,10 +208,16 @@ TEST(SurfaceReference, AmbientOcclusionAndShadowsMatchTheDefinition)
             s.normals.data(), count, p, ao.data()).ok);
           const Vec3 light = { 0.3, -1.0, 0.7 };
           ASSERT_TRUE(vao::surfaceShadow(s.pyramid, s.points.data(), s.normals.data(), count, light, p, shadow.data()).ok);
+          std::vector<float> tiledAo(count, -1.0f), tiledShadow(count, -1.0f);
+          ASSERT_TRUE(vao::surfaceAmbientOcclusion(tiled, s.view(), s.origin, s.spacing, s.points.data(),
+            s.normals.data(), count, p, tiledAo.data()).ok);
+          ASSERT_TRUE(vao::surfaceShadow(tiled, s.points.data(), s.normals.data(), count, light, p, tiledShadow.data()).ok);
           for (int i = 0; i < count; ++i)
           {
             EXPECT_NEAR(ao[i], refAo(s, i, p), 2e-5) << "AO, point " << i << " of " << count;
             EXPECT_NEAR(shadow[i], refShadow(s, i, light, p), 2e-5) << "shadow, point " << i << " of " << count;
+            EXPECT_NEAR(tiledAo[i], refAo(s, i, p), 2e-5) << "tiled AO, point " << i << " of " << count;
+            EXPECT_NEAR(tiledShadow[i], refShadow(s, i, light, p), 2e-5) << "tiled shadow, point " << i << " of " << count;
             ++compared;
           }
         }

@@ -121,29 +121,18 @@ bool LevelTiles::buildMarked(const Execution& execution)
 namespace
 {
 
-/// A block of level 0 as a source (level 1's tiles): the voxels [lo, lo + size) of the
-/// level, means then variances, x fastest.
-struct BlockSource
+/// The voxels [lo, lo + size) of a level kept as a block (means then variances, x
+/// fastest): level 1's tiles read level 0 there.
+struct BlockVoxels
 {
   const float* mean = nullptr;
   std::int64_t lo[3] = { 0, 0, 0 };
   std::int64_t size[3] = { 0, 0, 0 };
-  Index3 level; // the whole level's dims (the blur's clipping)
-  double shift = 0.0;
 
-  Index3 dims() const { return level; }
-  void blurRows(std::int64_t y, const std::int64_t* z, const double* w, std::int64_t x0, std::int64_t count,
-    double* a, double* b, SimdTier simd) const
+  std::pair<const float*, const float*> operator()(std::int64_t x, std::int64_t y, std::int64_t z) const
   {
-    const float* means[kTaps];
-    const float* variances[kTaps];
-    const std::int64_t plane = size[0] * size[1] * size[2];
-    for (int k = 0; k < kTaps; ++k)
-    {
-      means[k] = mean + ((z[k] - lo[2]) * size[1] + (y - lo[1])) * size[0] + (x0 - lo[0]);
-      variances[k] = means[k] + plane;
-    }
-    runRows<LevelRows>(simd, &means[0], &variances[0], w, shift, count, a, b);
+    const float* voxel = mean + ((z - lo[2]) * size[1] + (y - lo[1])) * size[0] + (x - lo[0]);
+    return { voxel, voxel + size[0] * size[1] * size[2] };
   }
 };
 
@@ -172,17 +161,14 @@ bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execut
   const RawSource<T> source{ TypedVolume<T>(this->Volume), this->Shift };
   const BlurPlan plan0(this->Volume.dims, this->FirstStep, this->Shift);
   const BlurPlan plan1(plan0.out, 2, this->Shift);
-  const BlurPlan& plan = this->Level == 0 ? plan0 : plan1;
   const int threads = resolveThreadCount(execution.threads);
   const auto count = static_cast<std::int64_t>(runs.size());
   const int chunks = static_cast<int>(std::min<std::int64_t>(count, std::max(1, threads) * 8));
   const Index3& n = this->Geometry.dims;
   return parallelFor(count, chunks, threads, execution, [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
     SliceBlur<RawSource<T>> blur0(source, plan0);
-    BlockSource base; // level 1: the block of level 0 its taps read
-    base.level = plan0.out;
-    base.shift = this->Shift;
-    SliceBlur<BlockSource> blur1(base, plan1);
+    StoredSource<BlockVoxels> base{ {}, plan0.out, this->Shift }; // level 1: the block of level 0 its taps read
+    SliceBlur<StoredSource<BlockVoxels>> blur1(base, plan1);
     std::vector<float> block, baseBlock; // a run's voxels before they go to their tiles
     for (std::int64_t r = begin; r < end; ++r)
     {
@@ -209,16 +195,17 @@ bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execut
       else
       {
         // Level 0 where level 1's taps reach (clamped to the level, as the blur clamps).
+        BlockVoxels& block0 = base.at;
+        std::int64_t baseHi[3];
         for (int a = 0; a < 3; ++a)
         {
-          base.lo[a] = std::max<std::int64_t>(0, 2 * lo[a] - kHalf);
-          base.size[a] = std::min<std::int64_t>(plan0.out[a], 2 * (hi[a] - 1) + kHalf + 1) - base.lo[a];
+          block0.lo[a] = std::max<std::int64_t>(0, 2 * lo[a] - kHalf);
+          baseHi[a] = std::min<std::int64_t>(plan0.out[a], 2 * (hi[a] - 1) + kHalf + 1);
+          block0.size[a] = baseHi[a] - block0.lo[a];
         }
-        baseBlock.resize(static_cast<std::size_t>(2 * base.size[0] * base.size[1] * base.size[2]));
-        const std::int64_t baseHi[3] = { base.lo[0] + base.size[0], base.lo[1] + base.size[1],
-          base.lo[2] + base.size[2] };
-        blurBlock(blur0, base.lo, baseHi, baseBlock.data());
-        base.mean = baseBlock.data();
+        baseBlock.resize(static_cast<std::size_t>(2 * block0.size[0] * block0.size[1] * block0.size[2]));
+        blurBlock(blur0, block0.lo, baseHi, baseBlock.data());
+        block0.mean = baseBlock.data();
         blurBlock(blur1, lo, hi, block.data());
       }
       // Rows of the block to rows of its tiles (a partial tile's other voxels are never read).

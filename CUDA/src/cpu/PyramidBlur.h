@@ -66,13 +66,14 @@ struct RawSource
   }
 };
 
-/// Stored slices of a level as a source: d = mean - K, s = variance + d^2. `slice(z)`
-/// gives the mean and variance of slice z (x fastest, rows of dims[0]).
-template <class Slices>
-struct SliceSource
+/// Stored moments of a level as a source: d = mean - K, s = variance + d^2. `at(x, y, z)`
+/// gives where voxel (x, y, z)'s mean and variance are, the row's next voxels following
+/// (a whole level, a ring of its slices, a block of it).
+template <class Voxels>
+struct StoredSource
 {
-  Slices slices;
-  Index3 size;
+  Voxels at;
+  Index3 size; // the whole level's dims (the blur's clipping)
   double shift;
 
   Index3 dims() const { return size; }
@@ -83,28 +84,28 @@ struct SliceSource
     const float* variances[kTaps];
     for (int k = 0; k < kTaps; ++k)
     {
-      const auto slice = slices(z[k]);
-      means[k] = slice.first + y * size[0] + x0;
-      variances[k] = slice.second + y * size[0] + x0;
+      const auto voxel = at(x0, y, z[k]);
+      means[k] = voxel.first;
+      variances[k] = voxel.second;
     }
     runRows<LevelRows>(simd, &means[0], &variances[0], w, shift, count, a, b);
   }
 };
 
-/// The slices of a stored level.
-struct LevelSlices
+/// The voxels of a whole stored level.
+struct LevelVoxels
 {
   const MomentLevel* level;
-  std::pair<const float*, const float*> operator()(std::int64_t z) const
+  std::pair<const float*, const float*> operator()(std::int64_t x, std::int64_t y, std::int64_t z) const
   {
-    const std::int64_t offset = z * level->dims[0] * level->dims[1];
+    const std::int64_t offset = (z * level->dims[1] + y) * level->dims[0] + x;
     return { level->mean.data() + offset, level->variance.data() + offset };
   }
 };
 
-inline SliceSource<LevelSlices> levelSource(const MomentLevel& level, double shift)
+inline StoredSource<LevelVoxels> levelSource(const MomentLevel& level, double shift)
 {
-  return { LevelSlices{ &level }, level.dims, shift };
+  return { LevelVoxels{ &level }, level.dims, shift };
 }
 
 /// What every output slice of one blurDecimate shares: sizes and weights.
@@ -300,6 +301,20 @@ bool blurDecimate(const Source& source, int step, double shift, MomentLevel& out
         }
       }
     });
+}
+
+/// Levels [from, levels.size()) of a pyramid, each blurred from the one before it and
+/// kept every second voxel; level l reports its progress on stage(l). Returns false when
+/// cancelled.
+template <class Stage>
+bool blurCoarserLevels(std::vector<MomentLevel>& levels, int from, double shift, int threads, Stage&& stage)
+{
+  for (int l = from; l < static_cast<int>(levels.size()); ++l)
+  {
+    if (!blurDecimate(levelSource(levels[l - 1], shift), 2, shift, levels[l], stage(l), threads))
+      return false;
+  }
+  return true;
 }
 
 } // namespace pyramid

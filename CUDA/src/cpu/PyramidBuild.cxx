@@ -48,13 +48,10 @@ Status buildPyramid(const VolumeView& volume, const std::array<double, 3>& origi
   {
     return Status::cancelled();
   }
-  for (int l = 1; l < levels; ++l)
+  if (!blurCoarserLevels(result, 1, shift, threads,
+        [&](int l) { return detail::stageExecution(execution, l * stageWidth, (l + 1) * stageWidth); }))
   {
-    const Execution stage = detail::stageExecution(execution, l * stageWidth, (l + 1) * stageWidth);
-    if (!blurDecimate(levelSource(result[l - 1], shift), 2, shift, result[l], stage, threads))
-    {
-      return Status::cancelled();
-    }
+    return Status::cancelled();
   }
   setLevelGeometry(result, origin, spacing, setup);
   pyramid = std::move(result);

@@ -64,12 +64,17 @@ private:
   std::int64_t Tags[kTaps];
 };
 
-/// A SliceRing as the source of the next level.
+/// The voxels of a SliceRing's slices, as the source of the next level.
 template <class Ring>
-struct RingSlices
+struct RingVoxels
 {
   const Ring* ring;
-  std::pair<const float*, const float*> operator()(std::int64_t z) const { return (*ring)(z); }
+  std::pair<const float*, const float*> operator()(std::int64_t x, std::int64_t y, std::int64_t z) const
+  {
+    const auto slice = (*ring)(z);
+    const std::int64_t offset = y * ring->dims()[0] + x;
+    return { slice.first + offset, slice.second + offset };
+  }
 };
 
 /// The input slices (of a level of dims n) that output slice zo of a step-2 blur reads.
@@ -101,13 +106,13 @@ bool blurThroughStreamedLevels(const RawSource<T>& raw, int firstStep, double sh
   return parallelFor(plan2.out[2], chunks, threads, execution,
     [&](std::int64_t zBegin, std::int64_t zEnd, ChunkProgress& progress) {
       using Ring0 = SliceRing<RawSource<T>>;
-      using Source1 = SliceSource<RingSlices<Ring0>>;
+      using Source1 = StoredSource<RingVoxels<Ring0>>;
       using Ring1 = SliceRing<Source1>;
       Ring0 ring0(raw, plan0);
       const Source1 source1{ { &ring0 }, plan0.out, shift };
       Ring1 ring1(source1, plan1);
-      const SliceSource<RingSlices<Ring1>> source2{ { &ring1 }, plan1.out, shift };
-      SliceBlur<SliceSource<RingSlices<Ring1>>> blur2(source2, plan2);
+      const StoredSource<RingVoxels<Ring1>> source2{ { &ring1 }, plan1.out, shift };
+      SliceBlur<StoredSource<RingVoxels<Ring1>>> blur2(source2, plan2);
       for (std::int64_t zo = zBegin; zo < zEnd; ++zo)
       {
         forInputSlices(zo, plan1.out, [&](std::int64_t z1) {
@@ -160,13 +165,10 @@ Status buildSurfaceLevels(const VolumeView& volume, const std::array<double, 3>&
       return Status::cancelled();
     }
   }
-  for (int l = 3; l < levels; ++l)
+  if (!blurCoarserLevels(result, 3, shift, threads,
+        [&](int l) { return stageExecution(execution, (l - 1) * stageWidth, l * stageWidth); }))
   {
-    const Execution stage = stageExecution(execution, (l - 1) * stageWidth, l * stageWidth);
-    if (!blurDecimate(levelSource(result[l - 1], shift), 2, shift, result[l], stage, threads))
-    {
-      return Status::cancelled();
-    }
+    return Status::cancelled();
   }
   setLevelGeometry(result, origin, spacing, setup);
   auto tiles = std::make_unique<PyramidTiles>();

@@ -139,9 +139,10 @@ void batchOcclusion(const PreparedPyramid& pyramid, int levels, const PointLanes
     const double offset = parameters.offsetFactor * pyramid.kernelRadius[l];
     for (int k = 0; k < W; ++k)
     {
-      x[k] = lanes.x[k] + offset * lanes.nx[k];
-      y[k] = lanes.y[k] + offset * lanes.ny[k];
-      z[k] = lanes.z[k] + offset * lanes.nz[k];
+      const std::array<double, 3> at = lanes.along(k, offset);
+      x[k] = at[0];
+      y[k] = at[1];
+      z[k] = at[2];
     }
     detail::occlusionLanes(pyramid.grids[l], parameters.estimator, x, y, z, lanes.query, occlusion);
     for (int k = 0; k < W; ++k)
@@ -260,8 +261,10 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles
         {
           const double offset = parameters.offsetFactor * pyramid[l].kernelRadius;
           for (int k = 0; k < lanes.used; ++k)
-            t.at(l)->markAround(lanes.x[k] + offset * lanes.nx[k], lanes.y[k] + offset * lanes.ny[k],
-              lanes.z[k] + offset * lanes.nz[k]);
+          {
+            const std::array<double, 3> at = lanes.along(k, offset);
+            t.at(l)->markAround(at[0], at[1], at[2]);
+          }
         }
       }))
   {
