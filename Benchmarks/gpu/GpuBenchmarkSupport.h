@@ -28,6 +28,8 @@ struct GpuTimes
   double kernelMs = 0.0; // best of the timed runs
   double totalMs = 0.0;  // best of the timed runs
   std::vector<vao::cuda::PassTiming> passes; // of the run with the best kernel time
+  double uploadGBs = 0.0;   // host-to-device copies (pinned staging), best run; 0: none
+  double downloadGBs = 0.0; // device-to-host
 };
 
 /// One warm-up call, then the best kernel and the best end-to-end time of `repeat` calls.
@@ -58,6 +60,10 @@ GpuTimes timeGpu(const Call& call, int repeat)
       times.passes = timing.passes;
     }
     times.totalMs = std::min(times.totalMs, timing.totalMilliseconds);
+    if (timing.uploadMilliseconds > 0)
+      times.uploadGBs = std::max(times.uploadGBs, timing.uploadBytes / (timing.uploadMilliseconds * 1e6));
+    if (timing.downloadMilliseconds > 0)
+      times.downloadGBs = std::max(times.downloadGBs, timing.downloadBytes / (timing.downloadMilliseconds * 1e6));
   }
   times.ok = true;
   return times;

@@ -162,6 +162,11 @@ void reportPasses(const std::string& what, const GpuTimes& times, double copyGBs
       worstName = pass.name;
     }
   }
+  if (times.uploadGBs > 0 || times.downloadGBs > 0)
+  {
+    std::printf("      transfers (z slabs, pinned staging, overlapped): up %.1f GB/s, down %.1f GB/s\n",
+      times.uploadGBs, times.downloadGBs);
+  }
   if (times.passes.empty())
   {
     bar("FAIL", what + ": every pass >= 50% of copy bandwidth: no passes reported in Timing");

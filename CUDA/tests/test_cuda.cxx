@@ -313,6 +313,39 @@ TEST(CudaTiming, FillsTimingAndRepeatsBitForBit)
   EXPECT_GT(vao::cuda::measureCopyBandwidth(64.0 * 1024 * 1024), 0.0);
 }
 
+TEST(CudaTransfers, SlabsThroughPinnedStagingEqualTheCpuAndMoveEachByteOnce)
+{
+  VAO_REQUIRE_CUDA_DEVICE();
+  // Tall enough for four z slabs (SlabPlan.h), so uploads, kernels and downloads overlap.
+  const vao::Index3 tall = { 40, 30, 300 };
+  const auto v16 = randomVolume<std::int16_t>(tall, -1024, 1600, 411);
+  const auto view = viewOf(v16, tall);
+  const vao::Region whole = vao::Region::whole(view), inner{ { 2, 3, 20 }, { 35, 25, 260 } };
+  expectEveryMethodMatchesCpu(view, whole, { 3, 3, 3 }, 100.0);
+  expectEveryMethodMatchesCpu(view, inner, { 6, 2, 9 }, 100.0);
+  vao::AmbientOcclusionParameters p;
+  p.method = vao::Method::GaussianCdf;
+  p.radius = { 3, 3, 3 };
+  std::vector<float> openness(whole.voxelCount()), variance(whole.voxelCount());
+  vao::cuda::Timing timing;
+  const vao::Status status =
+    vao::cuda::computeAmbientOcclusion(view, whole, p, { openness.data(), variance.data() }, {}, &timing);
+  ASSERT_TRUE(status.ok) << status.message;
+  EXPECT_EQ(timing.uploadBytes, 2.0 * whole.voxelCount());   // each slice once, no halo twice
+  EXPECT_EQ(timing.downloadBytes, 8.0 * whole.voxelCount()); // two float outputs
+  EXPECT_GT(timing.uploadMilliseconds, 0.0);
+  EXPECT_GT(timing.downloadMilliseconds, 0.0);
+  // A smaller call after a larger one, and a larger one again, reuse the cached buffers.
+  const vao::Index3 small = { 9, 7, 5 };
+  const auto f32 = randomVolume<float>(small, -1, 1, 412);
+  expectEveryMethodMatchesCpu(viewOf(f32, small), vao::Region::whole(viewOf(f32, small)), { 2, 2, 2 }, 0.1);
+  // A failure after the first upload leaves nothing in flight for the next call.
+  vao::cuda::injectDeviceFailures(1);
+  std::vector<float> failed(whole.voxelCount());
+  EXPECT_TRUE(vao::cuda::computeAmbientOcclusion(view, whole, p, { failed.data(), nullptr }).deviceFailure);
+  expectEveryMethodMatchesCpu(view, whole, { 3, 3, 3 }, 100.0);
+}
+
 } // namespace
 
 // ---------------------------------------------------------------------------------------

@@ -54,6 +54,13 @@ struct Timing
   double kernelMilliseconds = 0.0; // all kernels, measured with CUDA events
   double totalMilliseconds = 0.0;  // the whole call: allocation, transfers, kernels
   std::vector<PassTiming> passes;
+  // The host-device copies of the calls that stream z slabs (the fused pass): bytes each
+  // way and the time the copies themselves took (CUDA events; they overlap the kernels,
+  // so these are not parts of totalMilliseconds). Zero for the other calls.
+  double uploadBytes = 0.0;
+  double uploadMilliseconds = 0.0;
+  double downloadBytes = 0.0;
+  double downloadMilliseconds = 0.0;
 };
 
 /// Openness (and optionally the variance) of every voxel of the region, on the GPU. A

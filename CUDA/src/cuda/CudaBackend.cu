@@ -10,6 +10,7 @@
 #include "ExactPipeline.h"
 #include "HistogramPipeline.h"
 #include "PyramidPipeline.h"
+#include "SlabTransfers.h"
 #include "cpu/ExactReference.h"
 #include "cpu/PyramidPlan.h"
 #include "cpu/Parallel.h"
@@ -130,6 +131,16 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
   const detail::MomentScale scale = detail::momentScale(volume, scan.minimum, scan.maximum);
   const Acc shift = static_cast<Acc>(scale.shift);
   estimator.roundingVariance = scale.roundingVariance;
+  const BoxStatisticsOutput& st = host.statistics;
+  if (gpu::fusedPassFits<Acc>(g, withExtrema, sharedMemoryLimit()))
+  {
+    // One kernel, z slabs streamed: SlabTransfers.h.
+    const auto bytes = [](auto* p) { return reinterpret_cast<unsigned char*>(p); };
+    const OutputArray outputs[5] = { { bytes(host.openness), 4 }, { bytes(host.variance), 4 }, { bytes(st.count), 8 },
+      { bytes(st.mean), 8 }, { bytes(st.variance), 8 } };
+    runFusedSlabs<T, Acc>(volume, region, g, shift, estimator, outputs, execution, timing, failIfInjected);
+    return;
+  }
   CudaExecutor ex(timing, execution);
   DeviceBuffer<T> input(g.block());
   upload(volume, region, g, input.get());
@@ -137,7 +148,6 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
   ex.progress(0.1);
 
   const Index n = g.region();
-  const BoxStatisticsOutput& st = host.statistics;
   DeviceBuffer<float> openness(host.openness ? n : 0), variance(host.variance ? n : 0);
   DeviceBuffer<double> count(st.count ? n : 0), mean(st.mean ? n : 0), varianceD(st.variance ? n : 0),
     minimum(st.minimum ? n : 0), maximum(st.maximum ? n : 0);

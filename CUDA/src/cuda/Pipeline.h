@@ -346,14 +346,12 @@ VAO_HD void zRunningSums(const Acc* sum1, const Acc* sum2, const RegionGeometry&
   }
 }
 
-/// The z pass fused with the estimator: one thread per (x, y) column of the region and
-/// segment of slices; running sums of both moments along z, then the formulas of
-/// Estimators.h on each voxel's statistics.
+/// What a pass that ends with a voxel's box sums does with them: the mean and variance,
+/// then the estimator's openness (Estimators.h, the CPU's formulas) or the statistics,
+/// into whichever outputs are asked for. Shared by the z pass and the fused pass.
 template <class T, class Acc>
-struct FinalKernel
+struct StatisticsWriter
 {
-  const Acc* sum1; // x and y box sums, [sz][ry][rx]
-  const Acc* sum2;
   const T* extremaMin; // box extrema of the region, or null
   const T* extremaMax;
   const T* input; // the uploaded block, for the voxel-value query
@@ -361,24 +359,19 @@ struct FinalKernel
   Acc shift;
   EstimatorSetting estimator;
   FinalOutputs out;
-  Index segment;
 
-  VAO_HD Index threads() const { return g.rx * g.ry * segmentsOf(g.rz, segment); }
-
-  VAO_HD void operator()(Index thread) const
+  /// Voxel (x, y) of the region in block slice z: how many voxels its clipped box holds.
+  VAO_HD long long count(Index x, Index y, Index z) const
   {
-    const Index r = g.radius[2];
-    zRunningSums(sum1, sum2, g, segment, thread, [&](Index index, Index z, Index x, Index y, Acc s1, Acc s2) {
-      const long long count = clippedWindowCount(g.ox + x, g.radius[0], g.sx) *
-        clippedWindowCount(g.oy + y, g.radius[1], g.sy) * clippedWindowCount(z, r, g.sz);
-      this->write(index, z, x, y, count, s1, s2);
-    });
+    return clippedWindowCount(g.ox + x, g.radius[0], g.sx) * clippedWindowCount(g.oy + y, g.radius[1], g.sy) *
+      clippedWindowCount(z, g.radius[2], g.sz);
   }
 
-  VAO_HD void write(Index index, Index z, Index x, Index y, long long count, Acc s1, Acc s2) const
+  VAO_HD void write(Index index, Index z, Index x, Index y, Acc s1, Acc s2) const
   {
+    const long long n = this->count(x, y, z);
     NeighbourhoodStats s{ 0.0, 0.0, 0.0, 0.0, estimator.roundingVariance };
-    meanVarianceFromSums(s1, s2, count, static_cast<double>(shift), s.mean, s.variance);
+    meanVarianceFromSums(s1, s2, n, static_cast<double>(shift), s.mean, s.variance);
     if (extremaMin)
     {
       s.minimum = static_cast<double>(extremaMin[index]);
@@ -394,7 +387,7 @@ struct FinalKernel
     if (out.variance)
       out.variance[index] = static_cast<float>(s.variance);
     if (out.count)
-      out.count[index] = static_cast<double>(count);
+      out.count[index] = static_cast<double>(n);
     if (out.mean)
       out.mean[index] = s.mean;
     if (out.varianceD)
@@ -403,6 +396,33 @@ struct FinalKernel
       out.minimum[index] = s.minimum;
     if (out.maximum)
       out.maximum[index] = s.maximum;
+  }
+
+  /// Bytes the outputs take per voxel.
+  double bytesPerVoxel() const
+  {
+    return (out.openness ? 4.0 : 0.0) + (out.variance ? 4.0 : 0.0) +
+      8.0 * ((out.count != nullptr) + (out.mean != nullptr) + (out.varianceD != nullptr) +
+        (out.minimum != nullptr) + (out.maximum != nullptr));
+  }
+};
+
+/// The z pass fused with the estimator: one thread per (x, y) column of the region and
+/// segment of slices; running sums of both moments along z, then the writer.
+template <class T, class Acc>
+struct FinalKernel
+{
+  const Acc* sum1; // x and y box sums, [sz][ry][rx]
+  const Acc* sum2;
+  StatisticsWriter<T, Acc> writer;
+  Index segment;
+
+  VAO_HD Index threads() const { return writer.g.rx * writer.g.ry * segmentsOf(writer.g.rz, segment); }
+
+  VAO_HD void operator()(Index thread) const
+  {
+    zRunningSums(sum1, sum2, writer.g, segment, thread,
+      [&](Index index, Index z, Index x, Index y, Acc s1, Acc s2) { writer.write(index, z, x, y, s1, s2); });
   }
 };
 
@@ -465,13 +485,11 @@ void runPasses(Executor& ex, const T* input, const RegionGeometry& g, bool withE
   }
   ex.progress(0.6);
 
-  const FinalKernel<T, Acc> final{ a1.get(), a2.get(), withExtrema ? f1.get() : nullptr,
-    withExtrema ? f2.get() : nullptr, input, g, shift, estimator, out, segmentLength(g.radius[2]) };
-  const double written = g.region() * ((out.openness ? 4.0 : 0.0) + (out.variance ? 4.0 : 0.0) +
-    8.0 * ((out.count != nullptr) + (out.mean != nullptr) + (out.varianceD != nullptr) +
-      (out.minimum != nullptr) + (out.maximum != nullptr)));
+  const StatisticsWriter<T, Acc> writer{ withExtrema ? f1.get() : nullptr, withExtrema ? f2.get() : nullptr, input, g,
+    shift, estimator, out };
+  const FinalKernel<T, Acc> final{ a1.get(), a2.get(), writer, segmentLength(g.radius[2]) };
   ex.launch(final, "z + estimator",
-    2.0 * g.afterY() * sizeof(Acc) + g.region() * sizeof(T) * (withExtrema ? 3.0 : 1.0) + written);
+    2.0 * g.afterY() * sizeof(Acc) + g.region() * (sizeof(T) * (withExtrema ? 3.0 : 1.0) + writer.bytesPerVoxel()));
   ex.progress(0.9);
 }
 

@@ -1,0 +1,191 @@
+// The fused statistics pass of the device: the box sums of both moments and the estimator
+// in one kernel ("2.5-D blocking"), instead of Pipeline.h's x, y and z passes with their
+// transposes and four full-size intermediate arrays.
+//
+// A thread block owns a tile of kTileX x kTileY output columns and a segment of slices.
+// For each input slice it loads the tile with its x-y halo into shared memory, sums rows
+// (a running window along x, one thread per row), then columns (a running window along y,
+// one thread per column): each column's x-y box sums of that slice. A column's z running
+// sum, one per thread, adds the slice entering its window and subtracts the one leaving
+// it, which is summed again then (twice the x-y work, but no ring of 2 r + 1 slices whose
+// size would grow with the radius). Every step is O(1) per voxel whatever the radius, and
+// the only traffic to memory is the input (from cache, (1 + 2 rx / 32)(1 + 2 ry / 8) times
+// per slice) and the outputs, written once.
+//
+// The block's code is written once against a Block that runs a phase for every item and
+// then waits for all of them: on the device a strided loop over the block's threads and
+// __syncthreads() (CudaBackend.cu), on the host a loop (the tests' host twin, which also
+// runs the items backwards to show that no phase reads what another item of the same
+// phase writes). Every branch around a phase depends on the block only, so every thread
+// reaches every barrier.
+#pragma once
+
+#include "Pipeline.h"
+
+namespace vao
+{
+namespace gpu
+{
+
+/// A block's output columns: 32 x 8, one per thread.
+constexpr Index kTileX = 32;
+constexpr Index kTileY = 8;
+constexpr Index kTileColumns = kTileX * kTileY;
+
+/// The shared memory of one block, in accumulators: the loaded slice with its halo (two
+/// moments), the row sums, the columns' x-y sums and their z running sums.
+struct FusedLayout
+{
+  Index width;  // kTileX + 2 rx
+  Index height; // kTileY + 2 ry
+
+  VAO_HD Index loaded() const { return width * height; }
+  VAO_HD Index rows() const { return height * kTileX; }
+  VAO_HD Index elements() const { return 2 * loaded() + 2 * rows() + 4 * kTileColumns; }
+};
+
+VAO_HD FusedLayout fusedLayout(const RegionGeometry& g)
+{
+  return FusedLayout{ kTileX + 2 * g.radius[0], kTileY + 2 * g.radius[1] };
+}
+
+/// The fused pass over the region slices [sliceBegin, sliceEnd) (a z slab; the whole
+/// region is one), reading the uploaded block and writing through the writer.
+template <class T, class Acc>
+struct FusedStatisticsKernel
+{
+  const T* input; // the uploaded block, [sz][sy][sx]
+  StatisticsWriter<T, Acc> writer;
+  Index sliceBegin;
+  Index sliceEnd;
+  Index segment; // slices a block walks: its first window costs 2 rz + 1 slices
+
+  VAO_HD Index tilesX() const { return (writer.g.rx + kTileX - 1) / kTileX; }
+  VAO_HD Index tilesY() const { return (writer.g.ry + kTileY - 1) / kTileY; }
+  VAO_HD Index blocks() const { return tilesX() * tilesY() * segmentsOf(sliceEnd - sliceBegin, segment); }
+
+  template <class Block>
+  VAO_HD void run(const Block& block, Index blockIndex, Acc* shared) const
+  {
+    const RegionGeometry& g = writer.g;
+    const FusedLayout layout = fusedLayout(g);
+    Acc* z1 = shared + 2 * layout.loaded() + 2 * layout.rows() + 2 * kTileColumns;
+    Acc* z2 = z1 + kTileColumns;
+    const Index x0 = (blockIndex % tilesX()) * kTileX;
+    const Index y0 = ((blockIndex / tilesX()) % tilesY()) * kTileY;
+    const Index first = sliceBegin + (blockIndex / (tilesX() * tilesY())) * segment;
+    const Index last = lower(first + segment, sliceEnd);
+    const Index rz = g.radius[2];
+
+    block.each(kTileColumns, [&](Index c) {
+      z1[c] = 0;
+      z2[c] = 0;
+    });
+    const Index lo = greater(Index(0), g.oz + first - rz), hi = lower(g.sz - 1, g.oz + first + rz);
+    for (Index j = lo; j <= hi; ++j)
+    {
+      this->addSlice(block, shared, x0, y0, j, true);
+    }
+    for (Index k = first; k < last; ++k)
+    {
+      const Index z = g.oz + k;
+      block.each(kTileColumns, [&](Index c) {
+        const Index x = x0 + c % kTileX, y = y0 + c / kTileX;
+        if (x < g.rx && y < g.ry)
+          writer.write((k * g.ry + y) * g.rx + x, z, x, y, z1[c], z2[c]);
+      });
+      if (k + 1 == last)
+        break;
+      if (z + rz + 1 <= g.sz - 1)
+        this->addSlice(block, shared, x0, y0, z + rz + 1, true);
+      if (z - rz >= 0)
+        this->addSlice(block, shared, x0, y0, z - rz, false);
+    }
+  }
+
+  /// Adds (or subtracts) block slice j's x-y box sums to the columns' z running sums.
+  template <class Block>
+  VAO_HD void addSlice(const Block& block, Acc* shared, Index x0, Index y0, Index j, bool add) const
+  {
+    const RegionGeometry& g = writer.g;
+    const FusedLayout layout = fusedLayout(g);
+    const Index rx = g.radius[0], ry = g.radius[1];
+    Acc* v1 = shared;
+    Acc* v2 = v1 + layout.loaded();
+    Acc* r1 = v2 + layout.loaded();
+    Acc* r2 = r1 + layout.rows();
+    Acc* xy1 = r2 + layout.rows();
+    Acc* xy2 = xy1 + kTileColumns;
+    Acc* z1 = xy2 + kTileColumns;
+    Acc* z2 = z1 + kTileColumns;
+    const Acc shift = writer.shift;
+    // The tile and its halo, shifted and squared; zero outside the block, which holds
+    // every voxel of the volume a window of the region reaches.
+    block.each(layout.loaded(), [&](Index i) {
+      const Index bx = g.ox + x0 - rx + i % layout.width, by = g.oy + y0 - ry + i / layout.width;
+      Acc m1 = 0, m2 = 0;
+      if (bx >= 0 && bx < g.sx && by >= 0 && by < g.sy)
+      {
+        m1 = static_cast<Acc>(input[(j * g.sy + by) * g.sx + bx]) - shift;
+        m2 = m1 * m1;
+      }
+      v1[i] = m1;
+      v2[i] = m2;
+    });
+    // Each loaded row's sums over the x windows of the tile's columns.
+    block.each(layout.height, [&](Index row) {
+      const Acc* a1 = v1 + row * layout.width;
+      const Acc* a2 = v2 + row * layout.width;
+      Acc s1 = 0, s2 = 0;
+      for (Index i = 0; i <= 2 * rx; ++i)
+      {
+        s1 += a1[i];
+        s2 += a2[i];
+      }
+      for (Index c = 0; c < kTileX; ++c)
+      {
+        r1[row * kTileX + c] = s1;
+        r2[row * kTileX + c] = s2;
+        if (c + 1 < kTileX)
+        {
+          s1 += a1[c + 2 * rx + 1] - a1[c];
+          s2 += a2[c + 2 * rx + 1] - a2[c];
+        }
+      }
+    });
+    // Each column's sums of those over the y windows.
+    block.each(kTileX, [&](Index c) {
+      Acc s1 = 0, s2 = 0;
+      for (Index row = 0; row <= 2 * ry; ++row)
+      {
+        s1 += r1[row * kTileX + c];
+        s2 += r2[row * kTileX + c];
+      }
+      for (Index t = 0; t < kTileY; ++t)
+      {
+        xy1[t * kTileX + c] = s1;
+        xy2[t * kTileX + c] = s2;
+        if (t + 1 < kTileY)
+        {
+          s1 += r1[(t + 2 * ry + 1) * kTileX + c] - r1[t * kTileX + c];
+          s2 += r2[(t + 2 * ry + 1) * kTileX + c] - r2[t * kTileX + c];
+        }
+      }
+    });
+    block.each(kTileColumns, [&](Index c) {
+      z1[c] = add ? z1[c] + xy1[c] : z1[c] - xy1[c];
+      z2[c] = add ? z2[c] + xy2[c] : z2[c] - xy2[c];
+    });
+  }
+};
+
+/// Whether the fused pass applies: no extrema (they keep their van Herk passes) and a
+/// block's shared memory within what the device grants one (`sharedLimit` bytes).
+template <class Acc>
+bool fusedPassFits(const RegionGeometry& g, bool withExtrema, Index sharedLimit)
+{
+  return !withExtrema && fusedLayout(g).elements() * static_cast<Index>(sizeof(Acc)) <= sharedLimit;
+}
+
+} // namespace gpu
+} // namespace vao

@@ -1,0 +1,121 @@
+// The device's fused statistics pass (src/cuda/FusedStatistics.h) and its slab schedule
+// (src/cuda/SlabPlan.h) run on the host: the same block code as the GPU's, each phase as
+// a loop, the chunks arriving in the schedule's order into poisoned device memory. They
+// are checked against the separate passes (bit for bit where the sums are exact), against
+// themselves with every phase run backwards, and across slab thicknesses; their checks
+// against the CPU library are in test_pipeline_emulation.cxx, and test_cuda.cxx checks the
+// real device where there is one.
+#include "PipelineEmulation.h"
+
+#include "vao/AmbientOcclusion.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+using namespace vaotest;
+using vao::gpu::Index;
+
+namespace
+{
+
+const vao::gpu::EstimatorSetting kStatistics{ vao::Method::GaussianCdf, vao::QueryMode::VoxelValue, 0, vao::ErfMode::Exact };
+
+template <class U>
+bool sameBits(const std::vector<U>& a, const std::vector<U>& b)
+{
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(U)) == 0);
+}
+
+} // namespace
+
+TEST(FusedPassOnHost, ExactSumsEqualTheSeparatePassesBitForBit)
+{
+  // Integer moments are exact in both, so every output must have the same bits.
+  const vao::Index3 dims = { 45, 21, 30 };
+  const auto i16 = randomVolume<std::int16_t>(dims, -1024, 3000, 19);
+  const vao::Region region{ { 2, 1, 3 }, { 40, 19, 26 } };
+  for (const vao::Radius& r : { vao::Radius{ 3, 3, 3 }, vao::Radius{ 10, 10, 10 }, vao::Radius{ 1, 6, 2 } })
+  {
+    const vao::gpu::EstimatorSetting gaussian{ vao::Method::GaussianCdf, vao::QueryMode::VoxelValue, 0, vao::ErfMode::Exact };
+    const Results passes = emulate(i16, dims, region, r, false, gaussian);
+    const Results fused = emulate(i16, dims, region, r, false, gaussian, { true, 0, false });
+    EXPECT_TRUE(sameBits(passes.openness, fused.openness));
+    EXPECT_TRUE(sameBits(passes.variance, fused.variance));
+    const Results statsPasses = emulate(i16, dims, region, r, true, kStatistics);
+    const Results statsFused = emulate(i16, dims, region, r, true, kStatistics, { true, 0, false });
+    EXPECT_TRUE(sameBits(statsPasses.count, statsFused.count));
+    EXPECT_TRUE(sameBits(statsPasses.mean, statsFused.mean));
+    EXPECT_TRUE(sameBits(statsPasses.varianceD, statsFused.varianceD));
+  }
+}
+
+TEST(FusedPassOnHost, NoPhaseDependsOnTheOrderOfItsItemsOrOnTheSlabs)
+{
+  const vao::Index3 dims = { 40, 20, 50 };
+  const auto f32 = randomVolume<float>(dims, -3, 7, 20);
+  const vao::Region region{ { 1, 2, 4 }, { 38, 17, 43 } };
+  const vao::gpu::EstimatorSetting gaussian{ vao::Method::GaussianCdf, vao::QueryMode::VoxelValue, 0, vao::ErfMode::Exact };
+  for (const vao::Radius& r : { vao::Radius{ 2, 2, 2 }, vao::Radius{ 5, 1, 7 } })
+  {
+    const Results forwards = emulate(f32, dims, region, r, false, gaussian, { true, 0, false });
+    const Results backwards = emulate(f32, dims, region, r, false, gaussian, { true, 0, true });
+    EXPECT_TRUE(sameBits(forwards.openness, backwards.openness));
+    EXPECT_TRUE(sameBits(forwards.variance, backwards.variance));
+    // Thin slabs: each starts its own segments, so the float sums may round otherwise,
+    // but each slab must find its chunks uploaded.
+    for (Index slices : { 1, 3, 7, 100 })
+    {
+      SCOPED_TRACE(slices);
+      const Results slabs = emulate(f32, dims, region, r, false, gaussian, { true, slices, false });
+      for (size_t k = 0; k < forwards.openness.size(); ++k)
+      {
+        ASSERT_NEAR(slabs.openness[k], forwards.openness[k], 1e-6) << k;
+        ASSERT_NEAR(slabs.variance[k], forwards.variance[k], 1e-6 * std::max(1.0f, forwards.variance[k])) << k;
+      }
+    }
+  }
+}
+
+TEST(FusedPassOnHost, SlabPlanUploadsEachSliceOnceBeforeItIsRead)
+{
+  const vao::Index3 dims = { 8, 8, 97 };
+  for (const vao::Region& region : { vao::Region{ { 0, 0, 0 }, dims }, vao::Region{ { 0, 0, 10 }, { 8, 8, 50 } },
+         vao::Region{ { 0, 0, 96 }, { 8, 8, 1 } } })
+    for (int rz : { 0, 1, 4, 30, 200 })
+      for (Index slices : { Index(1), Index(5), Index(32), Index(1000) })
+      {
+        const auto g = vao::gpu::geometryFor(dims, region, { 1, 1, rz });
+        const auto plan = vao::gpu::planSlabs(g, slices);
+        ASSERT_FALSE(plan.empty());
+        Index slice = 0, chunk = 0;
+        for (const auto& step : plan)
+        {
+          EXPECT_EQ(step.sliceBegin, slice);
+          EXPECT_GT(step.sliceEnd, step.sliceBegin);
+          EXPECT_LE(step.sliceEnd - step.sliceBegin, slices);
+          EXPECT_EQ(step.chunkBegin, chunk);
+          // Everything the slab's last window reads is up.
+          EXPECT_GE(step.chunkEnd, std::min<Index>(g.sz, g.oz + step.sliceEnd + rz));
+          slice = step.sliceEnd;
+          chunk = step.chunkEnd;
+        }
+        EXPECT_EQ(slice, g.rz);
+        EXPECT_EQ(chunk, g.sz);
+      }
+  // About four slabs, each at least two segments.
+  const auto g = vao::gpu::geometryFor({ 256, 256, 415 }, { { 0, 0, 0 }, { 256, 256, 415 } }, { 10, 10, 10 });
+  EXPECT_EQ(vao::gpu::planSlabs(g, vao::gpu::slabSlices(g, vao::gpu::segmentLength(10))).size(), 4u);
+}
+
+TEST(FusedPassOnHost, SharedMemoryFitsTheDeviceForCommonRadii)
+{
+  // An H100 grants a block 227 KiB; R = 10 needs far less, and extrema never fuse.
+  const auto g = vao::gpu::geometryFor({ 256, 256, 415 }, { { 0, 0, 0 }, { 256, 256, 415 } }, { 10, 10, 10 });
+  EXPECT_TRUE(vao::gpu::fusedPassFits<std::int64_t>(g, false, 227 * 1024));
+  EXPECT_FALSE(vao::gpu::fusedPassFits<std::int64_t>(g, true, 227 * 1024));
+  EXPECT_LT(vao::gpu::fusedLayout(g).elements() * 8, 64 * 1024);
+  const auto wide = vao::gpu::geometryFor({ 256, 256, 415 }, { { 0, 0, 0 }, { 256, 256, 415 } }, { 200, 200, 10 });
+  EXPECT_FALSE(vao::gpu::fusedPassFits<double>(wide, false, 227 * 1024));
+}
