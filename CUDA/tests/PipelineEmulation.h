@@ -24,6 +24,33 @@ namespace vaotest
 
 using vao::gpu::Index;
 
+/// FusedStatistics.h's Block on the host: a phase's items in a loop (backwards on demand:
+/// an item that read what another item of its phase writes would then see other data).
+struct HostBlock
+{
+  bool backwards;
+  template <class F>
+  void each(Index count, F&& f) const
+  {
+    for (Index k = 0; k < count; ++k)
+      f(backwards ? count - 1 - k : k);
+  }
+};
+
+/// A FusedStatistics.h kernel's blocks in a loop, each with fresh shared memory filled
+/// with a poison value; phases forwards or backwards.
+template <class Kernel>
+void runBlocksOnHost(const Kernel& kernel, bool backwards)
+{
+  using Acc = typename Kernel::Acc;
+  std::vector<Acc> shared(static_cast<size_t>(kernel.sharedBytes() / static_cast<Index>(sizeof(Acc))));
+  for (Index b = 0; b < kernel.blocks(); ++b)
+  {
+    std::fill(shared.begin(), shared.end(), std::numeric_limits<Acc>::max() / 3);
+    kernel.run(HostBlock{ backwards }, b, shared.data());
+  }
+}
+
 /// Runs kernels as loops over their thread indices. Fresh buffers are filled with a
 /// poison value, so a pass that reads what no pass wrote shows up in the results.
 class HostExecutor
@@ -76,6 +103,15 @@ public:
           out[(z * nx + x) * ny + y] = in[(z * ny + y) * nx + x];
   }
 
+  template <class Kernel>
+  void launchBlocks(const Kernel& kernel, const char*, double)
+  {
+    runBlocksOnHost(kernel, false);
+  }
+
+  /// An H100's: larger radii take the separate passes, as there.
+  Index sharedLimit() const { return 227 * 1024; }
+
   void synchronize() {}
   void progress(double) {}
 };
@@ -110,19 +146,6 @@ struct Emulation
   bool backwards = false;
 };
 
-/// FusedStatistics.h's Block on the host: a phase's items in a loop (backwards on demand:
-/// an item that read what another item of its phase writes would then see other data).
-struct HostBlock
-{
-  bool backwards;
-  template <class F>
-  void each(Index count, F&& f) const
-  {
-    for (Index k = 0; k < count; ++k)
-      f(backwards ? count - 1 - k : k);
-  }
-};
-
 /// The fused pass as SlabTransfers.h runs it: the block's chunks arrive in the plan's
 /// order into device memory that starts poisoned, and slab i runs when chunks 0..i are
 /// there; shared memory is poisoned for every block.
@@ -134,19 +157,13 @@ void runFusedOnHost(const std::vector<T>& block, const vao::gpu::RegionGeometry&
   const auto plan =
     vao::gpu::planSlabs(g, how.slabSlices > 0 ? how.slabSlices : vao::gpu::slabSlices(g, segment));
   std::vector<T> device(block.size(), std::numeric_limits<T>::max());
-  std::vector<Acc> shared(static_cast<size_t>(vao::gpu::fusedLayout(g).elements()));
   const vao::gpu::StatisticsWriter<T, Acc> writer{ nullptr, nullptr, device.data(), g, shift, estimator, out };
   const Index slice = g.sx * g.sy;
   for (const auto& step : plan)
   {
     std::copy(block.begin() + step.chunkBegin * slice, block.begin() + step.chunkEnd * slice,
       device.begin() + step.chunkBegin * slice);
-    const vao::gpu::FusedStatisticsKernel<T, Acc> kernel{ device.data(), writer, step.sliceBegin, step.sliceEnd, segment };
-    for (Index b = 0; b < kernel.blocks(); ++b)
-    {
-      std::fill(shared.begin(), shared.end(), std::numeric_limits<Acc>::max() / 3);
-      kernel.run(HostBlock{ how.backwards }, b, shared.data());
-    }
+    runBlocksOnHost(vao::gpu::fusedStatistics(writer, step.sliceBegin, step.sliceEnd, segment), how.backwards);
   }
 }
 

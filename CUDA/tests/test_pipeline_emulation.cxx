@@ -226,4 +226,9 @@ TEST(GpuPipelineOnHost, HistogramCdfEqualsTheCpu)
     expectHistogramLikeTheCpu(i16, dims, whole, { 20, 20, 20 }, bins, false, 0.0);
   }
   expectHistogramLikeTheCpu(u8, dims, whole, { 2, 3, 2 }, 256, false, 0.0);
+  // A tile and halo beyond a block's shared memory: the separate passes.
+  const auto g = vao::gpu::geometryFor(dims, whole, { 70, 70, 2 });
+  ASSERT_FALSE(vao::gpu::fusedPassFits<int>(g, false, HostExecutor().sharedLimit()));
+  expectHistogramLikeTheCpu(i16, dims, whole, { 70, 70, 2 }, 7, false, 0.0);
+  expectHistogramLikeTheCpu(f32, dims, inner, { 70, 70, 2 }, 64, true, 0.1);
 }

@@ -3,6 +3,7 @@
 // CudaExecutor, which runs Pipeline.h's passes on the device with optional timing.
 #pragma once
 
+#include "FusedStatistics.h"
 #include "Pipeline.h"
 
 #include "vao/Cuda.h"
@@ -110,6 +111,55 @@ __global__ void transposeSlices(const T* in, T* out, Index nx, Index ny)
   }
 }
 
+/// A thread block as FusedStatistics.h's Block: each phase strided over the threads, then
+/// a barrier.
+struct DeviceBlock
+{
+  template <class F>
+  VAO_HD void each(Index count, F&& f) const
+  {
+#ifdef __CUDA_ARCH__
+    for (Index i = threadIdx.x; i < count; i += blockDim.x)
+      f(i);
+    __syncthreads();
+#else
+    for (Index i = 0; i < count; ++i)
+      f(i);
+#endif
+  }
+};
+
+template <class Kernel>
+__global__ void fusedBlocks(Kernel kernel)
+{
+  extern __shared__ __align__(16) unsigned char fusedShared[];
+  kernel.run(DeviceBlock{}, static_cast<Index>(blockIdx.x), reinterpret_cast<typename Kernel::Acc*>(fusedShared));
+}
+
+/// Bytes of shared memory a block may have on the current device (the opt-in maximum).
+Index sharedMemoryLimit()
+{
+  int device = 0, bytes = 0;
+  check(cudaGetDevice(&device), "device");
+  check(cudaDeviceGetAttribute(&bytes, cudaDevAttrMaxSharedMemoryPerBlockOptin, device), "device attribute");
+  return bytes;
+}
+
+/// Launches a FusedBoxSums kernel, one block of 32 x 8 threads per tile and segment, with
+/// the shared memory it needs (opted into beyond the default 48 KiB).
+template <class Kernel>
+void launchFusedBlocks(const Kernel& kernel, cudaStream_t stream)
+{
+  const Index shared = kernel.sharedBytes();
+  if (shared > 48 * 1024)
+    check(cudaFuncSetAttribute(fusedBlocks<Kernel>, cudaFuncAttributeMaxDynamicSharedMemorySize,
+            static_cast<int>(shared)),
+      "shared memory size");
+  if (kernel.blocks() > 0)
+    fusedBlocks<Kernel><<<static_cast<unsigned>(kernel.blocks()), static_cast<unsigned>(gpu::kTileColumns),
+      static_cast<std::size_t>(shared), stream>>>(kernel);
+}
+
 /// Runs the pipeline's kernels on the device. When asked for timings, each pass gets a
 /// pair of CUDA events; they are read once at the end (finish), so timing adds no waits
 /// between passes.
@@ -165,6 +215,17 @@ public:
     }
     this->end(name, bytes);
   }
+
+  /// A FusedStatistics.h kernel, timed like a pass.
+  template <class Kernel>
+  void launchBlocks(const Kernel& kernel, const char* name, double bytes)
+  {
+    this->begin();
+    launchFusedBlocks(kernel, nullptr);
+    this->end(name, bytes);
+  }
+
+  Index sharedLimit() const { return sharedMemoryLimit(); }
 
   template <class U>
   void transpose(const U* in, U* out, Index nx, Index ny, Index nz, const char* name)

@@ -50,24 +50,28 @@ VAO_HD FusedLayout fusedLayout(const RegionGeometry& g)
 }
 
 /// The fused pass over the region slices [sliceBegin, sliceEnd) (a z slab; the whole
-/// region is one), reading the uploaded block and writing through the writer.
-template <class T, class Acc>
-struct FusedStatisticsKernel
+/// region is one): the box sums of the two channels Source::load(block index, v1, v2)
+/// gives (the moments, or Histogram CDF's indicators), each voxel's pair handed to
+/// Sink::write(region index, block z, region x, region y, s1, s2).
+template <class Source, class Sink, class AccT>
+struct FusedBoxSums
 {
-  const T* input; // the uploaded block, [sz][sy][sx]
-  StatisticsWriter<T, Acc> writer;
+  using Acc = AccT;
+  Source source;
+  Sink sink;
+  RegionGeometry g;
   Index sliceBegin;
   Index sliceEnd;
   Index segment; // slices a block walks: its first window costs 2 rz + 1 slices
 
-  VAO_HD Index tilesX() const { return (writer.g.rx + kTileX - 1) / kTileX; }
-  VAO_HD Index tilesY() const { return (writer.g.ry + kTileY - 1) / kTileY; }
+  VAO_HD Index tilesX() const { return (g.rx + kTileX - 1) / kTileX; }
+  VAO_HD Index tilesY() const { return (g.ry + kTileY - 1) / kTileY; }
   VAO_HD Index blocks() const { return tilesX() * tilesY() * segmentsOf(sliceEnd - sliceBegin, segment); }
+  VAO_HD Index sharedBytes() const { return fusedLayout(g).elements() * static_cast<Index>(sizeof(Acc)); }
 
   template <class Block>
   VAO_HD void run(const Block& block, Index blockIndex, Acc* shared) const
   {
-    const RegionGeometry& g = writer.g;
     const FusedLayout layout = fusedLayout(g);
     Acc* z1 = shared + 2 * layout.loaded() + 2 * layout.rows() + 2 * kTileColumns;
     Acc* z2 = z1 + kTileColumns;
@@ -92,7 +96,7 @@ struct FusedStatisticsKernel
       block.each(kTileColumns, [&](Index c) {
         const Index x = x0 + c % kTileX, y = y0 + c / kTileX;
         if (x < g.rx && y < g.ry)
-          writer.write((k * g.ry + y) * g.rx + x, z, x, y, z1[c], z2[c]);
+          sink.write((k * g.ry + y) * g.rx + x, z, x, y, z1[c], z2[c]);
       });
       if (k + 1 == last)
         break;
@@ -107,7 +111,6 @@ struct FusedStatisticsKernel
   template <class Block>
   VAO_HD void addSlice(const Block& block, Acc* shared, Index x0, Index y0, Index j, bool add) const
   {
-    const RegionGeometry& g = writer.g;
     const FusedLayout layout = fusedLayout(g);
     const Index rx = g.radius[0], ry = g.radius[1];
     Acc* v1 = shared;
@@ -118,17 +121,13 @@ struct FusedStatisticsKernel
     Acc* xy2 = xy1 + kTileColumns;
     Acc* z1 = xy2 + kTileColumns;
     Acc* z2 = z1 + kTileColumns;
-    const Acc shift = writer.shift;
-    // The tile and its halo, shifted and squared; zero outside the block, which holds
-    // every voxel of the volume a window of the region reaches.
+    // The tile and its halo; zero outside the block, which holds every voxel of the
+    // volume a window of the region reaches.
     block.each(layout.loaded(), [&](Index i) {
       const Index bx = g.ox + x0 - rx + i % layout.width, by = g.oy + y0 - ry + i / layout.width;
       Acc m1 = 0, m2 = 0;
       if (bx >= 0 && bx < g.sx && by >= 0 && by < g.sy)
-      {
-        m1 = static_cast<Acc>(input[(j * g.sy + by) * g.sx + bx]) - shift;
-        m2 = m1 * m1;
-      }
+        source.load((j * g.sy + by) * g.sx + bx, m1, m2);
       v1[i] = m1;
       v2[i] = m2;
     });
@@ -178,6 +177,18 @@ struct FusedStatisticsKernel
     });
   }
 };
+
+/// The fused pass of the moment estimators and statistics: the shifted moments of the
+/// block, the estimator's writer.
+template <class T, class Acc>
+using FusedStatisticsKernel = FusedBoxSums<MomentSource<T, Acc, true>, StatisticsWriter<T, Acc>, Acc>;
+
+template <class T, class Acc>
+FusedStatisticsKernel<T, Acc> fusedStatistics(
+  const StatisticsWriter<T, Acc>& writer, Index sliceBegin, Index sliceEnd, Index segment)
+{
+  return { { writer.input, nullptr, writer.shift }, writer, writer.g, sliceBegin, sliceEnd, segment };
+}
 
 /// Whether the fused pass applies: no extrema (they keep their van Herk passes) and a
 /// block's shared memory within what the device grants one (`sharedLimit` bytes).

@@ -1,13 +1,15 @@
 // Histogram CDF on the GPU, written once for the CUDA executor and the host emulator (see
 // Pipeline.h). Each voxel gets its bin (thresholdIndex of its value) and each region voxel
 // the bin of its query; then, two thresholds at a time, the box counts of the indicators
-// [bin <= k] and [bin <= k + 1] go through the same running-sum passes as the moments
-// (x on the transposed bins, y, then z), and the z pass keeps, per voxel, the counts at
-// the two thresholds that enclose its query. The last kernel applies the formula of
+// [bin <= k] and [bin <= k + 1] go through the moments' fused pass (FusedStatistics.h;
+// where the tile does not fit a block, their running-sum passes: x on the transposed bins,
+// y, then z), which keeps, per voxel, the counts at the two thresholds that enclose its
+// query. The last kernel applies the formula of
 // Estimators.h (opennessHistogramCdfAt), the one the CPU uses. Every pass is O(1) per
 // voxel whatever the radius; there are K/2 rounds of three passes.
 #pragma once
 
+#include "FusedStatistics.h"
 #include "Pipeline.h"
 
 namespace vao
@@ -86,35 +88,45 @@ struct UpperKernel
   }
 };
 
-/// The z pass of round k: running sums of both indicators' x-y box counts along z; each
-/// voxel keeps the count at t_(upper-1) (below) and at t_upper (atOrBelow) when the round
-/// holds them.
+/// What round k keeps of a voxel's box counts of [bin <= k] (s1) and [bin <= k + 1] (s2):
+/// the count at t_(upper-1) (below) and at t_upper (atOrBelow), when the round holds them.
+struct GatherSink
+{
+  const int* upper;
+  int* below;
+  int* atOrBelow;
+  int k;
+
+  VAO_HD void write(Index index, Index, Index, Index, int s1, int s2) const
+  {
+    const int u = upper[index];
+    if (u - 1 == k)
+      below[index] = s1;
+    else if (u - 1 == k + 1)
+      below[index] = s2;
+    if (u == k)
+      atOrBelow[index] = s1;
+    else if (u == k + 1)
+      atOrBelow[index] = s2;
+  }
+};
+
+/// The z pass of round k: running sums of both indicators' x-y box counts along z, into
+/// the GatherSink.
 struct GatherKernel
 {
   const int* sum1; // x and y box counts of [bin <= k], [sz][ry][rx]
   const int* sum2; // of [bin <= k + 1]
-  const int* upper;
-  int* below;
-  int* atOrBelow;
+  GatherSink sink;
   RegionGeometry g;
-  int k;
   Index segment;
 
   VAO_HD Index threads() const { return g.rx * g.ry * segmentsOf(g.rz, segment); }
 
   VAO_HD void operator()(Index thread) const
   {
-    zRunningSums(sum1, sum2, g, segment, thread, [&](Index index, Index, Index, Index, int s1, int s2) {
-      const int u = upper[index];
-      if (u - 1 == k)
-        below[index] = s1;
-      else if (u - 1 == k + 1)
-        below[index] = s2;
-      if (u == k)
-        atOrBelow[index] = s1;
-      else if (u == k + 1)
-        atOrBelow[index] = s2;
-    });
+    zRunningSums(sum1, sum2, g, segment, thread,
+      [&](Index index, Index z, Index x, Index y, int s1, int s2) { sink.write(index, z, x, y, s1, s2); });
   }
 };
 
@@ -144,42 +156,58 @@ struct HistogramOpennessKernel
 };
 
 /// Histogram CDF's passes on an executor of Pipeline.h's kind that also provides
-///   Buffer<U> upload<U>(const U* host, Index count)   (a device copy of host values).
-/// `input` is the uploaded block; `openness` executor memory of g.region() floats.
+///   Buffer<U> upload<U>(const U* host, Index count)   (a device copy of host values)
+///   Index sharedLimit()                               (shared memory a block may have)
+///   void launchBlocks(const Kernel& k, const char* name, double bytes)   (FusedStatistics.h)
+/// `input` is the uploaded block; `openness` executor memory of g.region() floats. Each
+/// round is one fused pass of the indicators (FusedStatistics.h) where its tile fits a
+/// block, else x, y and z passes.
 template <class T, class Executor>
 void runHistogramPasses(Executor& ex, const T* input, const RegionGeometry& g, const double* hostThresholds,
   int n, bool iso, double isoValue, float* openness)
 {
-  const AxisPass xPass{ g.sy * g.sz, g.sx, g.radius[0], g.ox, g.rx, LaneLayout{ g.sy, g.sx * g.sy, g.sy },
-    LaneLayout{ g.sy, g.rx * g.sy, g.sy } };
-  const AxisPass yPass{ g.rx * g.sz, g.sy, g.radius[1], g.oy, g.ry, LaneLayout{ g.rx, g.sy * g.rx, g.rx },
-    LaneLayout{ g.rx, g.ry * g.rx, g.rx } };
+  const bool fused = fusedPassFits<int>(g, false, ex.sharedLimit());
   auto thresholds = ex.template upload<double>(hostThresholds, n);
-  auto bins = ex.template allocate<Bin>(g.block()), transposed = ex.template allocate<Bin>(g.block());
+  auto bins = ex.template allocate<Bin>(g.block()), transposed = ex.template allocate<Bin>(fused ? 0 : g.block());
   ex.launch(BinKernel<T>{ input, thresholds.get(), n, bins.get(), g.block() }, "bins",
     g.block() * (sizeof(T) + sizeof(Bin)));
-  ex.transpose(bins.get(), transposed.get(), g.sx, g.sy, g.sz, "transpose bins");
   auto upper = ex.template allocate<int>(g.region()), below = ex.template allocate<int>(g.region()),
        atOrBelow = ex.template allocate<int>(g.region());
   const HistogramQuerySource<T> query{ input, g, iso, isoValue, thresholds.get(), n };
   ex.launch(UpperKernel<T>{ query, upper.get(), below.get(), atOrBelow.get() },
     "query bins", g.region() * (sizeof(T) + 3.0 * sizeof(int)));
 
-  auto a1 = ex.template allocate<int>(g.afterX()), a2 = ex.template allocate<int>(g.afterX());
-  auto b1 = ex.template allocate<int>(g.afterX()), b2 = ex.template allocate<int>(g.afterX());
+  const Index afterX = fused ? 0 : g.afterX();
+  auto a1 = ex.template allocate<int>(afterX), a2 = ex.template allocate<int>(afterX);
+  auto b1 = ex.template allocate<int>(afterX), b2 = ex.template allocate<int>(afterX);
+  if (!fused)
+    ex.transpose(bins.get(), transposed.get(), g.sx, g.sy, g.sz, "transpose bins");
+  const AxisPass xPass{ g.sy * g.sz, g.sx, g.radius[0], g.ox, g.rx, LaneLayout{ g.sy, g.sx * g.sy, g.sy },
+    LaneLayout{ g.sy, g.rx * g.sy, g.sy } };
+  const AxisPass yPass{ g.rx * g.sz, g.sy, g.radius[1], g.oy, g.ry, LaneLayout{ g.rx, g.sy * g.rx, g.rx },
+    LaneLayout{ g.rx, g.ry * g.rx, g.rx } };
   for (int k = 0; k < n; k += 2)
   {
-    const SumKernel<IndicatorSource, int> countsX{ { transposed.get(), k }, a1.get(), a2.get(), xPass,
-      segmentLength(xPass.r) };
-    ex.launch(countsX, "indicators x", g.block() * sizeof(Bin) + 2.0 * g.afterX() * sizeof(int));
-    ex.transpose(a1.get(), b1.get(), g.sy, g.rx, g.sz, "transpose counts");
-    ex.transpose(a2.get(), b2.get(), g.sy, g.rx, g.sz, "transpose counts");
-    const MomentKernel<int, int, false> countsY{ { b1.get(), b2.get(), 0 }, a1.get(), a2.get(), yPass,
-      segmentLength(yPass.r) };
-    ex.launch(countsY, "indicators y", 2.0 * (g.afterX() + g.afterY()) * sizeof(int));
-    ex.launch(GatherKernel{ a1.get(), a2.get(), upper.get(), below.get(), atOrBelow.get(), g, k,
-                segmentLength(g.radius[2]) },
-      "indicators z", 2.0 * g.afterY() * sizeof(int) + 3.0 * g.region() * sizeof(int));
+    const GatherSink sink{ upper.get(), below.get(), atOrBelow.get(), k };
+    if (fused)
+    {
+      const FusedBoxSums<IndicatorSource, GatherSink, int> counts{ { bins.get(), k }, sink, g, 0, g.rz,
+        segmentLength(g.radius[2]) };
+      ex.launchBlocks(counts, "indicators (fused)", g.block() * sizeof(Bin) + 3.0 * g.region() * sizeof(int));
+    }
+    else
+    {
+      const SumKernel<IndicatorSource, int> countsX{ { transposed.get(), k }, a1.get(), a2.get(), xPass,
+        segmentLength(xPass.r) };
+      ex.launch(countsX, "indicators x", g.block() * sizeof(Bin) + 2.0 * g.afterX() * sizeof(int));
+      ex.transpose(a1.get(), b1.get(), g.sy, g.rx, g.sz, "transpose counts");
+      ex.transpose(a2.get(), b2.get(), g.sy, g.rx, g.sz, "transpose counts");
+      const MomentKernel<int, int, false> countsY{ { b1.get(), b2.get(), 0 }, a1.get(), a2.get(), yPass,
+        segmentLength(yPass.r) };
+      ex.launch(countsY, "indicators y", 2.0 * (g.afterX() + g.afterY()) * sizeof(int));
+      ex.launch(GatherKernel{ a1.get(), a2.get(), sink, g, segmentLength(g.radius[2]) }, "indicators z",
+        2.0 * g.afterY() * sizeof(int) + 3.0 * g.region() * sizeof(int));
+    }
     ex.progress(0.1 + 0.8 * lower(1.0, (k + 2.0) / n));
   }
   ex.launch(HistogramOpennessKernel<T>{ query, upper.get(), below.get(), atOrBelow.get(), openness },

@@ -183,40 +183,6 @@ void gatherChunk(const detail::TypedVolume<T>& volume, const Region& region, con
   });
 }
 
-/// A thread block as FusedStatistics.h's Block: each phase strided over the threads, then
-/// a barrier.
-struct DeviceBlock
-{
-  template <class F>
-  VAO_HD void each(Index count, F&& f) const
-  {
-#ifdef __CUDA_ARCH__
-    for (Index i = threadIdx.x; i < count; i += blockDim.x)
-      f(i);
-    __syncthreads();
-#else
-    for (Index i = 0; i < count; ++i)
-      f(i);
-#endif
-  }
-};
-
-template <class T, class Acc>
-__global__ void fusedStatistics(gpu::FusedStatisticsKernel<T, Acc> kernel)
-{
-  extern __shared__ __align__(16) unsigned char fusedShared[];
-  kernel.run(DeviceBlock{}, static_cast<Index>(blockIdx.x), reinterpret_cast<Acc*>(fusedShared));
-}
-
-/// Bytes of shared memory a block may have on the current device (opt-in maximum).
-Index sharedMemoryLimit()
-{
-  int device = 0, bytes = 0;
-  check(cudaGetDevice(&device), "device");
-  check(cudaDeviceGetAttribute(&bytes, cudaDevAttrMaxSharedMemoryPerBlockOptin, device), "device attribute");
-  return bytes;
-}
-
 /// The fused pass over the region in slabs, transfers overlapped; `outputs` in the order
 /// of FinalOutputs' openness, variance, count, mean, varianceD (null: not asked for).
 template <class T, class Acc>
@@ -270,12 +236,6 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
     reinterpret_cast<double*>(at(2)), reinterpret_cast<double*>(at(3)), reinterpret_cast<double*>(at(4)), nullptr,
     nullptr };
   const gpu::StatisticsWriter<T, Acc> writer{ nullptr, nullptr, input, g, shift, estimator, out };
-  const Index shared = gpu::fusedLayout(g).elements() * static_cast<Index>(sizeof(Acc));
-  if (shared > 48 * 1024)
-    check(cudaFuncSetAttribute(fusedStatistics<T, Acc>, cudaFuncAttributeMaxDynamicSharedMemorySize,
-            static_cast<int>(shared)),
-      "shared memory size");
-
   std::vector<std::unique_ptr<SlabEvents>> events;
   // Slab i's outputs from its staging buffer to the caller's arrays.
   auto copyOut = [&](std::size_t i) {
@@ -312,9 +272,7 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
 
     check(cudaStreamWaitEvent(computeStream, e.up, 0), "stream wait");
     check(cudaEventRecord(e.kernelStart, computeStream), "event record");
-    const gpu::FusedStatisticsKernel<T, Acc> kernel{ input, writer, s.sliceBegin, s.sliceEnd, segment };
-    fusedStatistics<T, Acc><<<static_cast<unsigned>(kernel.blocks()), static_cast<unsigned>(gpu::kTileColumns),
-      static_cast<std::size_t>(shared), computeStream>>>(kernel);
+    launchFusedBlocks(gpu::fusedStatistics(writer, s.sliceBegin, s.sliceEnd, segment), computeStream);
     check(cudaGetLastError(), "fused statistics");
     check(cudaEventRecord(e.kernel, computeStream), "event record");
 
