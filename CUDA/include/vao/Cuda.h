@@ -67,7 +67,8 @@ struct Timing
 /// failure of the device (none, a CUDA error) has Status::deviceFailure set: the CPU
 /// function may still succeed; bad input fails here as it would there.
 /// Execution: the device (Execution::device, see deviceStatus), progress and cancellation
-/// between stages (a running kernel is not interrupted); the thread count does not apply.
+/// between stages (a running kernel is not interrupted); the thread count is that of the
+/// CPU's copies into and out of the pinned staging buffers (the fused pass's slabs).
 /// Every method runs here (the exact references by brute force, one thread per voxel);
 /// the smoothed query runs on the CPU only.
 Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,

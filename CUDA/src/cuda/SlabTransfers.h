@@ -152,11 +152,11 @@ struct OutputArray
 
 /// Copies `bytes` between host buffers with the CPU's threads (the staging copies are the
 /// part of a transfer the CPU does; one thread would not keep up with the link).
-void parallelCopy(unsigned char* to, const unsigned char* from, Index bytes)
+void parallelCopy(unsigned char* to, const unsigned char* from, Index bytes, int threads)
 {
   constexpr Index kPiece = Index(1) << 20;
   const Index pieces = (bytes + kPiece - 1) / kPiece;
-  detail::parallelFor(pieces, static_cast<int>(pieces), 0, [&](std::int64_t begin, std::int64_t end) {
+  detail::parallelFor(pieces, static_cast<int>(pieces), threads, [&](std::int64_t begin, std::int64_t end) {
     const Index lo = begin * kPiece, hi = gpu::lower(bytes, end * kPiece);
     std::memcpy(to + lo, from + lo, static_cast<std::size_t>(hi - lo));
   });
@@ -165,11 +165,11 @@ void parallelCopy(unsigned char* to, const unsigned char* from, Index bytes)
 /// Block slices [begin, end) of the region's block, gathered from the volume into `to`.
 template <class T>
 void gatherChunk(const detail::TypedVolume<T>& volume, const Region& region, const gpu::RegionGeometry& g,
-  Index begin, Index end, T* to)
+  Index begin, Index end, T* to, int threads)
 {
   const Index x0 = region.begin[0] - g.ox, y0 = region.begin[1] - g.oy, z0 = region.begin[2] - g.oz;
   const Index rows = (end - begin) * g.sy;
-  detail::parallelFor(rows, static_cast<int>(gpu::lower<Index>(rows, 64)), 0, [&](std::int64_t lo, std::int64_t hi) {
+  detail::parallelFor(rows, static_cast<int>(gpu::lower<Index>(rows, 64)), threads, [&](std::int64_t lo, std::int64_t hi) {
     for (Index row = lo; row < hi; ++row)
     {
       const Index z = z0 + begin + row / g.sy, y = y0 + row % g.sy;
@@ -247,7 +247,7 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
       if (!outputs[a].host)
         continue;
       const Index bytes = (s.sliceEnd - s.sliceBegin) * plane * outputs[a].elementSize;
-      parallelCopy(outputs[a].host + s.sliceBegin * plane * outputs[a].elementSize, from, bytes);
+      parallelCopy(outputs[a].host + s.sliceBegin * plane * outputs[a].elementSize, from, bytes, execution.threads);
       from += bytes;
     }
   };
@@ -259,7 +259,7 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
     if (i >= 2)
       check(cudaEventSynchronize(events[i - 2]->up), "upload"); // staging in[i % 2] is free
     T* staged = reinterpret_cast<T*>(stagingIn[i % 2]);
-    gatherChunk(volume, region, g, s.chunkBegin, s.chunkEnd, staged);
+    gatherChunk(volume, region, g, s.chunkBegin, s.chunkEnd, staged, execution.threads);
     const Index sliceValues = g.sx * g.sy;
     check(cudaEventRecord(e.upStart, upStream), "event record");
     check(cudaMemcpyAsync(input + s.chunkBegin * sliceValues, staged,
