@@ -50,32 +50,6 @@ void failIfInjected()
   }
 }
 
-template <class T>
-void upload(const detail::TypedVolume<T>& volume, const Region& region, const gpu::RegionGeometry& g, T* device)
-{
-  const Index x0 = region.begin[0] - g.ox, y0 = region.begin[1] - g.oy, z0 = region.begin[2] - g.oz;
-  if (volume.stride == 1)
-  {
-    cudaMemcpy3DParms p = {};
-    p.srcPtr = make_cudaPitchedPtr(const_cast<T*>(volume.data), volume.dims[0] * sizeof(T), volume.dims[0],
-      volume.dims[1]);
-    p.srcPos = make_cudaPos(x0 * sizeof(T), y0, z0);
-    p.dstPtr = make_cudaPitchedPtr(device, g.sx * sizeof(T), g.sx, g.sy);
-    p.extent = make_cudaExtent(g.sx * sizeof(T), g.sy, g.sz);
-    p.kind = cudaMemcpyHostToDevice;
-    check(cudaMemcpy3D(&p), "upload");
-    return;
-  }
-  // One component of a multi-component array: gathered on the host first.
-  std::vector<T> gathered(static_cast<size_t>(g.block()));
-  Index k = 0;
-  for (Index z = z0; z < z0 + g.sz; ++z)
-    for (Index y = y0; y < y0 + g.sy; ++y)
-      for (Index x = x0; x < x0 + g.sx; ++x)
-        gathered[k++] = volume.value(x, y, z);
-  check(cudaMemcpy(device, gathered.data(), gathered.size() * sizeof(T), cudaMemcpyHostToDevice), "upload");
-}
-
 /// Host pointers of the results (null: not asked for), region-sized.
 struct HostOutputs
 {
@@ -96,7 +70,7 @@ void runCounting(const VolumeView& view, const Region& region, const AmbientOccl
   const gpu::RegionGeometry g = gpu::geometryFor(view.dims, region, p.radius);
   CudaExecutor ex(timing, execution);
   DeviceBuffer<T> input(g.block());
-  upload(volume, region, g, input.get());
+  uploadBlock(volume, region, g, input.get(), execution.threads);
   failIfInjected();
   ex.progress(0.1);
   DeviceBuffer<float> openness(g.region());
@@ -116,7 +90,7 @@ void runCounting(const VolumeView& view, const Region& region, const AmbientOccl
   {
     ex.finish();
   }
-  check(cudaMemcpy(hostOpenness, openness.get(), g.region() * sizeof(float), cudaMemcpyDeviceToHost), "download");
+  ex.download(hostOpenness, openness.get(), g.region());
   ex.progress(1.0);
 }
 
@@ -143,7 +117,7 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
   }
   CudaExecutor ex(timing, execution);
   DeviceBuffer<T> input(g.block());
-  upload(volume, region, g, input.get());
+  uploadBlock(volume, region, g, input.get(), execution.threads);
   failIfInjected();
   ex.progress(0.1);
 
@@ -159,9 +133,9 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
     ex.finish();
   }
 
-  auto download = [n](auto* to, const auto& from) {
+  auto download = [&](auto* to, const auto& from) {
     if (to)
-      check(cudaMemcpy(to, from.get(), n * sizeof(*to), cudaMemcpyDeviceToHost), "download");
+      ex.download(to, from.get(), n);
   };
   download(host.openness, openness);
   download(host.variance, variance);
@@ -369,7 +343,7 @@ Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>&
         const gpu::RegionGeometry g = gpu::geometryFor(volume.dims, whole, { 0, 0, 0 });
         CudaExecutor ex(timing, execution);
         DeviceBuffer<T> input(g.block());
-        upload(detail::TypedVolume<T>(volume), whole, g, input.get());
+        uploadBlock(detail::TypedVolume<T>(volume), whole, g, input.get(), execution.threads);
         failIfInjected();
         ex.progress(0.1);
         gpu::runPyramid<T>(ex, input.get(), volume.dims, setup, parameters.levels, levels);

@@ -1,9 +1,10 @@
-// The CUDA side of the GPU pipeline's executor (only CudaBackend.cu includes it): errors
-// as exceptions, device buffers, the kernel launcher and the slice transpose, and
-// CudaExecutor, which runs Pipeline.h's passes on the device with optional timing.
+// The CUDA side of the GPU pipeline's executor (only CudaBackend.cu includes it): the
+// kernel launchers and the slice transpose, and CudaExecutor, which runs Pipeline.h's
+// passes on the device with optional timing.
 #pragma once
 
 #include "FusedStatistics.h"
+#include "PinnedStaging.h"
 #include "Pipeline.h"
 
 #include "vao/Cuda.h"
@@ -22,56 +23,6 @@ namespace
 {
 
 using gpu::Index;
-
-struct CudaFailure : std::runtime_error
-{
-  using std::runtime_error::runtime_error;
-};
-
-/// The user aborted between two stages: unwinds like a failure, reported as cancelled.
-struct Cancelled
-{
-};
-
-void check(cudaError_t error, const char* what)
-{
-  if (error != cudaSuccess)
-  {
-    throw CudaFailure(std::string("CUDA ") + what + ": " + cudaGetErrorString(error));
-  }
-}
-
-/// A device allocation, freed on every exit path.
-template <class T>
-class DeviceBuffer
-{
-public:
-  explicit DeviceBuffer(Index count)
-  {
-    if (count > 0)
-    {
-      check(cudaMalloc(&this->Data, static_cast<size_t>(count) * sizeof(T)), "allocation");
-    }
-  }
-  ~DeviceBuffer() { cudaFree(this->Data); }
-  DeviceBuffer(DeviceBuffer&& other) noexcept : Data(other.Data) { other.Data = nullptr; }
-  DeviceBuffer& operator=(DeviceBuffer&& other) noexcept
-  {
-    if (this != &other)
-    {
-      cudaFree(this->Data);
-      this->Data = other.Data;
-      other.Data = nullptr;
-    }
-    return *this;
-  }
-  DeviceBuffer(const DeviceBuffer&) = delete;
-  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
-  T* get() const { return this->Data; }
-
-private:
-  T* Data = nullptr;
-};
 
 constexpr int kThreads = 256;
 
@@ -198,10 +149,12 @@ public:
     return buffer;
   }
 
+  /// Through pinned staging, after the kernels queued so far.
   template <class U>
   void download(U* host, const U* device, Index count)
   {
-    check(cudaMemcpy(host, device, count * sizeof(U), cudaMemcpyDeviceToHost), "download");
+    stagedDownload(reinterpret_cast<unsigned char*>(host), reinterpret_cast<const unsigned char*>(device),
+      count * static_cast<Index>(sizeof(U)), this->Exec.threads);
   }
 
   template <class Kernel>
