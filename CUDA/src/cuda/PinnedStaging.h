@@ -73,7 +73,8 @@ private:
   Index Size = 0;
 };
 
-/// What one device keeps between calls of the fused pass.
+/// What one device keeps between calls: the fused pass's device buffers, the pinned
+/// pieces each way, the streams (upload, compute, download).
 struct TransferCache
 {
   std::mutex busy; // one call at a time uses the buffers
@@ -99,10 +100,12 @@ struct TransferCache
 /// The cache of device `index` (kept for the life of the process).
 TransferCache& transferCache(int index)
 {
-  static std::mutex guard;
-  static std::map<int, std::unique_ptr<TransferCache>> caches;
-  std::lock_guard<std::mutex> lock(guard);
-  std::unique_ptr<TransferCache>& cache = caches[index];
+  // Never destroyed: freeing pinned and device memory from a static destructor would race
+  // the CUDA runtime's own teardown at exit; the process's end frees both.
+  static std::mutex* guard = new std::mutex;
+  static auto* caches = new std::map<int, std::unique_ptr<TransferCache>>;
+  std::lock_guard<std::mutex> lock(*guard);
+  std::unique_ptr<TransferCache>& cache = (*caches)[index];
   if (!cache)
     cache.reset(new TransferCache);
   return *cache;
@@ -153,9 +156,128 @@ struct Event
   Event& operator=(const Event&) = delete;
 };
 
+/// Milliseconds between two recorded events.
+float elapsed(cudaEvent_t start, cudaEvent_t stop)
+{
+  float ms = 0.0f;
+  check(cudaEventElapsedTime(&ms, start, stop), "event time");
+  return ms;
+}
+
 /// Bytes of one staged piece: large enough for the link's full rate, small enough that
-/// the first piece starts soon.
+/// the first piece starts soon and the pinned memory stays small (four pieces a device).
 constexpr Index kStagedPiece = Index(8) << 20;
+
+/// Copies between the host and the device through two pinned buffers of one piece each,
+/// taking turns on one stream: the CPU fills (empties) one while the other travels. It
+/// adds up the time the copies themselves took (CUDA events around each piece).
+class PinnedPipe
+{
+public:
+  PinnedPipe(PinnedBuffer (&buffers)[2], cudaStream_t stream)
+    : Stream(stream)
+  {
+    for (int b = 0; b < 2; ++b)
+      this->Buffers[b] = buffers[b].reserve(static_cast<std::size_t>(kStagedPiece));
+  }
+
+  /// Queues `units` units of `unitBytes` for `device`; fill(begin, end, to) writes units
+  /// [begin, end) into pinned memory. Returns when the last piece is queued (finish()
+  /// waits for it); the stream's earlier work runs first.
+  template <class Fill>
+  void up(unsigned char* device, Index units, Index unitBytes, const Fill& fill)
+  {
+    const Index per = gpu::greater<Index>(1, kStagedPiece / unitBytes);
+    if (per * unitBytes > kStagedPiece) // a unit beyond a piece: the buffers grow for it
+      this->grow(unitBytes);
+    for (Index u = 0; u < units; u += per)
+    {
+      const Index n = gpu::lower(per, units - u);
+      const int slot = this->take();
+      fill(u, u + n, this->Buffers[slot]);
+      this->send(slot, device + u * unitBytes, this->Buffers[slot], n * unitBytes, cudaMemcpyHostToDevice);
+    }
+  }
+
+  /// Copies `bytes` of `device` to `host` after the stream's earlier work; returns when
+  /// they are on the host.
+  void down(unsigned char* host, const unsigned char* device, Index bytes, int threads)
+  {
+    const Index pieces = (bytes + kStagedPiece - 1) / kStagedPiece;
+    Index copied = 0;
+    const auto copyOut = [&](Index piece) {
+      const int slot = static_cast<int>(piece % 2);
+      this->wait(slot);
+      const Index at = piece * kStagedPiece;
+      parallelCopy(host + at, this->Buffers[slot], gpu::lower(kStagedPiece, bytes - at), threads);
+      copied = piece + 1;
+    };
+    for (Index piece = 0; piece < pieces; ++piece)
+    {
+      const int slot = static_cast<int>(piece % 2);
+      if (piece >= 2)
+        copyOut(piece - 2);
+      const Index at = piece * kStagedPiece;
+      this->send(slot, this->Buffers[slot], device + at, gpu::lower(kStagedPiece, bytes - at), cudaMemcpyDeviceToHost);
+    }
+    for (Index piece = copied; piece < pieces; ++piece)
+      copyOut(piece);
+  }
+
+  /// Waits for every piece still travelling.
+  void finish()
+  {
+    for (int slot = 0; slot < 2; ++slot)
+      this->wait(slot);
+  }
+
+  double bytes() const { return this->Bytes; }
+  double milliseconds() const { return this->Milliseconds; }
+
+private:
+  /// A free slot: the older of the two, once its piece has arrived.
+  int take()
+  {
+    const int slot = static_cast<int>(this->Turn++ % 2);
+    this->wait(slot);
+    return slot;
+  }
+  void wait(int slot)
+  {
+    if (!this->Busy[slot])
+      return;
+    check(cudaEventSynchronize(this->Done[slot].event), "copy");
+    this->Milliseconds += elapsed(this->Start[slot].event, this->Done[slot].event);
+    this->Busy[slot] = false;
+  }
+  void send(int slot, void* to, const void* from, Index bytes, cudaMemcpyKind kind)
+  {
+    check(cudaEventRecord(this->Start[slot].event, this->Stream), "event record");
+    check(cudaMemcpyAsync(to, from, static_cast<std::size_t>(bytes), kind, this->Stream),
+      kind == cudaMemcpyHostToDevice ? "upload" : "download");
+    check(cudaEventRecord(this->Done[slot].event, this->Stream), "event record");
+    this->Busy[slot] = true;
+    this->Bytes += static_cast<double>(bytes);
+  }
+  void grow(Index bytes)
+  {
+    this->finish();
+    for (int b = 0; b < 2; ++b)
+    {
+      this->Owned[b].reset(new PinnedBuffer);
+      this->Buffers[b] = this->Owned[b]->reserve(static_cast<std::size_t>(bytes));
+    }
+  }
+
+  cudaStream_t Stream;
+  unsigned char* Buffers[2];
+  std::unique_ptr<PinnedBuffer> Owned[2]; // only for units beyond a piece
+  Event Start[2], Done[2];
+  bool Busy[2] = { false, false };
+  Index Turn = 0;
+  double Bytes = 0.0;
+  double Milliseconds = 0.0;
+};
 
 /// The current device's cache, held by one call (a staged copy, or the fused pass's slabs)
 /// and drained before it is let go, on every exit.
@@ -170,6 +292,8 @@ struct StagedCopy
     cache.createStreams();
   }
   ~StagedCopy() { cache.drain(); }
+  PinnedPipe upPipe() { return PinnedPipe(cache.stagingIn, cache.streams[0]); }
+  PinnedPipe downPipe() { return PinnedPipe(cache.stagingOut, cache.streams[2]); }
 };
 
 TransferCache& currentTransferCache()
@@ -179,76 +303,28 @@ TransferCache& currentTransferCache()
   return transferCache(device);
 }
 
-/// Uploads `units` units of `unitBytes` to `device` through pinned pieces; fill(begin,
-/// end, to) writes units [begin, end) of the source into pinned memory. Returns when the
-/// data is on the device.
-template <class Fill>
-void stagedUpload(unsigned char* device, Index units, Index unitBytes, const Fill& fill)
-{
-  if (units <= 0)
-    return;
-  StagedCopy copy(currentTransferCache());
-  const Index per = gpu::greater<Index>(1, kStagedPiece / unitBytes);
-  unsigned char* buffers[2] = { copy.cache.stagingIn[0].reserve(static_cast<std::size_t>(per * unitBytes)),
-    copy.cache.stagingIn[1].reserve(static_cast<std::size_t>(per * unitBytes)) };
-  Event sent[2];
-  const cudaStream_t stream = copy.cache.streams[0];
-  Index piece = 0;
-  for (Index u = 0; u < units; u += per, ++piece)
-  {
-    const Index n = gpu::lower(per, units - u);
-    if (piece >= 2)
-      check(cudaEventSynchronize(sent[piece % 2].event), "upload");
-    fill(u, u + n, buffers[piece % 2]);
-    check(cudaMemcpyAsync(device + u * unitBytes, buffers[piece % 2], static_cast<std::size_t>(n * unitBytes),
-            cudaMemcpyHostToDevice, stream),
-      "upload");
-    check(cudaEventRecord(sent[piece % 2].event, stream), "event record");
-  }
-  check(cudaStreamSynchronize(stream), "upload");
-}
-
-/// The region's block, from the volume to `device`, through pinned pieces.
+/// The region's block, from the volume to `device`, through pinned pieces; returns when it
+/// is on the device.
 template <class T>
 void uploadBlock(const detail::TypedVolume<T>& volume, const Region& region, const gpu::RegionGeometry& g, T* device,
   int threads)
 {
-  stagedUpload(reinterpret_cast<unsigned char*>(device), g.sy * g.sz, g.sx * static_cast<Index>(sizeof(T)),
+  StagedCopy copy(currentTransferCache());
+  PinnedPipe pipe = copy.upPipe();
+  pipe.up(reinterpret_cast<unsigned char*>(device), g.sy * g.sz, g.sx * static_cast<Index>(sizeof(T)),
     [&](Index begin, Index end, unsigned char* to) {
       gatherRows(volume, region, g, begin, end, reinterpret_cast<T*>(to), threads);
     });
+  pipe.finish();
 }
 
 /// `bytes` from `device` to `host` through pinned pieces, after the work queued on the
 /// default stream (the kernels that wrote them).
 void stagedDownload(unsigned char* host, const unsigned char* device, Index bytes, int threads)
 {
-  if (bytes <= 0)
-    return;
   check(cudaStreamSynchronize(nullptr), "passes");
   StagedCopy copy(currentTransferCache());
-  unsigned char* buffers[2] = { copy.cache.stagingOut[0].reserve(static_cast<std::size_t>(kStagedPiece)),
-    copy.cache.stagingOut[1].reserve(static_cast<std::size_t>(kStagedPiece)) };
-  Event arrived[2];
-  const cudaStream_t stream = copy.cache.streams[2];
-  const Index pieces = (bytes + kStagedPiece - 1) / kStagedPiece;
-  auto copyOut = [&](Index piece) {
-    check(cudaEventSynchronize(arrived[piece % 2].event), "download");
-    const Index at = piece * kStagedPiece;
-    parallelCopy(host + at, buffers[piece % 2], gpu::lower(kStagedPiece, bytes - at), threads);
-  };
-  for (Index piece = 0; piece < pieces; ++piece)
-  {
-    if (piece >= 2)
-      copyOut(piece - 2);
-    const Index at = piece * kStagedPiece;
-    check(cudaMemcpyAsync(buffers[piece % 2], device + at, static_cast<std::size_t>(gpu::lower(kStagedPiece, bytes - at)),
-            cudaMemcpyDeviceToHost, stream),
-      "download");
-    check(cudaEventRecord(arrived[piece % 2].event, stream), "event record");
-  }
-  for (Index piece = gpu::greater<Index>(0, pieces - 2); piece < pieces; ++piece)
-    copyOut(piece);
+  copy.downPipe().down(host, device, bytes, threads);
 }
 
 } // namespace

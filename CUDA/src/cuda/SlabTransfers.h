@@ -1,11 +1,9 @@
-// The fused pass with overlapped transfers (only CudaBackend.cu includes it): each chunk
-// of the block is copied by the CPU's threads into a pinned staging buffer and uploaded
-// from there asynchronously, each slab's outputs come back into another and are copied out
-// by the CPU (PinnedStaging.h). Three streams (upload, compute, download) with events
-// between them let chunk i + 1 travel up and slab i - 1 travel down while slab i computes;
-// two staging buffers each way let the CPU fill one while the other is in flight. The
-// buffers live in the device's TransferCache: a filter that runs again on the same volume
-// allocates nothing.
+// The fused pass with overlapped transfers (only CudaBackend.cu includes it). Three
+// streams (upload, compute, download) with events between them: while slab i computes,
+// the host brings slab i - 1's outputs down and then sends chunk i + 1 up, each through
+// two pinned pieces taking turns (PinnedStaging.h), so the kernels overlap the transfers
+// and the CPU's copies overlap the DMA. The device buffers live in the device's
+// TransferCache: a filter that runs again on the same volume allocates nothing.
 #pragma once
 
 #include "CudaExecutor.h"
@@ -27,24 +25,17 @@ namespace cuda
 namespace
 {
 
-/// Events of one slab: its upload, kernel and download, each with a start.
-struct SlabEvents
-{
-  Event upStart, up, kernelStart, kernel, downStart, down;
-};
-
-float elapsed(cudaEvent_t start, cudaEvent_t stop)
-{
-  float ms = 0.0f;
-  check(cudaEventElapsedTime(&ms, start, stop), "event time");
-  return ms;
-}
-
 /// One output array of the region: where it goes on the host and its element size.
 struct OutputArray
 {
   unsigned char* host;
   Index elementSize;
+};
+
+/// Events of one slab: its chunk uploaded, its kernel's start and end.
+struct SlabEvents
+{
+  Event uploaded, kernelStart, kernel;
 };
 
 /// The fused pass over the region in slabs, transfers overlapped; `outputs` in the order
@@ -56,19 +47,14 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
 {
   StagedCopy copy(currentTransferCache()); // the device's buffers, drained on every exit
   TransferCache& cache = copy.cache;
-  cudaStream_t upStream = cache.streams[0], computeStream = cache.streams[1], downStream = cache.streams[2];
+  PinnedPipe up = copy.upPipe(), down = copy.downPipe();
+  const cudaStream_t upStream = cache.streams[0], computeStream = cache.streams[1], downStream = cache.streams[2];
 
   const Index plane = g.rx * g.ry;
   const Index segment = gpu::segmentLength(g.radius[2]);
   const std::vector<gpu::SlabStep> plan = gpu::planSlabs(g, gpu::slabSlices(g, segment));
-  Index chunkMost = 0, slabMost = 0, perVoxel = 0;
-  for (const gpu::SlabStep& s : plan)
-  {
-    chunkMost = gpu::greater(chunkMost, s.chunkEnd - s.chunkBegin);
-    slabMost = gpu::greater(slabMost, s.sliceEnd - s.sliceBegin);
-  }
   // The device outputs, one array each, 256-byte aligned, region-sized.
-  Index offsets[5] = {}, outputBytes = 0;
+  Index offsets[5] = {}, outputBytes = 0, perVoxel = 0;
   for (int a = 0; a < 5; ++a)
   {
     offsets[a] = outputBytes;
@@ -80,31 +66,25 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
   }
   T* input = reinterpret_cast<T*>(cache.input.reserve(g.block() * static_cast<Index>(sizeof(T))));
   unsigned char* device = cache.outputs.reserve(outputBytes);
-  const Index chunkBytes = chunkMost * g.sx * g.sy * static_cast<Index>(sizeof(T));
-  const Index slabBytes = slabMost * plane * perVoxel;
-  unsigned char* stagingIn[2] = { cache.stagingIn[0].reserve(static_cast<std::size_t>(chunkBytes)),
-    cache.stagingIn[1].reserve(static_cast<std::size_t>(chunkBytes)) };
-  unsigned char* stagingOut[2] = { cache.stagingOut[0].reserve(static_cast<std::size_t>(slabBytes)),
-    cache.stagingOut[1].reserve(static_cast<std::size_t>(slabBytes)) };
-
-  auto at = [&](int a) { return outputs[a].host ? device + offsets[a] : nullptr; };
+  const auto at = [&](int a) { return outputs[a].host ? device + offsets[a] : nullptr; };
   const gpu::FinalOutputs out{ reinterpret_cast<float*>(at(0)), reinterpret_cast<float*>(at(1)),
     reinterpret_cast<double*>(at(2)), reinterpret_cast<double*>(at(3)), reinterpret_cast<double*>(at(4)), nullptr,
     nullptr };
   const gpu::StatisticsWriter<T, Acc> writer{ nullptr, nullptr, input, g, shift, estimator, out };
+  const Index rowBytes = g.sx * static_cast<Index>(sizeof(T));
+
   std::vector<std::unique_ptr<SlabEvents>> events;
-  // Slab i's outputs from its staging buffer to the caller's arrays.
-  auto copyOut = [&](std::size_t i) {
+  // Slab i's outputs to the caller's arrays, once its kernel is done.
+  const auto download = [&](std::size_t i) {
     const gpu::SlabStep& s = plan[i];
-    check(cudaEventSynchronize(events[i]->down.event), "download");
-    const unsigned char* from = stagingOut[i % 2];
+    check(cudaStreamWaitEvent(downStream, events[i]->kernel.event, 0), "stream wait");
     for (int a = 0; a < 5; ++a)
     {
       if (!outputs[a].host)
         continue;
-      const Index bytes = (s.sliceEnd - s.sliceBegin) * plane * outputs[a].elementSize;
-      parallelCopy(outputs[a].host + s.sliceBegin * plane * outputs[a].elementSize, from, bytes, execution.threads);
-      from += bytes;
+      const Index first = s.sliceBegin * plane * outputs[a].elementSize;
+      down.down(outputs[a].host + first, at(a) + first, (s.sliceEnd - s.sliceBegin) * plane * outputs[a].elementSize,
+        execution.threads);
     }
   };
   for (std::size_t i = 0; i < plan.size(); ++i)
@@ -112,65 +92,42 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
     const gpu::SlabStep& s = plan[i];
     events.emplace_back(new SlabEvents);
     SlabEvents& e = *events.back();
-    if (i >= 2)
-      check(cudaEventSynchronize(events[i - 2]->up.event), "upload"); // staging in[i % 2] is free
-    T* staged = reinterpret_cast<T*>(stagingIn[i % 2]);
-    gatherRows(volume, region, g, s.chunkBegin * g.sy, s.chunkEnd * g.sy, staged, execution.threads);
-    const Index sliceValues = g.sx * g.sy;
-    check(cudaEventRecord(e.upStart.event, upStream), "event record");
-    check(cudaMemcpyAsync(input + s.chunkBegin * sliceValues, staged,
-            static_cast<std::size_t>((s.chunkEnd - s.chunkBegin) * sliceValues) * sizeof(T), cudaMemcpyHostToDevice,
-            upStream),
-      "upload");
-    check(cudaEventRecord(e.up.event, upStream), "event record");
+    const Index firstRow = s.chunkBegin * g.sy;
+    up.up(reinterpret_cast<unsigned char*>(input) + firstRow * rowBytes, (s.chunkEnd - s.chunkBegin) * g.sy, rowBytes,
+      [&](Index begin, Index end, unsigned char* to) {
+        gatherRows(volume, region, g, firstRow + begin, firstRow + end, reinterpret_cast<T*>(to), execution.threads);
+      });
+    check(cudaEventRecord(e.uploaded.event, upStream), "event record");
     if (i == 0 && afterFirstUpload)
       afterFirstUpload();
 
-    check(cudaStreamWaitEvent(computeStream, e.up.event, 0), "stream wait");
+    check(cudaStreamWaitEvent(computeStream, e.uploaded.event, 0), "stream wait");
     check(cudaEventRecord(e.kernelStart.event, computeStream), "event record");
     launchFusedBlocks(gpu::fusedStatistics(writer, s.sliceBegin, s.sliceEnd, segment), computeStream);
     check(cudaGetLastError(), "fused statistics");
     check(cudaEventRecord(e.kernel.event, computeStream), "event record");
 
-    if (i >= 2)
-      copyOut(i - 2); // staging out[i % 2] is free
-    check(cudaStreamWaitEvent(downStream, e.kernel.event, 0), "stream wait");
-    check(cudaEventRecord(e.downStart.event, downStream), "event record");
-    unsigned char* staging = stagingOut[i % 2];
-    for (int a = 0; a < 5; ++a)
-    {
-      if (!outputs[a].host)
-        continue;
-      const Index bytes = (s.sliceEnd - s.sliceBegin) * plane * outputs[a].elementSize;
-      check(cudaMemcpyAsync(staging, at(a) + s.sliceBegin * plane * outputs[a].elementSize,
-              static_cast<std::size_t>(bytes), cudaMemcpyDeviceToHost, downStream),
-        "download");
-      staging += bytes;
-    }
-    check(cudaEventRecord(e.down.event, downStream), "event record");
+    if (i >= 1)
+      download(i - 1); // while slab i computes
     if (execution.progress)
       execution.progress(0.1 + 0.85 * static_cast<double>(i + 1) / plan.size());
     if (execution.abortRequested && execution.abortRequested())
       throw Cancelled{};
   }
-  for (std::size_t i = plan.size() >= 2 ? plan.size() - 2 : 0; i < plan.size(); ++i)
-    copyOut(i);
+  download(plan.size() - 1);
+  up.finish();
 
   if (timing)
   {
     double kernelMs = 0.0;
-    for (std::size_t i = 0; i < plan.size(); ++i)
-    {
-      const gpu::SlabStep& s = plan[i];
-      const SlabEvents& e = *events[i];
-      kernelMs += elapsed(e.kernelStart.event, e.kernel.event);
-      timing->uploadMilliseconds += elapsed(e.upStart.event, e.up.event);
-      timing->downloadMilliseconds += elapsed(e.downStart.event, e.down.event);
-      timing->uploadBytes += static_cast<double>((s.chunkEnd - s.chunkBegin) * g.sx * g.sy * sizeof(T));
-      timing->downloadBytes += static_cast<double>((s.sliceEnd - s.sliceBegin) * plane * perVoxel);
-    }
+    for (const auto& e : events)
+      kernelMs += elapsed(e->kernelStart.event, e->kernel.event);
     timing->passes.push_back({ "fused statistics", kernelMs, static_cast<double>(g.block() * sizeof(T) + g.region() * perVoxel) });
     timing->kernelMilliseconds += kernelMs;
+    timing->uploadBytes += up.bytes();
+    timing->uploadMilliseconds += up.milliseconds();
+    timing->downloadBytes += down.bytes();
+    timing->downloadMilliseconds += down.milliseconds();
   }
 }
 
