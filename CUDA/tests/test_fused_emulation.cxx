@@ -111,11 +111,55 @@ TEST(FusedPassOnHost, SlabPlanUploadsEachSliceOnceBeforeItIsRead)
 
 TEST(FusedPassOnHost, SharedMemoryFitsTheDeviceForCommonRadii)
 {
-  // An H100 grants a block 227 KiB; R = 10 needs far less, and extrema never fuse.
+  // An H100 grants a block 227 KiB: R = 10 fits with the extrema of 16-bit and 32-bit
+  // data; those of doubles, and x-y radii of 43, take the separate passes.
   const auto g = vao::gpu::geometryFor({ 256, 256, 415 }, { { 0, 0, 0 }, { 256, 256, 415 } }, { 10, 10, 10 });
-  EXPECT_TRUE(vao::gpu::fusedPassFits<std::int64_t>(g, false, 227 * 1024));
-  EXPECT_FALSE(vao::gpu::fusedPassFits<std::int64_t>(g, true, 227 * 1024));
-  EXPECT_LT(vao::gpu::fusedLayout(g).elements() * 8, 64 * 1024);
-  const auto wide = vao::gpu::geometryFor({ 256, 256, 415 }, { { 0, 0, 0 }, { 256, 256, 415 } }, { 200, 200, 10 });
-  EXPECT_FALSE(vao::gpu::fusedPassFits<double>(wide, false, 227 * 1024));
+  EXPECT_TRUE((vao::gpu::fusedPassFits<std::int64_t, std::int16_t>(g, false, 48 * 1024)));
+  EXPECT_TRUE((vao::gpu::fusedPassFits<std::int64_t, std::int16_t>(g, true, 227 * 1024)));
+  EXPECT_TRUE((vao::gpu::fusedPassFits<double, float>(g, true, 227 * 1024)));
+  EXPECT_FALSE((vao::gpu::fusedPassFits<double, double>(g, true, 227 * 1024)));
+  const auto wide = vao::gpu::geometryFor({ 256, 256, 415 }, { { 0, 0, 0 }, { 256, 256, 415 } }, { 43, 43, 10 });
+  EXPECT_FALSE((vao::gpu::fusedPassFits<double, float>(wide, false, 227 * 1024)));
+  const auto below = vao::gpu::geometryFor({ 256, 256, 415 }, { { 0, 0, 0 }, { 256, 256, 415 } }, { 42, 42, 10 });
+  EXPECT_TRUE((vao::gpu::fusedPassFits<double, float>(below, false, 227 * 1024)));
+}
+
+TEST(FusedPassOnHost, ExtremaEqualTheSeparatePassesForEveryRadius)
+{
+  // Minimum and maximum are exact in both: the same bits, through every edge clamp of the
+  // tile, deque and slab.
+  const vao::Index3 dims = { 45, 21, 37 };
+  const auto i16 = randomVolume<std::int16_t>(dims, -1024, 3000, 21);
+  const auto f32 = randomVolume<float>(dims, -2, 2, 22);
+  const vao::Region region{ { 3, 0, 2 }, { 40, 21, 33 } };
+  for (const vao::Radius& r : { vao::Radius{ 0, 0, 0 }, vao::Radius{ 1, 1, 1 }, vao::Radius{ 3, 2, 5 },
+         vao::Radius{ 10, 10, 10 }, vao::Radius{ 0, 7, 20 }, vao::Radius{ 30, 0, 1 } })
+    for (const Emulation& how : { Emulation{ true, 0, false }, Emulation{ true, 0, true }, Emulation{ true, 4, false } })
+    {
+      const Results passes = emulate(i16, dims, region, r, true, kStatistics);
+      const Results fused = emulate(i16, dims, region, r, true, kStatistics, how);
+      EXPECT_TRUE(sameBits(passes.minimum, fused.minimum));
+      EXPECT_TRUE(sameBits(passes.maximum, fused.maximum));
+      const Results floats = emulate(f32, dims, region, r, true, kStatistics);
+      const Results floatsFused = emulate(f32, dims, region, r, true, kStatistics, how);
+      EXPECT_TRUE(sameBits(floats.minimum, floatsFused.minimum));
+      EXPECT_TRUE(sameBits(floats.maximum, floatsFused.maximum));
+    }
+  // Values rising along z keep every slice of a window in the minimum's deque, falling
+  // ones in the maximum's: the deques at their fullest.
+  std::vector<std::int16_t> rising(i16.size()), falling(i16.size());
+  for (size_t i = 0; i < i16.size(); ++i)
+  {
+    const auto z = static_cast<int>(i / (dims[0] * dims[1]));
+    rising[i] = static_cast<std::int16_t>(20 * z + i16[i] % 5);
+    falling[i] = static_cast<std::int16_t>(-rising[i]);
+  }
+  for (const auto* v : { &rising, &falling })
+    for (const vao::Radius& r : { vao::Radius{ 1, 1, 1 }, vao::Radius{ 2, 3, 6 } })
+    {
+      const Results passes = emulate(*v, dims, region, r, true, kStatistics);
+      const Results fused = emulate(*v, dims, region, r, true, kStatistics, { true, 0, false });
+      EXPECT_TRUE(sameBits(passes.minimum, fused.minimum));
+      EXPECT_TRUE(sameBits(passes.maximum, fused.maximum));
+    }
 }

@@ -106,13 +106,14 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
   const Acc shift = static_cast<Acc>(scale.shift);
   estimator.roundingVariance = scale.roundingVariance;
   const BoxStatisticsOutput& st = host.statistics;
-  if (gpu::fusedPassFits<Acc>(g, withExtrema, sharedMemoryLimit()))
+  if (gpu::fusedPassFits<Acc, T>(g, withExtrema, sharedMemoryLimit()))
   {
     // One kernel, z slabs streamed: SlabTransfers.h.
     const auto bytes = [](auto* p) { return reinterpret_cast<unsigned char*>(p); };
-    const OutputArray outputs[5] = { { bytes(host.openness), 4 }, { bytes(host.variance), 4 }, { bytes(st.count), 8 },
-      { bytes(st.mean), 8 }, { bytes(st.variance), 8 } };
-    runFusedSlabs<T, Acc>(volume, region, g, shift, estimator, outputs, execution, timing, failIfInjected);
+    const OutputArray outputs[kFusedOutputs] = { { bytes(host.openness), 4 }, { bytes(host.variance), 4 },
+      { bytes(st.count), 8 }, { bytes(st.mean), 8 }, { bytes(st.variance), 8 }, { bytes(st.minimum), 8 },
+      { bytes(st.maximum), 8 } };
+    runFusedSlabs<T, Acc>(volume, region, g, shift, estimator, withExtrema, outputs, execution, timing, failIfInjected);
     return;
   }
   CudaExecutor ex(timing, execution);

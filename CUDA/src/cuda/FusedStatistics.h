@@ -20,6 +20,7 @@
 // reaches every barrier.
 #pragma once
 
+#include "FusedExtrema.h"
 #include "Pipeline.h"
 
 namespace vao
@@ -49,11 +50,19 @@ VAO_HD FusedLayout fusedLayout(const RegionGeometry& g)
   return FusedLayout{ kTileX + 2 * g.radius[0], kTileY + 2 * g.radius[1] };
 }
 
+/// Bytes of the sums' part of a block's shared memory, rounded to 16 (the extrema follow).
+template <class Acc>
+VAO_HD Index fusedSumBytes(const RegionGeometry& g)
+{
+  return (fusedLayout(g).elements() * static_cast<Index>(sizeof(Acc)) + 15) / 16 * 16;
+}
+
 /// The fused pass over the region slices [sliceBegin, sliceEnd) (a z slab; the whole
 /// region is one): the box sums of the two channels Source::load(block index, v1, v2)
 /// gives (the moments, or Histogram CDF's indicators), each voxel's pair handed to
-/// Sink::write(region index, block z, region x, region y, s1, s2).
-template <class Source, class Sink, class AccT>
+/// Sink::write(region index, block z, region x, region y, s1, s2), with the box's
+/// minimum and maximum after them when Extrema is FusedExtrema (FusedExtrema.h).
+template <class Source, class Sink, class AccT, class Extrema = NoExtrema>
 struct FusedBoxSums
 {
   using Acc = AccT;
@@ -63,11 +72,14 @@ struct FusedBoxSums
   Index sliceBegin;
   Index sliceEnd;
   Index segment; // slices a block walks: its first window costs 2 rz + 1 slices
+  Extrema extrema;
 
   VAO_HD Index tilesX() const { return (g.rx + kTileX - 1) / kTileX; }
   VAO_HD Index tilesY() const { return (g.ry + kTileY - 1) / kTileY; }
   VAO_HD Index blocks() const { return tilesX() * tilesY() * segmentsOf(sliceEnd - sliceBegin, segment); }
-  VAO_HD Index sharedBytes() const { return fusedLayout(g).elements() * static_cast<Index>(sizeof(Acc)); }
+  /// The sums' accumulators, then (16-byte aligned) the extrema's arrays.
+  VAO_HD Index sumBytes() const { return fusedSumBytes<Acc>(g); }
+  VAO_HD Index sharedBytes() const { return sumBytes() + extrema.bytes(g); }
 
   template <class Block>
   VAO_HD void run(const Block& block, Index blockIndex, Acc* shared) const
@@ -81,10 +93,13 @@ struct FusedBoxSums
     const Index last = lower(first + segment, sliceEnd);
     const Index rz = g.radius[2];
 
+    unsigned char* extremaShared = reinterpret_cast<unsigned char*>(shared) + sumBytes();
     block.each(kTileColumns, [&](Index c) {
       z1[c] = 0;
       z2[c] = 0;
     });
+    if constexpr (Extrema::kEnabled)
+      extrema.reset(block, g, extremaShared);
     const Index lo = greater(Index(0), g.oz + first - rz), hi = lower(g.sz - 1, g.oz + first + rz);
     for (Index j = lo; j <= hi; ++j)
     {
@@ -95,7 +110,14 @@ struct FusedBoxSums
       const Index z = g.oz + k;
       block.each(kTileColumns, [&](Index c) {
         const Index x = x0 + c % kTileX, y = y0 + c / kTileX;
-        if (x < g.rx && y < g.ry)
+        if constexpr (Extrema::kEnabled)
+        {
+          double minimum, maximum; // every column's deques move on, inside the region or not
+          extrema.window(g, extremaShared, c, z, minimum, maximum);
+          if (x < g.rx && y < g.ry)
+            sink.write((k * g.ry + y) * g.rx + x, z, x, y, z1[c], z2[c], minimum, maximum);
+        }
+        else if (x < g.rx && y < g.ry)
           sink.write((k * g.ry + y) * g.rx + x, z, x, y, z1[c], z2[c]);
       });
       if (k + 1 == last)
@@ -175,27 +197,40 @@ struct FusedBoxSums
       z1[c] = add ? z1[c] + xy1[c] : z1[c] - xy1[c];
       z2[c] = add ? z2[c] + xy2[c] : z2[c] - xy2[c];
     });
+    if constexpr (Extrema::kEnabled)
+    {
+      if (add) // a leaving slice leaves the deques by itself
+        extrema.enter(block, g, reinterpret_cast<unsigned char*>(shared) + sumBytes(), x0, y0, j);
+    }
   }
 };
 
 /// The fused pass of the moment estimators and statistics: the shifted moments of the
-/// block, the estimator's writer.
-template <class T, class Acc>
-using FusedStatisticsKernel = FusedBoxSums<MomentSource<T, Acc, true>, StatisticsWriter<T, Acc>, Acc>;
+/// block, the estimator's writer; with the extrema (CDF Reconstruction, the statistics'
+/// minimum and maximum) or without.
+template <class T, class Acc, class Extrema = NoExtrema>
+using FusedStatisticsKernel = FusedBoxSums<MomentSource<T, Acc, true>, StatisticsWriter<T, Acc>, Acc, Extrema>;
 
 template <class T, class Acc>
 FusedStatisticsKernel<T, Acc> fusedStatistics(
   const StatisticsWriter<T, Acc>& writer, Index sliceBegin, Index sliceEnd, Index segment)
 {
-  return { { writer.input, nullptr, writer.shift }, writer, writer.g, sliceBegin, sliceEnd, segment };
+  return { { writer.input, nullptr, writer.shift }, writer, writer.g, sliceBegin, sliceEnd, segment, {} };
 }
 
-/// Whether the fused pass applies: no extrema (they keep their van Herk passes) and a
-/// block's shared memory within what the device grants one (`sharedLimit` bytes).
-template <class Acc>
+template <class T, class Acc>
+FusedStatisticsKernel<T, Acc, FusedExtrema<T>> fusedStatisticsWithExtrema(
+  const StatisticsWriter<T, Acc>& writer, Index sliceBegin, Index sliceEnd, Index segment)
+{
+  return { { writer.input, nullptr, writer.shift }, writer, writer.g, sliceBegin, sliceEnd, segment, { writer.input } };
+}
+
+/// Whether the fused pass fits a block's shared memory (`sharedLimit` bytes) for sums in
+/// Acc and, withExtrema, the extrema of T.
+template <class Acc, class T>
 bool fusedPassFits(const RegionGeometry& g, bool withExtrema, Index sharedLimit)
 {
-  return !withExtrema && fusedLayout(g).elements() * static_cast<Index>(sizeof(Acc)) <= sharedLimit;
+  return fusedSumBytes<Acc>(g) + (withExtrema ? FusedExtrema<T>{ nullptr }.bytes(g) : 0) <= sharedLimit;
 }
 
 } // namespace gpu

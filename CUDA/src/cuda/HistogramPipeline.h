@@ -166,7 +166,7 @@ template <class T, class Executor>
 void runHistogramPasses(Executor& ex, const T* input, const RegionGeometry& g, const double* hostThresholds,
   int n, bool iso, double isoValue, float* openness)
 {
-  const bool fused = fusedPassFits<int>(g, false, ex.sharedLimit());
+  const bool fused = fusedPassFits<int, Bin>(g, false, ex.sharedLimit());
   auto thresholds = ex.template upload<double>(hostThresholds, n);
   auto bins = ex.template allocate<Bin>(g.block()), transposed = ex.template allocate<Bin>(fused ? 0 : g.block());
   ex.launch(BinKernel<T>{ input, thresholds.get(), n, bins.get(), g.block() }, "bins",

@@ -367,16 +367,18 @@ struct StatisticsWriter
       clippedWindowCount(z, g.radius[2], g.sz);
   }
 
+  /// With the extrema from extremaMin/Max (the separate passes) or none.
   VAO_HD void write(Index index, Index z, Index x, Index y, Acc s1, Acc s2) const
   {
+    this->write(index, z, x, y, s1, s2, extremaMin ? static_cast<double>(extremaMin[index]) : 0.0,
+      extremaMax ? static_cast<double>(extremaMax[index]) : 0.0);
+  }
+
+  VAO_HD void write(Index index, Index z, Index x, Index y, Acc s1, Acc s2, double minimum, double maximum) const
+  {
     const long long n = this->count(x, y, z);
-    NeighbourhoodStats s{ 0.0, 0.0, 0.0, 0.0, estimator.roundingVariance };
+    NeighbourhoodStats s{ 0.0, 0.0, minimum, maximum, estimator.roundingVariance };
     meanVarianceFromSums(s1, s2, n, static_cast<double>(shift), s.mean, s.variance);
-    if (extremaMin)
-    {
-      s.minimum = static_cast<double>(extremaMin[index]);
-      s.maximum = static_cast<double>(extremaMax[index]);
-    }
     if (out.openness)
     {
       const double q = estimator.query == QueryMode::VoxelValue

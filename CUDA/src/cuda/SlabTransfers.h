@@ -25,6 +25,10 @@ namespace cuda
 namespace
 {
 
+/// The outputs in FinalOutputs' order: openness, variance, count, mean, varianceD,
+/// minimum, maximum.
+constexpr int kFusedOutputs = 7;
+
 /// One output array of the region: where it goes on the host and its element size.
 struct OutputArray
 {
@@ -38,12 +42,13 @@ struct SlabEvents
   Event uploaded, kernelStart, kernel;
 };
 
-/// The fused pass over the region in slabs, transfers overlapped; `outputs` in the order
-/// of FinalOutputs' openness, variance, count, mean, varianceD (null: not asked for).
+/// The fused pass over the region in slabs, transfers overlapped; `outputs` (null: not
+/// asked for) in FinalOutputs' order. withExtrema: the box extrema too (CDF
+/// Reconstruction, the statistics' minimum and maximum).
 template <class T, class Acc>
 void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, const gpu::RegionGeometry& g,
-  Acc shift, const gpu::EstimatorSetting& estimator, const OutputArray (&outputs)[5], const Execution& execution,
-  Timing* timing, void (*afterFirstUpload)())
+  Acc shift, const gpu::EstimatorSetting& estimator, bool withExtrema, const OutputArray (&outputs)[kFusedOutputs],
+  const Execution& execution, Timing* timing, void (*afterFirstUpload)())
 {
   StagedCopy copy(currentTransferCache()); // the device's buffers, drained on every exit
   TransferCache& cache = copy.cache;
@@ -54,8 +59,8 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
   const Index segment = gpu::segmentLength(g.radius[2]);
   const std::vector<gpu::SlabStep> plan = gpu::planSlabs(g, gpu::slabSlices(g, segment));
   // The device outputs, one array each, 256-byte aligned, region-sized.
-  Index offsets[5] = {}, outputBytes = 0, perVoxel = 0;
-  for (int a = 0; a < 5; ++a)
+  Index offsets[kFusedOutputs] = {}, outputBytes = 0, perVoxel = 0;
+  for (int a = 0; a < kFusedOutputs; ++a)
   {
     offsets[a] = outputBytes;
     if (outputs[a].host)
@@ -68,8 +73,8 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
   unsigned char* device = cache.outputs.reserve(outputBytes);
   const auto at = [&](int a) { return outputs[a].host ? device + offsets[a] : nullptr; };
   const gpu::FinalOutputs out{ reinterpret_cast<float*>(at(0)), reinterpret_cast<float*>(at(1)),
-    reinterpret_cast<double*>(at(2)), reinterpret_cast<double*>(at(3)), reinterpret_cast<double*>(at(4)), nullptr,
-    nullptr };
+    reinterpret_cast<double*>(at(2)), reinterpret_cast<double*>(at(3)), reinterpret_cast<double*>(at(4)),
+    reinterpret_cast<double*>(at(5)), reinterpret_cast<double*>(at(6)) };
   const gpu::StatisticsWriter<T, Acc> writer{ nullptr, nullptr, input, g, shift, estimator, out };
   const Index rowBytes = g.sx * static_cast<Index>(sizeof(T));
 
@@ -78,7 +83,7 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
   const auto download = [&](std::size_t i) {
     const gpu::SlabStep& s = plan[i];
     check(cudaStreamWaitEvent(downStream, events[i]->kernel.event, 0), "stream wait");
-    for (int a = 0; a < 5; ++a)
+    for (int a = 0; a < kFusedOutputs; ++a)
     {
       if (!outputs[a].host)
         continue;
@@ -103,7 +108,10 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
 
     check(cudaStreamWaitEvent(computeStream, e.uploaded.event, 0), "stream wait");
     check(cudaEventRecord(e.kernelStart.event, computeStream), "event record");
-    launchFusedBlocks(gpu::fusedStatistics(writer, s.sliceBegin, s.sliceEnd, segment), computeStream);
+    if (withExtrema)
+      launchFusedBlocks(gpu::fusedStatisticsWithExtrema(writer, s.sliceBegin, s.sliceEnd, segment), computeStream);
+    else
+      launchFusedBlocks(gpu::fusedStatistics(writer, s.sliceBegin, s.sliceEnd, segment), computeStream);
     check(cudaGetLastError(), "fused statistics");
     check(cudaEventRecord(e.kernel.event, computeStream), "event record");
 
@@ -122,7 +130,8 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
     double kernelMs = 0.0;
     for (const auto& e : events)
       kernelMs += elapsed(e->kernelStart.event, e->kernel.event);
-    timing->passes.push_back({ "fused statistics", kernelMs, static_cast<double>(g.block() * sizeof(T) + g.region() * perVoxel) });
+    timing->passes.push_back({ withExtrema ? "fused statistics and extrema" : "fused statistics", kernelMs,
+      static_cast<double>(g.block() * sizeof(T) + g.region() * perVoxel) });
     timing->kernelMilliseconds += kernelMs;
     timing->uploadBytes += up.bytes();
     timing->uploadMilliseconds += up.milliseconds();
