@@ -8,6 +8,7 @@
 // is what limits the radius a block's shared memory allows.
 #pragma once
 
+#include "FusedTile.h"
 #include "Pipeline.h"
 
 namespace vao
@@ -34,13 +35,13 @@ struct FusedExtrema
   {
     Index width, height, depth; // the tile with its halo; deque slots per column
     VAO_HD Index values() const { return width * height; }
-    VAO_HD Index tValues() const { return 3 * values() + 4 * height * 32 + 2 * 256 + 2 * depth * 256; }
-    VAO_HD Index ints() const { return 2 * depth * 256 + 4 * 256; }
+    VAO_HD Index tValues() const { return 3 * values() + 4 * height * kTileX + 2 * kTileColumns + 2 * depth * kTileColumns; }
+    VAO_HD Index ints() const { return 2 * depth * kTileColumns + 4 * kTileColumns; }
   };
 
   VAO_HD static Layout layout(const RegionGeometry& g)
   {
-    return Layout{ 32 + 2 * g.radius[0], 8 + 2 * g.radius[1], 2 * g.radius[2] + 2 };
+    return Layout{ kTileX + 2 * g.radius[0], kTileY + 2 * g.radius[1], 2 * g.radius[2] + 2 };
   }
   VAO_HD Index bytes(const RegionGeometry& g) const
   {
@@ -63,20 +64,20 @@ struct FusedExtrema
     a.rowSufMin = a.value + l.values();
     a.rowSufMax = a.rowSufMin + l.values();
     a.rowMin = a.rowSufMax + l.values();
-    a.rowMax = a.rowMin + l.height * 32;
-    a.colSufMin = a.rowMax + l.height * 32;
-    a.colSufMax = a.colSufMin + l.height * 32;
-    a.xyMin = a.colSufMax + l.height * 32;
-    a.xyMax = a.xyMin + 256;
-    a.dqMin = a.xyMax + 256;
-    a.dqMax = a.dqMin + l.depth * 256;
+    a.rowMax = a.rowMin + l.height * kTileX;
+    a.colSufMin = a.rowMax + l.height * kTileX;
+    a.colSufMax = a.colSufMin + l.height * kTileX;
+    a.xyMin = a.colSufMax + l.height * kTileX;
+    a.xyMax = a.xyMin + kTileColumns;
+    a.dqMin = a.xyMax + kTileColumns;
+    a.dqMax = a.dqMin + l.depth * kTileColumns;
     int* n = reinterpret_cast<int*>(shared + (l.tValues() * static_cast<Index>(sizeof(T)) + 15) / 16 * 16);
     a.dqMinSlice = n;
-    a.dqMaxSlice = n + l.depth * 256;
-    a.minHead = a.dqMaxSlice + l.depth * 256;
-    a.minCount = a.minHead + 256;
-    a.maxHead = a.minCount + 256;
-    a.maxCount = a.maxHead + 256;
+    a.dqMaxSlice = n + l.depth * kTileColumns;
+    a.minHead = a.dqMaxSlice + l.depth * kTileColumns;
+    a.minCount = a.minHead + kTileColumns;
+    a.maxHead = a.minCount + kTileColumns;
+    a.maxCount = a.maxHead + kTileColumns;
     return a;
   }
 
@@ -111,7 +112,7 @@ struct FusedExtrema
   VAO_HD void reset(const Block& block, const RegionGeometry& g, unsigned char* shared) const
   {
     const Arrays a = arrays(g, shared);
-    block.each(256, [&](Index c) {
+    block.each(kTileColumns, [&](Index c) {
       a.minHead[c] = a.minCount[c] = a.maxHead[c] = a.maxCount[c] = 0;
     });
   }
@@ -132,14 +133,14 @@ struct FusedExtrema
     });
     block.each(l.height, [&](Index row) {
       const T* values = a.value + row * l.width;
-      windows(values, values, 1, 32, 2 * rx + 1, a.rowSufMin + row * l.width, a.rowSufMax + row * l.width,
-        a.rowMin + row * 32, a.rowMax + row * 32, 1);
+      windows(values, values, 1, kTileX, 2 * rx + 1, a.rowSufMin + row * l.width, a.rowSufMax + row * l.width,
+        a.rowMin + row * kTileX, a.rowMax + row * kTileX, 1);
     });
-    block.each(32, [&](Index c) {
-      windows(a.rowMin + c, a.rowMax + c, 32, 8, 2 * ry + 1, a.colSufMin + c, a.colSufMax + c, a.xyMin + c, a.xyMax + c,
-        32);
+    block.each(kTileX, [&](Index c) {
+      windows(a.rowMin + c, a.rowMax + c, kTileX, kTileY, 2 * ry + 1, a.colSufMin + c, a.colSufMax + c, a.xyMin + c,
+        a.xyMax + c, kTileX);
     });
-    block.each(256, [&](Index c) {
+    block.each(kTileColumns, [&](Index c) {
       push(a.dqMin + c * l.depth, a.dqMinSlice + c * l.depth, a.minHead[c], a.minCount[c], l.depth, j, a.xyMin[c],
         true);
       push(a.dqMax + c * l.depth, a.dqMaxSlice + c * l.depth, a.maxHead[c], a.maxCount[c], l.depth, j, a.xyMax[c],

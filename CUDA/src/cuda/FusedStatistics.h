@@ -21,17 +21,13 @@
 #pragma once
 
 #include "FusedExtrema.h"
+#include "FusedTile.h"
 #include "Pipeline.h"
 
 namespace vao
 {
 namespace gpu
 {
-
-/// A block's output columns: 32 x 8, one per thread.
-constexpr Index kTileX = 32;
-constexpr Index kTileY = 8;
-constexpr Index kTileColumns = kTileX * kTileY;
 
 /// The shared memory of one block, in accumulators: the loaded slice with its halo (two
 /// moments), the row sums, the columns' x-y sums and their z running sums.
