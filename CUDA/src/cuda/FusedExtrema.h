@@ -117,20 +117,23 @@ struct FusedExtrema
     });
   }
 
-  /// Slice j enters the columns' windows (x0, y0: the tile's first region column).
+  /// Item i of the tile with its halo at block (bx, by) of slice j, into the loaded
+  /// values (in the sums' load phase). Outside the block no voxel exists: the edge value
+  /// stands in, which no window of a region voxel changes (its clipped window holds that
+  /// voxel already).
+  VAO_HD void load(const RegionGeometry& g, unsigned char* shared, Index i, Index bx, Index by, Index j) const
+  {
+    const Index x = lower(greater(bx, Index(0)), g.sx - 1), y = lower(greater(by, Index(0)), g.sy - 1);
+    arrays(g, shared).value[i] = input[(j * g.sy + y) * g.sx + x];
+  }
+
+  /// Slice j, loaded, enters the columns' windows.
   template <class Block>
-  VAO_HD void enter(const Block& block, const RegionGeometry& g, unsigned char* shared, Index x0, Index y0, Index j) const
+  VAO_HD void enter(const Block& block, const RegionGeometry& g, unsigned char* shared, Index j) const
   {
     const Layout l = layout(g);
     const Arrays a = arrays(g, shared);
     const Index rx = g.radius[0], ry = g.radius[1];
-    // Outside the block no voxel exists: the edge value stands in, which no window of a
-    // region voxel changes (its clipped window holds that voxel already).
-    block.each(l.values(), [&](Index i) {
-      const Index bx = lower(greater(g.ox + x0 - rx + i % l.width, Index(0)), g.sx - 1);
-      const Index by = lower(greater(g.oy + y0 - ry + i / l.width, Index(0)), g.sy - 1);
-      a.value[i] = input[(j * g.sy + by) * g.sx + bx];
-    });
     block.each(l.height, [&](Index row) {
       const T* values = a.value + row * l.width;
       windows(values, values, 1, kTileX, 2 * rx + 1, a.rowSufMin + row * l.width, a.rowSufMax + row * l.width,

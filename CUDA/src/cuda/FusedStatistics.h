@@ -14,7 +14,7 @@
 //
 // The block's code is written once against a Block that runs a phase for every item and
 // then waits for all of them: on the device a strided loop over the block's threads and
-// __syncthreads() (CudaBackend.cu), on the host a loop (the tests' host twin, which also
+// __syncthreads() (CudaExecutor.h), on the host a loop (the tests' host twin, which also
 // runs the items backwards to show that no phase reads what another item of the same
 // phase writes). Every branch around a phase depends on the block only, so every thread
 // reaches every barrier.
@@ -44,6 +44,50 @@ struct FusedLayout
 VAO_HD FusedLayout fusedLayout(const RegionGeometry& g)
 {
   return FusedLayout{ kTileX + 2 * g.radius[0], kTileY + 2 * g.radius[1] };
+}
+
+/// The sums' arrays, carved from a block's shared accumulators in FusedLayout's order.
+template <class Acc>
+struct SumArrays
+{
+  Acc *v1, *v2, *r1, *r2, *xy1, *xy2, *z1, *z2;
+
+  VAO_HD SumArrays(const FusedLayout& layout, Acc* shared)
+    : v1(shared)
+    , v2(v1 + layout.loaded())
+    , r1(v2 + layout.loaded())
+    , r2(r1 + layout.rows())
+    , xy1(r2 + layout.rows())
+    , xy2(xy1 + kTileColumns)
+    , z1(xy2 + kTileColumns)
+    , z2(z1 + kTileColumns)
+  {
+  }
+};
+
+/// Sums of both channels over windows of k inputs for `count` outputs: inputs at stride
+/// `step`, outputs at stride `outStep`, a running window moved by one addition and one
+/// subtraction per output.
+template <class Acc>
+VAO_HD void windowSums(const Acc* in1, const Acc* in2, Index step, Index count, Index k, Acc* out1, Acc* out2,
+  Index outStep)
+{
+  Acc s1 = 0, s2 = 0;
+  for (Index i = 0; i < k; ++i)
+  {
+    s1 += in1[i * step];
+    s2 += in2[i * step];
+  }
+  for (Index c = 0; c < count; ++c)
+  {
+    out1[c * outStep] = s1;
+    out2[c * outStep] = s2;
+    if (c + 1 < count)
+    {
+      s1 += in1[(c + k) * step] - in1[c * step];
+      s2 += in2[(c + k) * step] - in2[c * step];
+    }
+  }
 }
 
 /// Bytes of the sums' part of a block's shared memory, rounded to 16 (the extrema follow).
@@ -80,9 +124,7 @@ struct FusedBoxSums
   template <class Block>
   VAO_HD void run(const Block& block, Index blockIndex, Acc* shared) const
   {
-    const FusedLayout layout = fusedLayout(g);
-    Acc* z1 = shared + 2 * layout.loaded() + 2 * layout.rows() + 2 * kTileColumns;
-    Acc* z2 = z1 + kTileColumns;
+    const SumArrays<Acc> a(fusedLayout(g), shared);
     const Index x0 = (blockIndex % tilesX()) * kTileX;
     const Index y0 = ((blockIndex / tilesX()) % tilesY()) * kTileY;
     const Index first = sliceBegin + (blockIndex / (tilesX() * tilesY())) * segment;
@@ -91,8 +133,8 @@ struct FusedBoxSums
 
     unsigned char* extremaShared = reinterpret_cast<unsigned char*>(shared) + sumBytes();
     block.each(kTileColumns, [&](Index c) {
-      z1[c] = 0;
-      z2[c] = 0;
+      a.z1[c] = 0;
+      a.z2[c] = 0;
     });
     if constexpr (Extrema::kEnabled)
       extrema.reset(block, g, extremaShared);
@@ -111,10 +153,10 @@ struct FusedBoxSums
           double minimum, maximum; // every column's deques move on, inside the region or not
           extrema.window(g, extremaShared, c, z, minimum, maximum);
           if (x < g.rx && y < g.ry)
-            sink.write((k * g.ry + y) * g.rx + x, z, x, y, z1[c], z2[c], minimum, maximum);
+            sink.write((k * g.ry + y) * g.rx + x, z, x, y, a.z1[c], a.z2[c], minimum, maximum);
         }
         else if (x < g.rx && y < g.ry)
-          sink.write((k * g.ry + y) * g.rx + x, z, x, y, z1[c], z2[c]);
+          sink.write((k * g.ry + y) * g.rx + x, z, x, y, a.z1[c], a.z2[c]);
       });
       if (k + 1 == last)
         break;
@@ -130,73 +172,42 @@ struct FusedBoxSums
   VAO_HD void addSlice(const Block& block, Acc* shared, Index x0, Index y0, Index j, bool add) const
   {
     const FusedLayout layout = fusedLayout(g);
+    const SumArrays<Acc> a(layout, shared);
+    unsigned char* extremaShared = reinterpret_cast<unsigned char*>(shared) + sumBytes();
     const Index rx = g.radius[0], ry = g.radius[1];
-    Acc* v1 = shared;
-    Acc* v2 = v1 + layout.loaded();
-    Acc* r1 = v2 + layout.loaded();
-    Acc* r2 = r1 + layout.rows();
-    Acc* xy1 = r2 + layout.rows();
-    Acc* xy2 = xy1 + kTileColumns;
-    Acc* z1 = xy2 + kTileColumns;
-    Acc* z2 = z1 + kTileColumns;
     // The tile and its halo; zero outside the block, which holds every voxel of the
-    // volume a window of the region reaches.
+    // volume a window of the region reaches. The extrema's copy of an entering slice is
+    // loaded in the same phase.
     block.each(layout.loaded(), [&](Index i) {
       const Index bx = g.ox + x0 - rx + i % layout.width, by = g.oy + y0 - ry + i / layout.width;
       Acc m1 = 0, m2 = 0;
       if (bx >= 0 && bx < g.sx && by >= 0 && by < g.sy)
         source.load((j * g.sy + by) * g.sx + bx, m1, m2);
-      v1[i] = m1;
-      v2[i] = m2;
+      a.v1[i] = m1;
+      a.v2[i] = m2;
+      if constexpr (Extrema::kEnabled)
+      {
+        if (add)
+          extrema.load(g, extremaShared, i, bx, by, j);
+      }
     });
     // Each loaded row's sums over the x windows of the tile's columns.
     block.each(layout.height, [&](Index row) {
-      const Acc* a1 = v1 + row * layout.width;
-      const Acc* a2 = v2 + row * layout.width;
-      Acc s1 = 0, s2 = 0;
-      for (Index i = 0; i <= 2 * rx; ++i)
-      {
-        s1 += a1[i];
-        s2 += a2[i];
-      }
-      for (Index c = 0; c < kTileX; ++c)
-      {
-        r1[row * kTileX + c] = s1;
-        r2[row * kTileX + c] = s2;
-        if (c + 1 < kTileX)
-        {
-          s1 += a1[c + 2 * rx + 1] - a1[c];
-          s2 += a2[c + 2 * rx + 1] - a2[c];
-        }
-      }
+      windowSums(a.v1 + row * layout.width, a.v2 + row * layout.width, 1, kTileX, 2 * rx + 1, a.r1 + row * kTileX,
+        a.r2 + row * kTileX, 1);
     });
     // Each column's sums of those over the y windows.
     block.each(kTileX, [&](Index c) {
-      Acc s1 = 0, s2 = 0;
-      for (Index row = 0; row <= 2 * ry; ++row)
-      {
-        s1 += r1[row * kTileX + c];
-        s2 += r2[row * kTileX + c];
-      }
-      for (Index t = 0; t < kTileY; ++t)
-      {
-        xy1[t * kTileX + c] = s1;
-        xy2[t * kTileX + c] = s2;
-        if (t + 1 < kTileY)
-        {
-          s1 += r1[(t + 2 * ry + 1) * kTileX + c] - r1[t * kTileX + c];
-          s2 += r2[(t + 2 * ry + 1) * kTileX + c] - r2[t * kTileX + c];
-        }
-      }
+      windowSums(a.r1 + c, a.r2 + c, kTileX, kTileY, 2 * ry + 1, a.xy1 + c, a.xy2 + c, kTileX);
     });
     block.each(kTileColumns, [&](Index c) {
-      z1[c] = add ? z1[c] + xy1[c] : z1[c] - xy1[c];
-      z2[c] = add ? z2[c] + xy2[c] : z2[c] - xy2[c];
+      a.z1[c] = add ? a.z1[c] + a.xy1[c] : a.z1[c] - a.xy1[c];
+      a.z2[c] = add ? a.z2[c] + a.xy2[c] : a.z2[c] - a.xy2[c];
     });
     if constexpr (Extrema::kEnabled)
     {
       if (add) // a leaving slice leaves the deques by itself
-        extrema.enter(block, g, reinterpret_cast<unsigned char*>(shared) + sumBytes(), x0, y0, j);
+        extrema.enter(block, g, extremaShared, j);
     }
   }
 };

@@ -4,9 +4,9 @@
 // [bin <= k] and [bin <= k + 1] go through the moments' fused pass (FusedStatistics.h;
 // where the tile does not fit a block, their running-sum passes: x on the transposed bins,
 // y, then z), which keeps, per voxel, the counts at the two thresholds that enclose its
-// query. The last kernel applies the formula of
-// Estimators.h (opennessHistogramCdfAt), the one the CPU uses. Every pass is O(1) per
-// voxel whatever the radius; there are K/2 rounds of three passes.
+// query. The last kernel applies the formula of Estimators.h (opennessHistogramCdfAt),
+// the one the CPU uses. Every pass is O(1) per voxel whatever the radius; there are K/2
+// rounds (one fused pass each, or three).
 #pragma once
 
 #include "FusedStatistics.h"
