@@ -1,7 +1,8 @@
 // The estimators over rows of neighbourhoods (EstimatorRows.h, four voxels at a time on
-// AVX2 with glibc's vector erf and pow) against the formulas of METHODS.md written out again
+// AVX2 and eight on AVX-512, with glibc's vector erf and pow; each tier the processor has) against the formulas of METHODS.md written out again
 // (ReferenceFormulas.h): rows of every length around the vector width, queries per voxel
 // and one iso value, flat boxes among noisy ones, small and large magnitudes.
+#include "../src/cpu/CpuDispatch.h"
 #include "../src/cpu/EstimatorRows.h"
 #include "../src/cpu/MomentRows.h"
 #include "ReferenceFormulas.h"
@@ -84,49 +85,66 @@ double referenceOpenness(vao::Method method, double q, const RowData& d, std::si
   }
 }
 
+/// Runs check() with the row loops capped at each tier (all tiers this processor lacks run
+/// as its best one), then lifts the cap.
+template <class Check>
+void onEveryTier(Check&& check)
+{
+  using vao::detail::SimdTier;
+  for (const SimdTier tier : { SimdTier::Baseline, SimdTier::Avx2, SimdTier::Avx512 })
+  {
+    SCOPED_TRACE(static_cast<int>(tier));
+    vao::detail::limitSimdTier(tier);
+    check();
+  }
+  vao::detail::limitSimdTier(SimdTier::Avx512);
+}
+
 } // namespace
 
 TEST(EstimatorRows, EveryLengthQueryAndMagnitudeAgainstTheReference)
 {
-  std::mt19937 rng(20261202);
-  std::size_t compared = 0, offByOneUlp = 0;
-  for (const vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
-  {
-    // Reach 12: most Gaussian CDF lanes beyond |z| = 6, where erf is +-1, often whole groups.
-    for (const double magnitude : { 1.0, 1000.0, 3.0e6, -12.0 })
+  onEveryTier([] {
+    std::mt19937 rng(20261202);
+    std::size_t compared = 0, offByOneUlp = 0;
+    for (const vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
     {
-      for (std::size_t n = 0; n <= 37; ++n)
+      // Reach 12: most Gaussian CDF lanes beyond |z| = 6, where erf is +-1, often whole groups.
+      for (const double magnitude : { 1.0, 1000.0, 3.0e6, -12.0 })
       {
-        const RowData d = magnitude > 0 ? makeRow(n, magnitude, rng) : makeRow(n, 1000.0, rng, -magnitude);
-        const double iso = magnitude * 0.25;
-        for (const bool perVoxel : { true, false })
+        for (std::size_t n = 0; n <= 37; ++n)
         {
-          std::vector<float> out(n, -1.0f);
-          vao::detail::opennessRow(method, vao::ErfMode::Exact, d.row(), perVoxel ? d.query.data() : nullptr, iso,
-            out.data());
-          for (std::size_t i = 0; i < n; ++i)
+          const RowData d = magnitude > 0 ? makeRow(n, magnitude, rng) : makeRow(n, 1000.0, rng, -magnitude);
+          const double iso = magnitude * 0.25;
+          for (const bool perVoxel : { true, false })
           {
-            const double q = perVoxel ? d.query[i] : iso;
-            const float expected = static_cast<float>(referenceOpenness(method, q, d, i));
-            ++compared;
-            if (out[i] == expected)
-              continue;
-            // The vector erf and pow are within a few double ulps of the scalar ones: the
-            // float may round the other way (one float ulp), or, in the tails where 1 + erf
-            // cancels, differ by those few ulps of 1, as the scalar value differs from the truth.
-            ASSERT_NE(method, vao::Method::Chebyshev) << "voxel " << i << " of " << n << ": " << out[i] << " vs " << expected;
-            const double tolerance = std::fmax(std::fabs(std::nextafter(expected, out[i]) - expected), 8 * kHalfUlpOfOne);
-            ASSERT_LE(std::fabs(double(out[i]) - expected), tolerance) << "voxel " << i << " of " << n << ", q " << q
-              << ", mean " << d.mean[i] << ", variance " << d.variance[i];
-            offByOneUlp += expected > kTail; // a rounding coincidence there
+            std::vector<float> out(n, -1.0f);
+            vao::detail::opennessRow(method, vao::ErfMode::Exact, d.row(), perVoxel ? d.query.data() : nullptr, iso,
+              out.data());
+            for (std::size_t i = 0; i < n; ++i)
+            {
+              const double q = perVoxel ? d.query[i] : iso;
+              const float expected = static_cast<float>(referenceOpenness(method, q, d, i));
+              ++compared;
+              if (out[i] == expected)
+                continue;
+              // The vector erf and pow are within a few double ulps of the scalar ones: the
+              // float may round the other way (one float ulp), or, in the tails where 1 + erf
+              // cancels, differ by those few ulps of 1, as the scalar value differs from the truth.
+              ASSERT_NE(method, vao::Method::Chebyshev) << "voxel " << i << " of " << n << ": " << out[i] << " vs " << expected;
+              const double tolerance = std::fmax(std::fabs(std::nextafter(expected, out[i]) - expected), 8 * kHalfUlpOfOne);
+              ASSERT_LE(std::fabs(double(out[i]) - expected), tolerance) << "voxel " << i << " of " << n << ", q " << q
+                << ", mean " << d.mean[i] << ", variance " << d.variance[i];
+              offByOneUlp += expected > kTail; // a rounding coincidence there
+            }
           }
         }
       }
     }
-  }
-  std::printf("%zu opennesses compared, %zu above the tail a rounding away from the reference, vector form: %s\n", compared,
-    offByOneUlp, vao::detail::opennessRowIsVector(vao::Method::GaussianCdf, vao::ErfMode::Exact) ? "yes" : "no");
-  EXPECT_LE(offByOneUlp * 1000, compared); // a rounding coincidence, not a habit
+    std::printf("%zu opennesses compared, %zu above the tail a rounding away from the reference, vector form: %s\n", compared,
+      offByOneUlp, vao::detail::opennessRowIsVector(vao::Method::GaussianCdf, vao::ErfMode::Exact) ? "yes" : "no");
+    EXPECT_LE(offByOneUlp * 1000, compared); // a rounding coincidence, not a habit
+  });
 }
 
 TEST(EstimatorRows, VectorAndPlainFormsAgree)
@@ -138,24 +156,26 @@ TEST(EstimatorRows, VectorAndPlainFormsAgree)
   for (const Field field : { &RowData::value, &RowData::count, &RowData::mean, &RowData::variance,
          &RowData::minimum, &RowData::maximum, &RowData::query })
     (d.*field).insert((d.*field).end(), (far.*field).begin(), (far.*field).end());
-  for (const vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
-  {
-    std::vector<float> fast(d.mean.size()), plain(d.mean.size());
-    vao::detail::opennessRow(method, vao::ErfMode::Exact, d.row(), d.query.data(), 0.0, fast.data());
-    vao::detail::opennessRowPlain(method, vao::ErfMode::Exact, d.row(), d.query.data(), 0.0, plain.data());
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < fast.size(); ++i)
+  onEveryTier([&] {
+    for (const vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
     {
-      if (fast[i] != plain[i])
+      std::vector<float> fast(d.mean.size()), plain(d.mean.size());
+      vao::detail::opennessRow(method, vao::ErfMode::Exact, d.row(), d.query.data(), 0.0, fast.data());
+      vao::detail::opennessRowPlain(method, vao::ErfMode::Exact, d.row(), d.query.data(), 0.0, plain.data());
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < fast.size(); ++i)
       {
-        ASSERT_NE(method, vao::Method::Chebyshev) << "Chebyshev rounds as the scalar formula, voxel " << i;
-        const double tolerance = std::fmax(std::fabs(std::nextafter(plain[i], fast[i]) - plain[i]), 8 * kHalfUlpOfOne);
-        ASSERT_LE(std::fabs(double(fast[i]) - plain[i]), tolerance) << "voxel " << i;
-        differ += plain[i] > kTail;
+        if (fast[i] != plain[i])
+        {
+          ASSERT_NE(method, vao::Method::Chebyshev) << "Chebyshev rounds as the scalar formula, voxel " << i;
+          const double tolerance = std::fmax(std::fabs(std::nextafter(plain[i], fast[i]) - plain[i]), 8 * kHalfUlpOfOne);
+          ASSERT_LE(std::fabs(double(fast[i]) - plain[i]), tolerance) << "voxel " << i;
+          differ += plain[i] > kTail;
+        }
       }
+      EXPECT_LE(differ * 1000, fast.size());
     }
-    EXPECT_LE(differ * 1000, fast.size());
-  }
+  });
 }
 
 // The mean and variance of rows of boxes from exact sums: against the definition (double of
@@ -164,37 +184,39 @@ TEST(EstimatorRows, VectorAndPlainFormsAgree)
 // in large boxes), mixed within a row.
 TEST(MomentRows, MeanAndVarianceFromExactSumsBitForBit)
 {
-  std::mt19937_64 rng(99);
-  for (std::int64_t n = 0; n <= 29; ++n)
-  {
-    for (const std::int64_t countYZ : { std::int64_t(1), std::int64_t(441), std::int64_t(1) << 20 })
+  onEveryTier([] {
+    std::mt19937_64 rng(99);
+    for (std::int64_t n = 0; n <= 29; ++n)
     {
-      std::vector<std::int64_t> sum(n), sumSquares(n), countX(n);
-      for (std::int64_t i = 0; i < n; ++i)
+      for (const std::int64_t countYZ : { std::int64_t(1), std::int64_t(441), std::int64_t(1) << 20 })
       {
-        countX[i] = 1 + static_cast<std::int64_t>(rng() % 21);
-        const std::int64_t count = countX[i] * countYZ;
-        const std::int64_t magnitude = rng() % 3 == 0 ? 32768 : 3000; // the int16 range, or a CT's
-        // Values of the box: a few distinct ones stand for all (only the sums matter).
-        const std::int64_t a = static_cast<std::int64_t>(rng() % (2 * magnitude)) - magnitude;
-        const std::int64_t b = static_cast<std::int64_t>(rng() % (2 * magnitude)) - magnitude;
-        const std::int64_t ofA = static_cast<std::int64_t>(rng() % (count + 1));
-        sum[i] = a * ofA + b * (count - ofA);
-        sumSquares[i] = a * a * ofA + b * b * (count - ofA);
-      }
-      std::vector<double> count(n), mean(n), variance(n);
-      vao::detail::meanVarianceRowExact(sum.data(), sumSquares.data(), countX.data(), countYZ, n, count.data(),
-        mean.data(), variance.data());
-      for (std::int64_t i = 0; i < n; ++i)
-      {
-        const std::int64_t c = countX[i] * countYZ;
-        const __int128 numerator = static_cast<__int128>(c) * sumSquares[i] - static_cast<__int128>(sum[i]) * sum[i];
-        const double cd = static_cast<double>(c);
-        ASSERT_EQ(count[i], cd);
-        ASSERT_EQ(mean[i], static_cast<double>(sum[i]) / cd) << "box " << i << " of " << n;
-        ASSERT_EQ(variance[i], numerator > 0 ? static_cast<double>(numerator) / (cd * cd) : 0.0)
-          << "box " << i << " of " << n << ", count " << c;
+        std::vector<std::int64_t> sum(n), sumSquares(n), countX(n);
+        for (std::int64_t i = 0; i < n; ++i)
+        {
+          countX[i] = 1 + static_cast<std::int64_t>(rng() % 21);
+          const std::int64_t count = countX[i] * countYZ;
+          const std::int64_t magnitude = rng() % 3 == 0 ? 32768 : 3000; // the int16 range, or a CT's
+          // Values of the box: a few distinct ones stand for all (only the sums matter).
+          const std::int64_t a = static_cast<std::int64_t>(rng() % (2 * magnitude)) - magnitude;
+          const std::int64_t b = static_cast<std::int64_t>(rng() % (2 * magnitude)) - magnitude;
+          const std::int64_t ofA = static_cast<std::int64_t>(rng() % (count + 1));
+          sum[i] = a * ofA + b * (count - ofA);
+          sumSquares[i] = a * a * ofA + b * b * (count - ofA);
+        }
+        std::vector<double> count(n), mean(n), variance(n);
+        vao::detail::meanVarianceRowExact(sum.data(), sumSquares.data(), countX.data(), countYZ, n, count.data(),
+          mean.data(), variance.data());
+        for (std::int64_t i = 0; i < n; ++i)
+        {
+          const std::int64_t c = countX[i] * countYZ;
+          const __int128 numerator = static_cast<__int128>(c) * sumSquares[i] - static_cast<__int128>(sum[i]) * sum[i];
+          const double cd = static_cast<double>(c);
+          ASSERT_EQ(count[i], cd);
+          ASSERT_EQ(mean[i], static_cast<double>(sum[i]) / cd) << "box " << i << " of " << n;
+          ASSERT_EQ(variance[i], numerator > 0 ? static_cast<double>(numerator) / (cd * cd) : 0.0)
+            << "box " << i << " of " << n << ", count " << c;
+        }
       }
     }
-  }
+  });
 }

@@ -8,7 +8,7 @@
 // (CellBounds) shows cannot raise a lane's occlusion, which changes no maximum.
 #pragma once
 
-#include "EstimatorsAvx2.h"
+#include "EstimatorLanes.h"
 #include "LevelGrid.h"
 
 #include <cmath>
@@ -161,7 +161,7 @@ VAO_AVX2_HELPER __m256d chebyshevCellsAvx2(const LevelGrid& g, const CellsAvx2& 
     variance = g.pairedRows ? blendPairsAvx2(g.variance, c.base, c.step, c.f) : blendAvx2(g.variance, c.base, c.step, c.f);
   }
   variance = _mm256_max_pd(variance, _mm256_setzero_pd());
-  return _mm256_sub_pd(_mm256_set1_pd(1.0), chebyshevOpennessAvx2(q, mean, variance,
+  return _mm256_sub_pd(_mm256_set1_pd(1.0), avx2::chebyshevOpenness(q, mean, variance,
     _mm256_set1_pd(g.roundingVariance), _mm256_set1_pd(g.roundingSpread)));
 }
 

@@ -1,0 +1,137 @@
+// Vectors of doubles on AVX2 (four lanes, namespace avx2) and AVX-512 (eight, namespace
+// avx512) behind one set of names, so that the estimators' lane formulas
+// (EstimatorLanes-inl.h) are written once and compiled for both: every operation is the
+// same IEEE operation per lane in both, so both tiers give the same bits but for the
+// vector erf and pow, which glibc's libmvec implements per width (within a few ulps).
+//
+// Why a re-included formula file and not a template over these two sets: GCC inlines a
+// target-specific intrinsic only into a function of that target, and a template cannot
+// take its target from its parameter.
+#pragma once
+
+#include "CpuDispatch.h"
+
+#if VAO_HAVE_AVX2_TARGET && defined(VAO_HAVE_LIBMVEC)
+#define VAO_VECTOR_MATH 1 // glibc's vector erf and pow (libmvec)
+#else
+#define VAO_VECTOR_MATH 0
+#endif
+
+#if VAO_HAVE_AVX2_TARGET
+#include <immintrin.h>
+
+#include <cstdint>
+
+#if VAO_VECTOR_MATH
+// Their x86-64 vector function ABI names.
+extern "C" __attribute__((target("avx2"))) __m256d _ZGVdN4v_erf(__m256d);
+extern "C" __attribute__((target("avx2"))) __m256d _ZGVdN4vv_pow(__m256d, __m256d);
+extern "C" __attribute__((target("avx512f"))) __m512d _ZGVeN8v_erf(__m512d);
+extern "C" __attribute__((target("avx512f"))) __m512d _ZGVeN8vv_pow(__m512d, __m512d);
+#endif
+
+#define VAO_AVX512_HELPER                                                                                    \
+  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"), always_inline)) inline
+#define VAO_AVX512_INLINE __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"))) inline
+
+namespace vao
+{
+namespace detail
+{
+namespace avx2
+{
+using D = __m256d;
+using I = __m256i;  // 64-bit integers
+using Mask = __m256d; // all bits set in the lanes where true
+constexpr int kWidth = 4;
+#define VAO_LANES VAO_AVX2_HELPER
+
+VAO_LANES D set1(double x) { return _mm256_set1_pd(x); }
+VAO_LANES D zero() { return _mm256_setzero_pd(); }
+VAO_LANES D load(const double* p) { return _mm256_loadu_pd(p); }
+VAO_LANES I loadIntegers(const std::int64_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
+VAO_LANES void store(double* p, D x) { _mm256_storeu_pd(p, x); }
+VAO_LANES void storeFloats(float* p, D x) { _mm_storeu_ps(p, _mm256_cvtpd_ps(x)); }
+VAO_LANES D add(D a, D b) { return _mm256_add_pd(a, b); }
+VAO_LANES D sub(D a, D b) { return _mm256_sub_pd(a, b); }
+VAO_LANES D mul(D a, D b) { return _mm256_mul_pd(a, b); }
+VAO_LANES D div(D a, D b) { return _mm256_div_pd(a, b); }
+VAO_LANES D sqrt(D a) { return _mm256_sqrt_pd(a); }
+VAO_LANES D min(D a, D b) { return _mm256_min_pd(a, b); }
+VAO_LANES D max(D a, D b) { return _mm256_max_pd(a, b); }
+VAO_LANES D abs(D a) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), a); }
+VAO_LANES Mask lessThan(D a, D b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
+VAO_LANES Mask lessEqual(D a, D b) { return _mm256_cmp_pd(a, b, _CMP_LE_OQ); }
+VAO_LANES Mask greaterThan(D a, D b) { return _mm256_cmp_pd(a, b, _CMP_GT_OQ); }
+VAO_LANES Mask greaterEqual(D a, D b) { return _mm256_cmp_pd(a, b, _CMP_GE_OQ); }
+VAO_LANES Mask either(Mask a, Mask b) { return _mm256_or_pd(a, b); }
+VAO_LANES Mask both(Mask a, Mask b) { return _mm256_and_pd(a, b); }
+VAO_LANES bool all(Mask m) { return _mm256_movemask_pd(m) == 0xF; }
+VAO_LANES bool none(Mask m) { return _mm256_movemask_pd(m) == 0; }
+/// yes where m, else no.
+VAO_LANES D select(Mask m, D yes, D no) { return _mm256_blendv_pd(no, yes, m); }
+/// x where m, else 0.
+VAO_LANES D onlyWhere(Mask m, D x) { return _mm256_and_pd(m, x); }
+/// a < b, 64-bit signed.
+VAO_LANES Mask lessThan(I a, I b) { return _mm256_castsi256_pd(_mm256_cmpgt_epi64(b, a)); }
+VAO_LANES I set1(std::int64_t x) { return _mm256_set1_epi64x(x); }
+/// Integers of magnitude below 2^51 to doubles (exact): added to the bits of 1.5 * 2^52,
+/// they are its mantissa.
+VAO_LANES D smallIntegersToDouble(I x)
+{
+  const __m256d magic = _mm256_set1_pd(6755399441055744.0);
+  return _mm256_sub_pd(_mm256_castsi256_pd(_mm256_add_epi64(x, _mm256_castpd_si256(magic))), magic);
+}
+#if VAO_VECTOR_MATH
+VAO_LANES D erf(D x) { return _ZGVdN4v_erf(x); }
+VAO_LANES D pow(D x, D y) { return _ZGVdN4vv_pow(x, y); }
+#endif
+#undef VAO_LANES
+} // namespace avx2
+
+namespace avx512
+{
+using D = __m512d;
+using I = __m512i;
+using Mask = __mmask8;
+constexpr int kWidth = 8;
+#define VAO_LANES VAO_AVX512_HELPER
+
+VAO_LANES D set1(double x) { return _mm512_set1_pd(x); }
+VAO_LANES D zero() { return _mm512_setzero_pd(); }
+VAO_LANES D load(const double* p) { return _mm512_loadu_pd(p); }
+VAO_LANES I loadIntegers(const std::int64_t* p) { return _mm512_loadu_si512(p); }
+VAO_LANES void store(double* p, D x) { _mm512_storeu_pd(p, x); }
+VAO_LANES void storeFloats(float* p, D x) { _mm256_storeu_ps(p, _mm512_cvtpd_ps(x)); }
+VAO_LANES D add(D a, D b) { return _mm512_add_pd(a, b); }
+VAO_LANES D sub(D a, D b) { return _mm512_sub_pd(a, b); }
+VAO_LANES D mul(D a, D b) { return _mm512_mul_pd(a, b); }
+VAO_LANES D div(D a, D b) { return _mm512_div_pd(a, b); }
+VAO_LANES D sqrt(D a) { return _mm512_sqrt_pd(a); }
+VAO_LANES D min(D a, D b) { return _mm512_min_pd(a, b); }
+VAO_LANES D max(D a, D b) { return _mm512_max_pd(a, b); }
+VAO_LANES D abs(D a) { return _mm512_abs_pd(a); }
+VAO_LANES Mask lessThan(D a, D b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
+VAO_LANES Mask lessEqual(D a, D b) { return _mm512_cmp_pd_mask(a, b, _CMP_LE_OQ); }
+VAO_LANES Mask greaterThan(D a, D b) { return _mm512_cmp_pd_mask(a, b, _CMP_GT_OQ); }
+VAO_LANES Mask greaterEqual(D a, D b) { return _mm512_cmp_pd_mask(a, b, _CMP_GE_OQ); }
+VAO_LANES Mask either(Mask a, Mask b) { return static_cast<Mask>(a | b); }
+VAO_LANES Mask both(Mask a, Mask b) { return static_cast<Mask>(a & b); }
+VAO_LANES bool all(Mask m) { return m == 0xFF; }
+VAO_LANES bool none(Mask m) { return m == 0; }
+VAO_LANES D select(Mask m, D yes, D no) { return _mm512_mask_blend_pd(m, no, yes); }
+VAO_LANES D onlyWhere(Mask m, D x) { return _mm512_maskz_mov_pd(m, x); }
+VAO_LANES Mask lessThan(I a, I b) { return _mm512_cmplt_epi64_mask(a, b); }
+VAO_LANES I set1(std::int64_t x) { return _mm512_set1_epi64(x); }
+/// Exact below 2^53 (AVX-512 DQ converts 64-bit integers directly).
+VAO_LANES D smallIntegersToDouble(I x) { return _mm512_cvtepi64_pd(x); }
+#if VAO_VECTOR_MATH
+VAO_LANES D erf(D x) { return _ZGVeN8v_erf(x); }
+VAO_LANES D pow(D x, D y) { return _ZGVeN8vv_pow(x, y); }
+#endif
+#undef VAO_LANES
+} // namespace avx512
+
+} // namespace detail
+} // namespace vao
+#endif

@@ -1,0 +1,143 @@
+// The estimators of Estimators.h on a vector of doubles (DoubleLanes.h), written once and
+// included by EstimatorLanes.h into the avx2 and the avx512 namespace, whose D, Mask and
+// operations it uses, with VAO_LANES the namespace's inline target. Both branches of a
+// formula are formed and one is kept by a mask. Files that use these are compiled without
+// fused multiply-adds (-ffp-contract=off), so each lane rounds as the scalar formula does.
+// No include guard: included once per namespace.
+
+/// isFlatVariance: true in the lanes whose box is flat.
+VAO_LANES Mask flatMask(D mean, D variance, D roundingVariance)
+{
+  const D scale = max(mul(mean, mean), set1(1.0));
+  const D limit = max(roundingVariance, mul(set1(kFlatEpsilon), scale));
+  return lessEqual(variance, limit);
+}
+
+/// flatOpennessWithin: 1 where q >= mean - max(roundingSpread, kFlatSpread max(1, |mean|)).
+VAO_LANES D flatOpenness(D q, D mean, D roundingSpread)
+{
+  const D magnitude = max(abs(mean), set1(1.0));
+  const D spread = max(roundingSpread, mul(set1(kFlatSpread), magnitude));
+  return onlyWhere(greaterEqual(q, sub(mean, spread)), set1(1.0));
+}
+
+/// opennessChebyshevWithin (the bound's 0/0 on a flat box is not kept).
+VAO_LANES D chebyshevOpenness(D q, D mean, D variance, D roundingVariance, D roundingSpread)
+{
+  const D one = set1(1.0);
+  const D d = sub(q, mean);
+  const D share = div(variance, add(variance, mul(d, d)));
+  const D bound = onlyWhere(greaterThan(d, zero()), min(max(sub(one, share), zero()), one));
+  return select(flatMask(mean, variance, roundingVariance), flatOpenness(q, mean, roundingSpread), bound);
+}
+
+#if VAO_VECTOR_MATH
+/// opennessGaussianCdf with the exact erf. Flat lanes take a variance of 1 into the erf
+/// (their 0 would give it infinities or NaN, and libmvec a slow path) and their flat
+/// answer after it.
+VAO_LANES D gaussianCdf(D q, D mean, D variance, D roundingVariance, D roundingSpread)
+{
+  const D one = set1(1.0);
+  const Mask flat = flatMask(mean, variance, roundingVariance);
+  const D z = div(sub(q, mean), sqrt(mul(set1(2.0), select(flat, one, variance))));
+  // Beyond |z| = 6 erf is +-1 in doubles (1 - erf(6) ~ 2e-17 is under half an ulp of 1), so
+  // the openness is 1 or 0: groups of only such lanes and flat ones skip the erf (most of a
+  // volume with smooth regions).
+  const Mask saturated = greaterThan(abs(z), set1(6.0));
+  D open;
+  if (all(either(saturated, flat)))
+    open = onlyWhere(greaterThan(z, zero()), one);
+  else
+    open = min(max(mul(set1(0.5), add(one, erf(z))), zero()), one);
+  return select(flat, flatOpenness(q, mean, roundingSpread), open);
+}
+
+/// opennessCdfReconstruction: t^beta, its cases (flat box, t at or past either end, the
+/// mean at the maximum) by masks in the scalar form's order of precedence. The lanes of
+/// those cases take t = 1/2 and beta = 1 into the pow; groups of only such lanes skip it.
+VAO_LANES D cdfReconstruction(D q, D mean, D minimum, D maximum)
+{
+  const D one = set1(1.0);
+  const Mask flat = lessEqual(maximum, minimum);
+  const D flatOpen = onlyWhere(greaterEqual(q, minimum), one);
+  const D t = div(sub(q, minimum), select(flat, one, sub(maximum, minimum)));
+  const Mask atTop = greaterEqual(t, one);
+  const Mask atBottom = lessEqual(t, zero());
+  const D m = min(max(mean, minimum), maximum);
+  const Mask meanAtMaximum = greaterEqual(m, maximum);
+  const Mask decided = either(either(flat, atTop), either(atBottom, meanAtMaximum));
+  // Every decided lane but t >= 1 (and a flat box's, which comes last) is 0.
+  D open = onlyWhere(atTop, one);
+  if (!all(decided))
+  {
+    const D beta = div(sub(m, minimum), select(decided, one, sub(maximum, m)));
+    const D power = pow(select(decided, set1(0.5), t), select(decided, one, beta));
+    open = select(decided, open, power);
+  }
+  return select(flat, flatOpen, open);
+}
+#endif
+
+/// The openness of a row of neighbourhoods (EstimatorRows.h's NeighbourhoodRow) by method
+/// M (opennessRowIsVector says which), kWidth voxels at a time; `plain(begin)` does the
+/// voxels from `begin` on (the row's tail).
+template <Method M, class Row, class Plain>
+VAO_LANES_ENTRY void opennessRowLanes(const Row& row, const double* query, double isoValue, float* openness,
+  Plain&& plain)
+{
+  const D roundingVariance = set1(row.roundingVariance);
+  const D roundingSpread = set1(flatRoundingSpread(row.roundingVariance));
+  std::int64_t i = 0;
+  for (; i + kWidth <= row.size; i += kWidth)
+  {
+    const D q = query ? load(query + i) : set1(isoValue);
+    const D mean = load(row.mean + i);
+    D open = zero();
+    if constexpr (M == Method::Chebyshev)
+      open = chebyshevOpenness(q, mean, load(row.variance + i), roundingVariance, roundingSpread);
+#if VAO_VECTOR_MATH
+    else if constexpr (M == Method::CdfReconstruction)
+      open = cdfReconstruction(q, mean, load(row.minimum + i), load(row.maximum + i));
+    else
+      open = gaussianCdf(q, mean, load(row.variance + i), roundingVariance, roundingSpread);
+#endif
+    storeFloats(openness + i, open);
+  }
+  plain(i);
+}
+
+/// meanVarianceRowExact (MomentRows.h), kWidth boxes at a time: count * sumSquares - sum^2
+/// in doubles, exact while both products stay below 2^52; `plain(end, begin)` does the
+/// boxes of [begin, end) that could leave that range, and the row's tail.
+template <class Plain>
+VAO_LANES_ENTRY void meanVarianceRowLanes(const std::int64_t* sum, const std::int64_t* sumSquares,
+  const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, double* count, double* mean, double* variance,
+  Plain&& plain)
+{
+  const I limit = set1(std::int64_t(1) << 50);
+  const I negativeLimit = set1(-(std::int64_t(1) << 50));
+  const D exact = set1(4503599627370496.0); // 2^52
+  const D yz = set1(static_cast<double>(countYZ));
+  for (std::int64_t i = 0; i + kWidth <= n; i += kWidth)
+  {
+    const I s = loadIntegers(sum + i);
+    const I s2 = loadIntegers(sumSquares + i);
+    if (all(both(both(lessThan(s, limit), lessThan(negativeLimit, s)), lessThan(s2, limit))))
+    {
+      const D c = mul(smallIntegersToDouble(loadIntegers(countX + i)), yz);
+      const D sd = smallIntegersToDouble(s);
+      const D a = mul(c, smallIntegersToDouble(s2));
+      const D b = mul(sd, sd);
+      if (none(either(greaterEqual(a, exact), greaterEqual(b, exact))))
+      {
+        const D numerator = sub(a, b);
+        store(count + i, c);
+        store(mean + i, div(sd, c));
+        store(variance + i, onlyWhere(greaterThan(numerator, zero()), div(numerator, mul(c, c))));
+        continue;
+      }
+    }
+    plain(i + kWidth, i);
+  }
+  plain(n, n - n % kWidth);
+}
