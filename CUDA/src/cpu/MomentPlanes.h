@@ -256,7 +256,7 @@ private:
   std::vector<Acc> XBox1, XBox2;
   std::vector<Acc> Run1, Run2;
   std::vector<Acc> Zeros; // a row outside the volume
-  SimdTier Simd = cpuSimdTierUpTo(SimdTier::Avx2); // AVX-512: no faster (integer sums)
+  SimdTier Simd = cpuSimdTier();
 };
 
 /// Per-slice view handed to the consumer of the moments: everything needed to turn the
