@@ -178,6 +178,83 @@ TEST(EstimatorRows, VectorAndPlainFormsAgree)
   });
 }
 
+// Chebyshev and the Gaussian CDF straight from exact integer sums (opennessFromExactSums,
+// on the row's lanes and on the plain loop) against the reference formulas given the mean
+// and variance of the same boxes: boxes of two int16 values, flat ones among them, sums
+// the lanes take in doubles and sums too large for that, mixed within a row; queries at
+// either value, between, just outside, and one iso value.
+TEST(EstimatorRows, ExactSumsAgainstTheReference)
+{
+  onEveryTier([] {
+    std::mt19937_64 rng(20261203);
+    std::size_t compared = 0, offByOneUlp = 0;
+    for (const vao::Method method : { vao::Method::Chebyshev, vao::Method::GaussianCdf })
+    {
+      for (std::int64_t n = 0; n <= 37; ++n)
+      {
+        for (const std::int64_t countYZ : { std::int64_t(1), std::int64_t(441) })
+        {
+          std::vector<std::int64_t> sum(n), sumSquares(n), countX(n);
+          std::vector<double> query(n);
+          std::vector<vaotest::reference::Statistics> stats(n);
+          for (std::int64_t i = 0; i < n; ++i)
+          {
+            countX[i] = 1 + static_cast<std::int64_t>(rng() % 21);
+            const std::int64_t c = countX[i] * countYZ;
+            const std::int64_t magnitude = rng() % 3 == 0 ? 32768 : 3000;
+            const std::int64_t a = static_cast<std::int64_t>(rng() % (2 * magnitude)) - magnitude;
+            const std::int64_t b = static_cast<std::int64_t>(rng() % (2 * magnitude)) - magnitude;
+            const std::int64_t choice = static_cast<std::int64_t>(rng() % 6);
+            const std::int64_t ofA = choice == 0 ? c : (choice == 1 ? 0 : static_cast<std::int64_t>(rng() % (c + 1)));
+            sum[i] = a * ofA + b * (c - ofA);
+            sumSquares[i] = a * a * ofA + b * b * (c - ofA);
+            const std::int64_t queries[] = { a, b, (a + b) / 2, a - 1, b + 1 };
+            query[i] = static_cast<double>(queries[rng() % 5]);
+            const __int128 numerator = static_cast<__int128>(c) * sumSquares[i] - static_cast<__int128>(sum[i]) * sum[i];
+            const double cd = static_cast<double>(c);
+            const double lowest = static_cast<double>(ofA == 0 ? b : (ofA == c ? a : std::min(a, b)));
+            const double highest = static_cast<double>(ofA == 0 ? b : (ofA == c ? a : std::max(a, b)));
+            stats[i] = { static_cast<double>(sum[i]) / cd, numerator > 0 ? static_cast<double>(numerator) / (cd * cd) : 0.0,
+              lowest, highest };
+          }
+          vao::detail::NeighbourhoodRow row;
+          row.size = n;
+          row.sum = sum.data();
+          row.sumSquares = sumSquares.data();
+          row.countX = countX.data();
+          row.countYZ = countYZ;
+          const double iso = 750.5;
+          for (const bool perVoxel : { true, false })
+          {
+            std::vector<float> out(n, -1.0f);
+            vao::detail::opennessRow(method, vao::ErfMode::Exact, row, perVoxel ? query.data() : nullptr, iso, out.data());
+            for (std::int64_t i = 0; i < n; ++i)
+            {
+              const double q = perVoxel ? query[i] : iso;
+              const double reference = method == vao::Method::Chebyshev ? vaotest::reference::chebyshev(q, stats[i])
+                                                                        : vaotest::reference::gaussianCdf(q, stats[i], false);
+              const float expected = static_cast<float>(reference);
+              ++compared;
+              if (out[i] == expected)
+                continue;
+              // The sums' form rounds differently from the mean and variance's (a double
+              // ulp or two), and the vector erf is within a few ulps of the scalar one.
+              const double tolerance = std::fmax(std::fabs(std::nextafter(expected, out[i]) - expected), 8 * kHalfUlpOfOne);
+              ASSERT_LE(std::fabs(double(out[i]) - expected), tolerance)
+                << "box " << i << " of " << n << ", q " << q << ", mean " << stats[i].mean << ", variance "
+                << stats[i].variance;
+              offByOneUlp += expected > kTail;
+            }
+          }
+        }
+      }
+    }
+    std::printf("%zu opennesses from exact sums compared, %zu above the tail a rounding away from the reference\n",
+      compared, offByOneUlp);
+    EXPECT_LE(offByOneUlp * 1000, compared);
+  });
+}
+
 // The mean and variance of rows of boxes from exact sums: against the definition (double of
 // the exact integer numerator count * sum(v^2) - sum(v)^2, over count^2), bit for bit, for
 // sums that the vector form takes in doubles and sums too large for that (the int16 range

@@ -251,16 +251,13 @@ VAO_HD double opennessFromStats(
   }
 }
 
-/// Mean and variance of a box of `count` voxels from exact integer sums of v and v^2.
-/// The numerator count * sumSquares - sum^2 is exact (in 64 bits when it fits, as it does
-/// for 16-bit data in boxes of up to 65536 voxels, else in 128), and its conversion to
-/// double is correctly rounded either way, so the variance does not depend on how the sums
-/// were formed: a distributed or streamed run gives the serial bits.
-VAO_HD void meanVarianceFromExactSums(
-  long long sum, long long sumSquares, long long count, double& mean, double& variance)
+/// count * sumSquares - sum^2 of a box's exact integer sums of v and v^2 (count^2 times
+/// its variance; 0 where not positive), computed exactly (in 64 bits when it fits, as it
+/// does for 16-bit data in boxes of up to 65536 voxels, else in 128) and rounded to double
+/// once, so it does not depend on how the sums were formed: a distributed or streamed run
+/// gives the serial bits.
+VAO_HD double exactSumsNumerator(long long sum, long long sumSquares, long long count)
 {
-  const double n = static_cast<double>(count);
-  mean = static_cast<double>(sum) / n;
   long long a = 0, b = 0;
 #if defined(__CUDA_ARCH__)
   const bool fits = false;
@@ -271,11 +268,49 @@ VAO_HD void meanVarianceFromExactSums(
   {
     // a - b >= 0 up to rounding-free integer arithmetic (Cauchy-Schwarz), so no overflow.
     const long long numerator = a - b;
-    variance = numerator > 0 ? static_cast<double>(numerator) / (n * n) : 0.0;
-    return;
+    return numerator > 0 ? static_cast<double>(numerator) : 0.0;
   }
   const __int128 numerator = static_cast<__int128>(count) * sumSquares - static_cast<__int128>(sum) * sum;
-  variance = numerator > 0 ? static_cast<double>(numerator) / (n * n) : 0.0;
+  return numerator > 0 ? static_cast<double>(numerator) : 0.0;
+}
+
+/// Mean and variance of a box of `count` voxels from exact integer sums of v and v^2: the
+/// variance is exactSumsNumerator / count^2.
+VAO_HD void meanVarianceFromExactSums(
+  long long sum, long long sumSquares, long long count, double& mean, double& variance)
+{
+  const double n = static_cast<double>(count);
+  mean = static_cast<double>(sum) / n;
+  variance = exactSumsNumerator(sum, sumSquares, count) / (n * n);
+}
+
+/// Chebyshev's bound and the Gaussian CDF (opennessFromStats) from a box's exact integer
+/// sums (which have no shift and no rounding variance) without dividing out the mean and
+/// the variance: with c the count, S the sum, N = exactSumsNumerator (c^2 times the
+/// variance) and D = q c - S (c times q - mean), the box is flat where
+/// N <= kFlatEpsilon max(c^2, S^2), open then where D >= -kFlatSpread max(c, |S|); else
+/// Chebyshev is 1 - N / (N + D^2) where D > 0 (0 elsewhere) and the Gaussian CDF
+/// (1 + erf(D / sqrt(2 N))) / 2. These are the formulas above multiplied through by c or
+/// c^2: they differ from them by rounding alone (an ulp or two of a double), and cost one
+/// division instead of three.
+VAO_HD double opennessFromExactSums(
+  Method method, double query, double count, double sum, double numerator, ErfMode erfMode)
+{
+  const double d = query * count - sum;
+  const double magnitude = sum < 0.0 ? -sum : sum;
+  const double scale = count * count > sum * sum ? count * count : sum * sum;
+  if (numerator <= kFlatEpsilon * scale)
+  {
+    return d >= -(kFlatSpread * (count > magnitude ? count : magnitude)) ? 1.0 : 0.0;
+  }
+  if (method == Method::Chebyshev)
+  {
+    const double occluderShare = numerator / (numerator + d * d);
+    return d > 0.0 ? clamp01(1.0 - occluderShare) : 0.0;
+  }
+  const double z = d / sqrt(2.0 * numerator);
+  const double e = erfMode == ErfMode::Winitzki ? erfWinitzki(z) : erf(z);
+  return clamp01(0.5 * (1.0 + e));
 }
 
 /// Mean and variance from double sums of (v - shift) and (v - shift)^2: the shift keeps

@@ -40,7 +40,10 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   const bool withExtrema = output.openness && p.method == Method::CdfReconstruction;
   const bool voxelQuery = p.queryMode == QueryMode::VoxelValue;
   const detail::MomentScale scale = detail::momentScale(volume, scan.minimum, scan.maximum);
-  const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, withExtrema, execution,
+  // Chebyshev and the Gaussian CDF take exact sums as they are (opennessRow).
+  const bool fromSums = p.method == Method::Chebyshev || p.method == Method::GaussianCdf;
+  const detail::RowContents contents{ withExtrema, output.variance != nullptr || !output.openness || !fromSums };
+  const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, contents, execution,
     [&](const detail::NeighbourhoodRow& row) {
       if (output.variance)
       {

@@ -138,6 +138,12 @@ struct NeighbourhoodRow
   const double* minimum = nullptr;  // null unless the extrema were asked for
   const double* maximum = nullptr;
   double roundingVariance = 0.0;    // as NeighbourhoodStats::roundingVariance
+  // The boxes' exact integer sums (null for double sums), which Chebyshev and the Gaussian
+  // CDF take directly (opennessFromExactSums): box i holds countX[i] * countYZ voxels.
+  const std::int64_t* sum = nullptr;
+  const std::int64_t* sumSquares = nullptr;
+  const std::int64_t* countX = nullptr;
+  std::int64_t countYZ = 0;
 
   NeighbourhoodStats stats(std::int64_t i) const
   {
@@ -146,12 +152,23 @@ struct NeighbourhoodRow
   }
 };
 
+/// What forEachNeighbourhoodRow hands over besides the sums: the box extrema (computed in
+/// passes of their own), and the means and variances, which exact integer sums can skip
+/// for consumers that take the sums (NeighbourhoodRow::sum).
+struct RowContents
+{
+  bool extrema = false;
+  bool moments = true;
+};
+
 /// forEachNeighbourhoodRow on one band (band.region, a slab of rows of `whole`): voxel
 /// indices are those of the whole region.
 template <class T, class Visit>
 bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Region& whole,
-  const MomentScale& scale, bool withExtrema, const Execution& execution, Visit&& visit)
+  const MomentScale& scale, RowContents contents, const Execution& execution, Visit&& visit)
 {
+  const bool withExtrema = contents.extrema;
+  [[maybe_unused]] const bool withMoments = contents.moments; // double sums always give them
   const Region& region = band.region;
   BoxExtrema<T> extrema;
   const double split = withExtrema ? 0.5 : 0.0;
@@ -192,8 +209,13 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
           value[i] = static_cast<double>(row[i * volume.stride]);
         if constexpr (MomentTraits<T>::exactInteger)
         {
-          meanVarianceRowExact(slice.sum + j * nx, slice.sumSquares + j * nx, countX.data(), countYZ, nx,
-            count.data(), mean.data(), variance.data());
+          out.sum = slice.sum + j * nx;
+          out.sumSquares = slice.sumSquares + j * nx;
+          out.countX = countX.data();
+          out.countYZ = countYZ;
+          if (withMoments)
+            meanVarianceRowExact(slice.sum + j * nx, slice.sumSquares + j * nx, countX.data(), countYZ, nx,
+              count.data(), mean.data(), variance.data());
         }
         else
         {
@@ -235,8 +257,9 @@ inline std::int64_t extremaBandRows(const BoxGeometry& geometry)
 /// each band's extrema first, then its moments. Returns false when cancelled.
 template <class T, class Visit>
 bool forEachNeighbourhoodRow(const TypedVolume<T>& volume, const BoxGeometry& geometry,
-  const MomentScale& scale, bool withExtrema, const Execution& execution, Visit&& visit)
+  const MomentScale& scale, RowContents contents, const Execution& execution, Visit&& visit)
 {
+  const bool withExtrema = contents.extrema;
   const Region& region = geometry.region;
   const std::int64_t ny = region.size[1];
   const std::int64_t bandRows = withExtrema ? std::min(ny, extremaBandRows(geometry)) : ny;
@@ -247,7 +270,7 @@ bool forEachNeighbourhoodRow(const TypedVolume<T>& volume, const BoxGeometry& ge
     band.begin[1] = region.begin[1] + b * bandRows;
     band.size[1] = std::min(bandRows, ny - b * bandRows);
     const Execution stage = stageExecution(execution, double(b) / bands, double(b + 1) / bands);
-    if (!visitBand(volume, BoxGeometry(geometry.dims, band, geometry.radius), region, scale, withExtrema, stage, visit))
+    if (!visitBand(volume, BoxGeometry(geometry.dims, band, geometry.radius), region, scale, contents, stage, visit))
     {
       return false;
     }

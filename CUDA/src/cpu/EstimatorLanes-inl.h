@@ -106,6 +106,27 @@ VAO_LANES_ENTRY void opennessRowLanes(const Row& row, const double* query, doubl
   plain(i);
 }
 
+/// The kWidth boxes from box i in doubles: their counts c (countX times yz), sums S, S^2
+/// and numerators c sumSquares - S^2 (exactSumsNumerator before its clamp at 0), when all
+/// are exact (sums of magnitude below 2^50, both products below 2^52); false otherwise.
+VAO_LANES bool exactBoxes(const std::int64_t* sum, const std::int64_t* sumSquares, const std::int64_t* countX, D yz,
+  std::int64_t i, D& c, D& total, D& totalSquared, D& numerator)
+{
+  const I limit = set1(std::int64_t(1) << 50);
+  const I negativeLimit = set1(-(std::int64_t(1) << 50));
+  const D exact = set1(4503599627370496.0); // 2^52
+  const I s = loadIntegers(sum + i);
+  const I s2 = loadIntegers(sumSquares + i);
+  if (!all(both(both(lessThan(s, limit), lessThan(negativeLimit, s)), lessThan(s2, limit))))
+    return false;
+  c = mul(smallIntegersToDouble(loadIntegers(countX + i)), yz);
+  total = smallIntegersToDouble(s);
+  const D a = mul(c, smallIntegersToDouble(s2));
+  totalSquared = mul(total, total);
+  numerator = sub(a, totalSquared);
+  return none(either(greaterEqual(a, exact), greaterEqual(totalSquared, exact)));
+}
+
 /// meanVarianceRowExact (MomentRows.h), kWidth boxes at a time: count * sumSquares - sum^2
 /// in doubles, exact while both products stay below 2^52; `plain(end, begin)` does the
 /// boxes of [begin, end) that could leave that range, and the row's tail.
@@ -114,28 +135,63 @@ VAO_LANES_ENTRY void meanVarianceRowLanes(const std::int64_t* sum, const std::in
   const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, double* count, double* mean, double* variance,
   Plain&& plain)
 {
-  const I limit = set1(std::int64_t(1) << 50);
-  const I negativeLimit = set1(-(std::int64_t(1) << 50));
-  const D exact = set1(4503599627370496.0); // 2^52
   const D yz = set1(static_cast<double>(countYZ));
   for (std::int64_t i = 0; i + kWidth <= n; i += kWidth)
   {
-    const I s = loadIntegers(sum + i);
-    const I s2 = loadIntegers(sumSquares + i);
-    if (all(both(both(lessThan(s, limit), lessThan(negativeLimit, s)), lessThan(s2, limit))))
+    D c, total, totalSquared, numerator;
+    if (exactBoxes(sum, sumSquares, countX, yz, i, c, total, totalSquared, numerator))
     {
-      const D c = mul(smallIntegersToDouble(loadIntegers(countX + i)), yz);
-      const D sd = smallIntegersToDouble(s);
-      const D a = mul(c, smallIntegersToDouble(s2));
-      const D b = mul(sd, sd);
-      if (none(either(greaterEqual(a, exact), greaterEqual(b, exact))))
+      store(count + i, c);
+      store(mean + i, div(total, c));
+      store(variance + i, onlyWhere(greaterThan(numerator, zero()), div(numerator, mul(c, c))));
+      continue;
+    }
+    plain(i + kWidth, i);
+  }
+  plain(n, n - n % kWidth);
+}
+
+/// opennessFromExactSums (Chebyshev or the Gaussian CDF, by M) of n boxes from their exact
+/// sums, kWidth at a time, with q_i = query[i] (isoValue where query is null): c, S and N
+/// in doubles, exact while c sumSquares and S^2 stay below 2^52 (as meanVarianceRowLanes);
+/// `plain(end, begin)` does the boxes of [begin, end) that could leave that range, and the
+/// row's tail.
+template <Method M, class Plain>
+VAO_LANES_ENTRY void opennessFromExactSumsLanes(const std::int64_t* sum, const std::int64_t* sumSquares,
+  const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, const double* query, double isoValue,
+  float* openness, Plain&& plain)
+{
+  const D yz = set1(static_cast<double>(countYZ));
+  const D one = set1(1.0);
+  for (std::int64_t i = 0; i + kWidth <= n; i += kWidth)
+  {
+    D c, total, totalSquared, numerator;
+    if (exactBoxes(sum, sumSquares, countX, yz, i, c, total, totalSquared, numerator))
+    {
+      const D positive = onlyWhere(greaterThan(numerator, zero()), numerator);
+      const D q = query ? load(query + i) : set1(isoValue);
+      const D d = sub(mul(q, c), total);
+      const Mask flat = lessEqual(positive, mul(set1(kFlatEpsilon), max(mul(c, c), totalSquared)));
+      const D flatOpen =
+        onlyWhere(greaterEqual(d, sub(zero(), mul(set1(kFlatSpread), max(c, abs(total))))), one);
+      D open = zero();
+      if constexpr (M == Method::Chebyshev)
       {
-        const D numerator = sub(a, b);
-        store(count + i, c);
-        store(mean + i, div(sd, c));
-        store(variance + i, onlyWhere(greaterThan(numerator, zero()), div(numerator, mul(c, c))));
-        continue;
+        const D share = div(positive, add(positive, mul(d, d)));
+        open = onlyWhere(greaterThan(d, zero()), min(max(sub(one, share), zero()), one));
       }
+#if VAO_VECTOR_MATH
+      else
+      {
+        const D z = div(d, sqrt(mul(set1(2.0), select(flat, one, positive))));
+        if (all(either(greaterThan(abs(z), set1(6.0)), flat))) // as gaussianCdf
+          open = onlyWhere(greaterThan(z, zero()), one);
+        else
+          open = min(max(mul(set1(0.5), add(one, erf(z))), zero()), one);
+      }
+#endif
+      storeFloats(openness + i, select(flat, flatOpen, open));
+      continue;
     }
     plain(i + kWidth, i);
   }

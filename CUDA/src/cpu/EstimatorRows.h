@@ -1,6 +1,6 @@
-// The separable estimators over a row of neighbourhoods: on AVX2 four voxels at a time
-// (Chebyshev; with glibc's vector erf and pow, the Gaussian CDF and CDF Reconstruction),
-// elsewhere voxel by voxel.
+// The separable estimators over a row of neighbourhoods: on AVX2 four voxels at a time,
+// on AVX-512 eight (Chebyshev; with glibc's vector erf and pow, the Gaussian CDF and CDF
+// Reconstruction), elsewhere voxel by voxel.
 #pragma once
 
 #include "BoxEngine.h"
@@ -11,7 +11,9 @@ namespace detail
 {
 
 /// openness[i] = opennessFromStats(method, q_i, row.stats(i), erfMode) as float, for the
-/// row's voxels, with q_i = query[i], or isoValue when query is null.
+/// row's voxels, with q_i = query[i], or isoValue when query is null; for Chebyshev and the
+/// Gaussian CDF on a row with exact sums (row.sum), opennessFromExactSums of them instead
+/// (the same formulas without the divisions: the mean and variance need not be formed).
 void opennessRow(Method method, ErfMode erfMode, const NeighbourhoodRow& row, const double* query,
   double isoValue, float* openness);
 
