@@ -182,7 +182,7 @@ TEST(EstimatorRows, VectorAndPlainFormsAgree)
 // on the row's lanes and on the plain loop) against the reference formulas given the mean
 // and variance of the same boxes: boxes of two int16 values, flat ones among them, sums
 // the lanes take in doubles and sums too large for that, mixed within a row; queries at
-// either value, between, just outside, and one iso value.
+// either value, between, just outside, an iso value and iso values far beyond the data.
 TEST(EstimatorRows, ExactSumsAgainstTheReference)
 {
   onEveryTier([] {
@@ -223,7 +223,7 @@ TEST(EstimatorRows, ExactSumsAgainstTheReference)
           row.sumSquares = sumSquares.data();
           row.countX = countX.data();
           row.countYZ = countYZ;
-          const double iso = 750.5;
+          for (const double iso : { 750.5, 1e300, -1e300 }) // iso values whose q c overflows too
           for (const bool perVoxel : { true, false })
           {
             std::vector<float> out(n, -1.0f);
