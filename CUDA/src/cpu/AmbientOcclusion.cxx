@@ -42,7 +42,8 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   const detail::MomentScale scale = detail::momentScale(volume, scan.minimum, scan.maximum);
   // Chebyshev and the Gaussian CDF take exact sums as they are (opennessRow).
   const bool fromSums = p.method == Method::Chebyshev || p.method == Method::GaussianCdf;
-  const detail::RowContents contents{ withExtrema, output.variance != nullptr || !output.openness || !fromSums };
+  const detail::RowContents contents{ withExtrema, output.variance != nullptr || !output.openness || !fromSums,
+    output.openness && voxelQuery && !query };
   const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, contents, execution,
     [&](const detail::NeighbourhoodRow& row) {
       if (output.variance)

@@ -153,12 +153,13 @@ struct NeighbourhoodRow
 };
 
 /// What forEachNeighbourhoodRow hands over besides the sums: the box extrema (computed in
-/// passes of their own), and the means and variances, which exact integer sums can skip
-/// for consumers that take the sums (NeighbourhoodRow::sum).
+/// passes of their own), the means and variances, which exact integer sums can skip for
+/// consumers that take the sums (NeighbourhoodRow::sum), and the voxels' own values.
 struct RowContents
 {
   bool extrema = false;
   bool moments = true;
+  bool values = true;
 };
 
 /// forEachNeighbourhoodRow on one band (band.region, a slab of rows of `whole`): voxel
@@ -205,8 +206,9 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
       {
         const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
         const std::int64_t countYZ = countY[j] * slice.countZ;
-        for (std::int64_t i = 0; i < nx; ++i)
-          value[i] = static_cast<double>(row[i * volume.stride]);
+        if (contents.values)
+          for (std::int64_t i = 0; i < nx; ++i)
+            value[i] = static_cast<double>(row[i * volume.stride]);
         if constexpr (MomentTraits<T>::exactInteger)
         {
           out.sum = slice.sum + j * nx;

@@ -24,7 +24,7 @@ Status computeBoxStatistics(const VolumeView& view, const Region& region, const 
     const detail::TypedVolume<decltype(tag)> volume(view);
     // Only the shift matters here: the statistics are written as they are.
     const detail::MomentScale scale{ detail::momentScale(volume, 0.0, 0.0).shift, 0.0 };
-    const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, detail::RowContents{ withExtrema, true }, execution,
+    const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, detail::RowContents{ withExtrema, true, false }, execution,
       [&](const detail::NeighbourhoodRow& row) {
         const auto put = [&](double* field, const double* values) {
           if (field)
