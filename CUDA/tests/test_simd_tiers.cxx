@@ -7,12 +7,14 @@
 #include "PyramidTestSupport.h"
 
 #include "cpu/CpuDispatch.h"
+#include "cpu/RunningTotals.h"
 
 #include "vao/HistogramCdf.h"
 
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <random>
 
 using namespace vaotest;
 using vao::detail::SimdTier;
@@ -202,4 +204,29 @@ TEST(SimdTiers, HistogramCdfOfEveryQueryCaseEqualsTheBaselineBitForBit)
   for (double iso : isoValues)
     expectOpennessTiersEqual(scan.view, vao::Method::HistogramCdf, t, vao::QueryMode::IsoValue, iso);
   expectOpennessTiersEqual(scan.view, vao::Method::HistogramCdf, t, vao::QueryMode::SmoothedValue);
+}
+
+// The box sums' running totals (RunningTotals.h) on every tier against the totals summed
+// one by one here: lengths around the 8-wide vector, values up to 2^40 of either sign.
+TEST(SimdTiers, RunningTotalsEqualTheSumsOneByOne)
+{
+  std::mt19937_64 rng(31);
+  for (const SimdTier tier : kTiers)
+  {
+    for (std::int64_t n = 0; n <= 41; ++n)
+    {
+      std::vector<std::int64_t> a(n), b(n), expectedA(n), expectedB(n);
+      std::int64_t totalA = 0, totalB = 0;
+      for (std::int64_t i = 0; i < n; ++i)
+      {
+        a[i] = static_cast<std::int64_t>(rng() % (std::uint64_t(1) << 41)) - (std::int64_t(1) << 40);
+        b[i] = static_cast<std::int64_t>(rng() % 1000);
+        expectedA[i] = totalA += a[i];
+        expectedB[i] = totalB += b[i];
+      }
+      vao::detail::runningTotals(a.data(), b.data(), n, tier);
+      ASSERT_EQ(a, expectedA) << "tier " << static_cast<int>(tier) << ", n " << n;
+      ASSERT_EQ(b, expectedB) << "tier " << static_cast<int>(tier) << ", n " << n;
+    }
+  }
 }

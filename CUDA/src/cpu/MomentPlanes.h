@@ -11,6 +11,7 @@
 
 #include "CpuDispatch.h"
 #include "Parallel.h"
+#include "RunningTotals.h"
 #include "VolumeAccess.h"
 
 #include <algorithm>
@@ -221,11 +222,14 @@ private:
     runRows<RowDifferences<T, Acc>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
     p1[0] = 0;
     p2[0] = 0;
-    for (std::int64_t i = 0; i < span; ++i)
-    {
-      p1[i + 1] += p1[i];
-      p2[i + 1] += p2[i];
-    }
+    if constexpr (std::is_same<Acc, std::int64_t>::value)
+      runningTotals(p1, p2, span + 1, this->Simd); // exact: any order of the additions
+    else
+      for (std::int64_t i = 0; i < span; ++i) // double sums: this order on every tier
+      {
+        p1[i + 1] += p1[i];
+        p2[i + 1] += p2[i];
+      }
     const std::int64_t nx = this->Geo.region.size[0];
     const std::int64_t r = this->Geo.radius.x;
     const std::int64_t x0 = this->Geo.region.begin[0] - this->Geo.xs.lo; // first output in span

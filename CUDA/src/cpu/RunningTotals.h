@@ -1,0 +1,20 @@
+// Running totals of rows of 64-bit integers in place, for the box sums' x pass
+// (MomentPlanes.h): integer sums are exact, so any order of the additions gives the same
+// values, and AVX-512 forms eight at a time by a scan within the register (three shifted
+// adds) plus the total carried from the previous eight.
+#pragma once
+
+#include "CpuDispatch.h"
+
+#include <cstdint>
+
+namespace vao
+{
+namespace detail
+{
+
+/// a[i] += a[i - 1] and b[i] += b[i - 1] for i in [1, n): the running totals of both rows.
+void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier tier);
+
+} // namespace detail
+} // namespace vao
