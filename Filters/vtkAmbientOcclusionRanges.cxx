@@ -16,20 +16,14 @@
 namespace vtkAmbientOcclusionRanges
 {
 
-void Cache(vtkDataArray* array)
+namespace
 {
-  auto* values = vtkFloatArray::SafeDownCast(array);
-  if (!values || values->GetInformation()->Has(vtkAbstractArray::PER_COMPONENT()))
-  {
-    return;
-  }
+
+/// Where vtkDataArray caches ranges: every value is finite, so the range and the finite
+/// range are the same.
+void Store(vtkFloatArray* values, const vao::ValueRanges& ranges)
+{
   const int components = values->GetNumberOfComponents();
-  vao::ValueRanges ranges;
-  if (!vao::computeFiniteValueRanges(values->GetPointer(0), values->GetNumberOfTuples(), components, ranges))
-  {
-    return;
-  }
-  // All values are finite: the range and the finite range are the same.
   vtkInformation* info = values->GetInformation();
   for (vtkInformationInformationVectorKey* key :
     { vtkAbstractArray::PER_COMPONENT(), vtkAbstractArray::PER_FINITE_COMPONENT() })
@@ -47,6 +41,37 @@ void Cache(vtkDataArray* array)
     info->Set(vtkDataArray::L2_NORM_RANGE(), ranges.norm, 2);
     info->Set(vtkDataArray::L2_NORM_FINITE_RANGE(), ranges.norm, 2);
   }
+}
+
+} // namespace
+
+
+void Cache(vtkDataArray* array)
+{
+  auto* values = vtkFloatArray::SafeDownCast(array);
+  if (!values || values->GetInformation()->Has(vtkAbstractArray::PER_COMPONENT()))
+  {
+    return;
+  }
+  const int components = values->GetNumberOfComponents();
+  vao::ValueRanges ranges;
+  if (!vao::computeFiniteValueRanges(values->GetPointer(0), values->GetNumberOfTuples(), components, ranges))
+  {
+    return;
+  }
+  Store(values, ranges);
+}
+
+void CacheKnown(vtkDataArray* array, double lowest, double highest)
+{
+  auto* values = vtkFloatArray::SafeDownCast(array);
+  if (!values || values->GetNumberOfComponents() != 1 || values->GetNumberOfTuples() == 0)
+  {
+    return;
+  }
+  vao::ValueRanges ranges;
+  ranges.components = { lowest, highest };
+  Store(values, ranges);
 }
 
 void CacheOutput(vtkDataObject* output)

@@ -19,6 +19,10 @@ namespace vtkAmbientOcclusionRanges
 /// infinity apply there) as they are.
 void Cache(vtkDataArray* array);
 
+/// Stores the range [lowest, highest] of a one-component float array whose values are all
+/// finite, as a pass that wrote them kept it (vao::OutputRange).
+void CacheKnown(vtkDataArray* array, double lowest, double highest);
+
 /// Cache() for every point-data array of the output (a data set, or the data sets of a
 /// composite output).
 void CacheOutput(vtkDataObject* output);

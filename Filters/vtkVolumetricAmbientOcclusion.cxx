@@ -4,6 +4,7 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionRanges.h"
 #include "vtkAmbientOcclusionThresholds.h"
 
 #include "vao/AmbientOcclusion.h"
@@ -362,8 +363,9 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     auto variance = this->ComputeVariance ? NewFloatArray("Variance", region.voxelCount()) : nullptr;
     vao::AmbientOcclusionParameters parameters = this->Parameters(radius);
     parameters.thresholds = std::move(thresholds);
+    vao::OutputRange range; // kept by the pass, so that the range cache need not scan
     const vao::Status status = this->Compute(scalars.view, region, parameters,
-      { openness->GetPointer(0), variance ? variance->GetPointer(0) : nullptr });
+      { openness->GetPointer(0), variance ? variance->GetPointer(0) : nullptr, &range });
     if (!status.ok)
     {
       error = vtkAmbientOcclusionArrayInput::KernelError(status, scalars, "Ambient occlusion failed");
@@ -377,6 +379,8 @@ int vtkVolumetricAmbientOcclusion::RequestData(
     // The output is exactly the requested extent: the input's arrays cropped to it.
     vtkAmbientOcclusionExtents::CopyRequestedExtent(input, output, outExt);
     output->GetPointData()->AddArray(openness);
+    if (range.known)
+      vtkAmbientOcclusionRanges::CacheKnown(openness, range.lowest, range.highest);
     if (variance)
     {
       output->GetPointData()->AddArray(variance);

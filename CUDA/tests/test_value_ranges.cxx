@@ -2,8 +2,13 @@
 // it leaves to VTK (no tuple, a NaN, an infinity).
 #include "vao/ValueRanges.h"
 
+#include "vao/AmbientOcclusion.h"
+#include "cpu/ConcurrentRange.h"
+#include "cpu/CpuDispatch.h"
+
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -92,6 +97,87 @@ TEST(ValueRanges, LeaveNoTuplesNaNAndInfinityToTheCaller)
   values[5] = -std::numeric_limits<float>::max();
   EXPECT_TRUE(vao::computeFiniteValueRanges(values.data(), 1000, 3, ranges, 2));
   EXPECT_EQ(ranges.components[3], static_cast<double>(std::numeric_limits<float>::max()));
+}
+
+} // namespace
+
+// The range a pass keeps as it writes (ConcurrentRange.h): each row's extremes on every
+// tier against a plain scan, with a NaN or an infinity anywhere making it unknown; and
+// computeAmbientOcclusion's openness range, known for the moment methods and equal to a
+// scan of what they wrote, unknown for the others.
+namespace
+{
+
+TEST(KeptRanges, RowExtremesOnEveryTierEqualAPlainScan)
+{
+  using vao::detail::SimdTier;
+  std::mt19937 random(12);
+  for (const SimdTier tier : { SimdTier::Baseline, SimdTier::Avx2, SimdTier::Avx512 })
+  {
+    vao::detail::limitSimdTier(tier);
+    for (std::int64_t n = 0; n <= 50; ++n)
+    {
+      std::vector<float> v(static_cast<std::size_t>(n));
+      for (float& x : v)
+        x = std::uniform_real_distribution<float>(-3.0f, 5.0f)(random);
+      float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+      ASSERT_TRUE(vao::detail::rowExtremes(v.data(), n, lo, hi));
+      if (n > 0)
+      {
+        EXPECT_EQ(lo, *std::min_element(v.begin(), v.end())) << "n " << n;
+        EXPECT_EQ(hi, *std::max_element(v.begin(), v.end())) << "n " << n;
+      }
+      for (const float bad : { std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity() })
+        for (std::int64_t at = 0; at < n; at += 7)
+        {
+          std::vector<float> w = v;
+          w[static_cast<std::size_t>(at)] = bad;
+          float l = 0.0f, h = 0.0f;
+          EXPECT_FALSE(vao::detail::rowExtremes(w.data(), n, l, h)) << "n " << n << ", at " << at;
+        }
+    }
+  }
+  vao::detail::limitSimdTier(SimdTier::Avx512);
+}
+
+TEST(KeptRanges, OpennessRangeOfTheMomentMethodsEqualsAScan)
+{
+  const vao::Index3 dims = { 23, 19, 17 };
+  std::vector<std::int16_t> values(static_cast<std::size_t>(dims[0] * dims[1] * dims[2]));
+  std::mt19937 random(3);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = static_cast<std::int16_t>(i % 11 == 0 ? 900 : std::uniform_int_distribution<int>(-50, 50)(random));
+  std::vector<float> floats(values.begin(), values.end());
+  for (const bool asFloat : { false, true })
+  {
+    vao::VolumeView view;
+    view.data = asFloat ? static_cast<const void*>(floats.data()) : values.data();
+    view.type = asFloat ? vao::ScalarType::Float32 : vao::ScalarType::Int16;
+    view.dims = dims;
+    for (const vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev,
+           vao::Method::CdfReconstruction, vao::Method::ExactBox })
+    {
+      vao::AmbientOcclusionParameters p;
+      p.method = method;
+      p.radius = { 2, 3, 1 };
+      std::vector<float> out(values.size());
+      vao::OutputRange range;
+      range.known = true; // stale: the call must reset it
+      vao::AmbientOcclusionOutput output;
+      output.openness = out.data();
+      output.opennessRange = &range;
+      ASSERT_TRUE(vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, output).ok);
+      if (method == vao::Method::ExactBox)
+      {
+        EXPECT_FALSE(range.known);
+        continue;
+      }
+      ASSERT_TRUE(range.known) << static_cast<int>(method);
+      EXPECT_EQ(range.lowest, *std::min_element(out.begin(), out.end())) << static_cast<int>(method);
+      EXPECT_EQ(range.highest, *std::max_element(out.begin(), out.end())) << static_cast<int>(method);
+      EXPECT_LT(range.lowest, range.highest); // a scene with both open and occluded voxels
+    }
+  }
 }
 
 } // namespace

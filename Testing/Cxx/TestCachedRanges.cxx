@@ -113,6 +113,29 @@ TEST(CachedRanges, VolumetricOutputsEqualVtksRangesAndModifiedDropsThem)
   EXPECT_EQ(range[1], 41.0);
 }
 
+// Chebyshev, the Gaussian CDF and CDF Reconstruction keep the openness's range as they
+// write it (vao::OutputRange); the cache that comes from it must be VTK's too.
+TEST(CachedRanges, RangesTheMomentMethodsKeepEqualVtksRanges)
+{
+  auto input = Phantom();
+  for (const int method : { vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, vtkVolumetricAmbientOcclusion::CHEBYSHEV,
+         vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION })
+  {
+    for (const bool variance : { false, true })
+    {
+      SCOPED_TRACE(method);
+      vtkNew<vtkVolumetricAmbientOcclusion> filter;
+      filter->SetInputData(input);
+      filter->SetMethod(method);
+      filter->SetRadius(3);
+      filter->SetComputeVariance(variance);
+      filter->SetBackend(vtkVolumetricAmbientOcclusion::BACKEND_CPU);
+      filter->Update();
+      ExpectCachedRangesOfVtk(filter->GetOutput(), variance ? 2 : 1);
+    }
+  }
+}
+
 TEST(CachedRanges, SurfaceArraysWithDistinctComponentsEqualVtksRanges)
 {
   auto volume = Phantom();

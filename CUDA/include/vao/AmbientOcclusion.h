@@ -108,11 +108,23 @@ struct Execution
   std::function<bool()> abortRequested;
 };
 
+/// The lowest and highest of the values a pass wrote, where it kept them (known): a caller
+/// that needs the range (VTK's range cache) then need not read the array again.
+struct OutputRange
+{
+  bool known = false;
+  float lowest = 0.0f;
+  float highest = 0.0f;
+};
+
 /// Output arrays of region.voxelCount() values, x fastest; a null pointer skips it.
 struct AmbientOcclusionOutput
 {
   float* openness = nullptr;
   float* variance = nullptr; // intensity variance of the box (Ruiz et al. section 4.2)
+  // Where not null: the openness's range, known when every value written was finite and
+  // the method's pass kept it (the CPU's Chebyshev, Gaussian CDF and CDF Reconstruction).
+  OutputRange* opennessRange = nullptr;
 };
 
 struct BoxStatisticsOutput

@@ -2,6 +2,7 @@
 // (and the box extrema for CDF Reconstruction), the box histograms of Histogram CDF, or the
 // exact references; with the voxel's value, the iso value or the smoothed query as q.
 #include "BoxEngine.h"
+#include "ConcurrentRange.h"
 #include "EstimatorRows.h"
 #include "ExactReference.h"
 #include "HistogramChannels.h"
@@ -44,6 +45,7 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   const bool fromSums = p.method == Method::Chebyshev || p.method == Method::GaussianCdf;
   const detail::RowContents contents{ withExtrema, output.variance != nullptr || !output.openness || !fromSums,
     output.openness && voxelQuery && !query };
+  detail::ConcurrentRange range;
   const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, contents, execution,
     [&](const detail::NeighbourhoodRow& row) {
       if (output.variance)
@@ -55,8 +57,12 @@ Status separableOpenness(const VolumeView& view, const Region& region,
       {
         const double* q = query ? query + row.index : (voxelQuery ? row.value : nullptr);
         detail::opennessRow(p.method, p.erfMode, row, q, p.isoValue, output.openness + row.index);
+        if (output.opennessRange)
+          range.add(output.openness + row.index, row.size);
       }
     });
+  if (ok && output.openness && output.opennessRange)
+    *output.opennessRange = range.result();
   return ok ? Status::success() : Status::cancelled();
 }
 
@@ -84,6 +90,8 @@ Status ambientOcclusion(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
   const Execution& execution)
 {
+  if (output.opennessRange)
+    *output.opennessRange = OutputRange{}; // unknown unless the pass that writes it keeps it
   Status status = checkParameters(parameters);
   const bool moments = output.variance || (output.openness && isSeparableMethod(parameters.method));
   ValueScan scan;
