@@ -169,7 +169,6 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
   const MomentScale& scale, RowContents contents, const Execution& execution, Visit&& visit)
 {
   const bool withExtrema = contents.extrema;
-  [[maybe_unused]] const bool withMoments = contents.moments; // double sums always give them
   const Region& region = band.region;
   BoxExtrema<T> extrema;
   const double split = withExtrema ? 0.5 : 0.0;
@@ -215,7 +214,7 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
           out.sumSquares = slice.sumSquares + j * nx;
           out.countX = countX.data();
           out.countYZ = countYZ;
-          if (withMoments)
+          if (contents.moments) // double sums below always give them
             meanVarianceRowExact(slice.sum + j * nx, slice.sumSquares + j * nx, countX.data(), countYZ, nx,
               count.data(), mean.data(), variance.data());
         }
