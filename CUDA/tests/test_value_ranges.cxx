@@ -172,6 +172,16 @@ TEST(KeptRanges, OpennessRangeOfTheMomentMethodsEqualsAScan)
         EXPECT_FALSE(range.known);
         continue;
       }
+      // Without vector instructions the range is left to the caller's threaded pass.
+      vao::detail::limitSimdTier(vao::detail::SimdTier::Baseline);
+      vao::OutputRange plainRange;
+      plainRange.known = true;
+      output.opennessRange = &plainRange;
+      ASSERT_TRUE(vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, output).ok);
+      vao::detail::limitSimdTier(vao::detail::SimdTier::Avx512);
+      EXPECT_FALSE(plainRange.known);
+      output.opennessRange = &range;
+      ASSERT_TRUE(vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, output).ok);
       ASSERT_TRUE(range.known) << static_cast<int>(method);
       EXPECT_EQ(range.lowest, *std::min_element(out.begin(), out.end())) << static_cast<int>(method);
       EXPECT_EQ(range.highest, *std::max_element(out.begin(), out.end())) << static_cast<int>(method);

@@ -123,7 +123,8 @@ struct AmbientOcclusionOutput
   float* openness = nullptr;
   float* variance = nullptr; // intensity variance of the box (Ruiz et al. section 4.2)
   // Where not null: the openness's range, known when every value written was finite and
-  // the method's pass kept it (the CPU's Chebyshev, Gaussian CDF and CDF Reconstruction).
+  // the method's pass kept it (the CPU's Chebyshev, Gaussian CDF and CDF Reconstruction,
+  // on a processor with AVX2).
   OutputRange* opennessRange = nullptr;
 };
 

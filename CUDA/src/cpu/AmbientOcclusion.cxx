@@ -3,6 +3,7 @@
 // exact references; with the voxel's value, the iso value or the smoothed query as q.
 #include "BoxEngine.h"
 #include "ConcurrentRange.h"
+#include "CpuDispatch.h"
 #include "EstimatorRows.h"
 #include "ExactReference.h"
 #include "HistogramChannels.h"
@@ -45,6 +46,9 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   const bool fromSums = p.method == Method::Chebyshev || p.method == Method::GaussianCdf;
   const detail::RowContents contents{ withExtrema, output.variance != nullptr || !output.openness || !fromSums,
     output.openness && voxelQuery && !query };
+  // Kept where the rows' extremes take vector instructions; the plain loop would cost
+  // several times the separate, threaded pass the caller then makes (vao/ValueRanges.h).
+  const bool keepRange = output.openness && output.opennessRange && detail::cpuHasAvx2();
   detail::ConcurrentRange range;
   const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, contents, execution,
     [&](const detail::NeighbourhoodRow& row) {
@@ -57,11 +61,11 @@ Status separableOpenness(const VolumeView& view, const Region& region,
       {
         const double* q = query ? query + row.index : (voxelQuery ? row.value : nullptr);
         detail::opennessRow(p.method, p.erfMode, row, q, p.isoValue, output.openness + row.index);
-        if (output.opennessRange)
+        if (keepRange)
           range.add(output.openness + row.index, row.size);
       }
     });
-  if (ok && output.openness && output.opennessRange)
+  if (ok && keepRange)
     *output.opennessRange = range.result();
   return ok ? Status::success() : Status::cancelled();
 }

@@ -15,7 +15,7 @@ namespace detail
 {
 
 /// The lowest and highest of n values; false when one is not finite (then lo and hi are
-/// unspecified). Sixteen at a time on AVX-512.
+/// unspecified). Eight at a time on AVX2, sixteen on AVX-512.
 bool rowExtremes(const float* v, std::int64_t n, float& lo, float& hi);
 
 class ConcurrentRange
