@@ -1,7 +1,8 @@
 // Peak resident memory of each filter on one volume (default: the 512x512x209 CT head
 // phantom at R = 10), as a table: the input's and the outputs' sizes, the peak, and the
 // extra memory (peak - resident before the filter - the new output arrays) against the
-// input's size (the separable filters aim at extra <= 25% of the input).
+// input's size (the volume filters aim at extra <= 25% of the input, the isosurface AO,
+// which keeps a moment pyramid's tiles between light moves, at <= 50%).
 //
 //   vao_memory [CT.mha] [--radius R] [--threads N] [--exact]
 //
@@ -85,6 +86,7 @@ struct Case
 {
   const char* name;
   const char* outputs;
+  double bar = 25.0; // the extra memory aimed at, in % of the input
 };
 
 const Case kCases[] = {
@@ -96,8 +98,8 @@ const Case kCases[] = {
   { "Occlusion Sweeping", "AmbientOcclusion, SignedDistance" },
   { "Variance Occlusion Map", "4 levels of Mean, Variance" },
   { "Shading (RGBA)", "ShadedRGBA" },
-  { "Isosurface AO + shadows", "AmbientOcclusion, Shadow (bone)" },
-  { "Isosurface AO, half res.", "AmbientOcclusion, Shadow (bone)" },
+  { "Isosurface AO + shadows", "AmbientOcclusion, Shadow (bone)", 50.0 },
+  { "Isosurface AO, half res.", "AmbientOcclusion, Shadow (bone)", 50.0 },
   { "Exact Box", "AmbientOcclusion" },   // only with --exact (minutes: O(R^3))
   { "Exact Sphere", "AmbientOcclusion" }, // only with --exact
 };
@@ -250,7 +252,7 @@ int main(int argc, char* argv[])
   std::printf("peak resident memory of each filter on %s, R = %g (one process per row)\n",
     path.c_str(), radius);
   std::printf("%-26s %-34s %9s %9s %9s %9s %8s  %s\n", "filter", "new output arrays", "input MB",
-    "output MB", "peak MB", "extra MB", "extra %", "bar: extra <= 25% of input");
+    "output MB", "peak MB", "extra MB", "extra %", "bar: extra <= 25% of input (isosurface: 50%)");
   int failures = 0;
   const int cases = exact ? static_cast<int>(sizeof kCases / sizeof kCases[0]) : kFirstExactCase;
   for (int c = 0; c < cases; ++c)
@@ -280,7 +282,7 @@ int main(int argc, char* argv[])
     const double percent = 100.0 * extra / input;
     std::printf("%-26s %-34s %9s %9s %9s %9s %7.1f%%  %s\n", kCases[c].name, kCases[c].outputs,
       Mb(input).c_str(), Mb(output).c_str(), Mb(peak).c_str(), Mb(extra).c_str(), percent,
-      percent <= 25.0 ? "PASS" : "FAIL");
+      percent <= kCases[c].bar ? "PASS" : "FAIL");
   }
   return failures ? 1 : 0;
 }

@@ -215,6 +215,81 @@ TEST(SurfacePyramid, BuildsOnlyTheTilesASurfaceReachesAndKeepsThem)
   EXPECT_LT(surface.builtTiles(1), surface.tileCount(1) / 2);
 }
 
+TEST(SurfacePyramid, SweepsInSlabsHoldingLittleMoreThanItKeeps)
+{
+  // A tall volume (12 layers of level-0 tiles) whose surface spans it. Unlimited, a query
+  // holds every tile its points reach at the end; with nothing kept, it holds at most
+  // the tiles near one slab at any moment (watched from the progress reports, made on
+  // the calling thread between a slab's loops) and the same results bit for bit; with
+  // half kept, it ends with at most that, and the next query finds them built and
+  // builds fewer tiles than a fresh one.
+  const Field f = shellScene({ 30, 28, 90 });
+  std::vector<double> points, normals;
+  scenePoints(f, points, normals);
+  const Vec3 c = { f.origin[0] + 15 * f.spacing[0], f.origin[1] + 14 * f.spacing[1], f.origin[2] + 45 * f.spacing[2] };
+  std::vector<double> column, columnNormals; // a tall cylinder of points through the scene
+  for (int i = 0; i < 4000; ++i)
+  {
+    const double angle = 0.37 * i, height = (i % 400) / 400.0 * 86 * f.spacing[2];
+    points.insert(points.end(), { c[0] + 6 * std::cos(angle), c[1] + 6 * std::sin(angle), f.origin[2] + height });
+    normals.insert(normals.end(), { std::cos(angle), std::sin(angle), 0.1 });
+  }
+  const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
+  vao::PyramidParameters pp;
+  std::vector<vao::MomentLevel> whole;
+  ASSERT_TRUE(vao::buildMomentPyramid(f.view(), f.origin, f.spacing, pp, whole).ok);
+  std::vector<float> expectedAo(n), expectedShadow(n), ao(n, -1.0f), shadow(n, -1.0f);
+  const std::array<double, 3> light = { 0.3, -0.2, 1.0 };
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing, points.data(), normals.data(), n,
+    {}, expectedAo.data()).ok);
+  ASSERT_TRUE(vao::surfaceShadow(whole, points.data(), normals.data(), n, light, {}, expectedShadow.data()).ok);
+  auto held = [](const vao::SurfacePyramid& s) { return s.builtTiles(0) + s.builtTiles(1); };
+  auto made = [](vao::SurfacePyramid& s) {
+    const auto& tiles = *vao::SurfacePyramidAccess::tiles(s);
+    return tiles.at(0)->madeTiles() + tiles.at(1)->madeTiles();
+  };
+
+  vao::SurfacePyramid unlimited = surfacePyramidOf(f, pp);
+  unlimited.setKeptTileBytes(static_cast<std::size_t>(-1));
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(unlimited, f.view(), f.origin, f.spacing, points.data(), normals.data(),
+    n, {}, ao.data()).ok);
+  ASSERT_TRUE(vao::surfaceShadow(unlimited, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
+  const std::int64_t reached = held(unlimited);
+  EXPECT_EQ(made(unlimited), reached);
+  ASSERT_EQ(unlimited.tileCount(0), 4 * 4 * 12);
+  EXPECT_GT(unlimited.builtTiles(0), 4 * 4 * 10 / 2) << "the surface reaches most layers";
+  EXPECT_EQ(ao, expectedAo);
+  EXPECT_EQ(shadow, expectedShadow);
+
+  vao::SurfacePyramid streamed = surfacePyramidOf(f, pp);
+  streamed.setKeptTileBytes(0);
+  std::int64_t peak = 0;
+  vao::Execution watched;
+  watched.progress = [&](double) { peak = std::max(peak, held(streamed)); };
+  std::fill(ao.begin(), ao.end(), -1.0f);
+  std::fill(shadow.begin(), shadow.end(), -1.0f);
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(streamed, f.view(), f.origin, f.spacing, points.data(), normals.data(),
+    n, {}, ao.data(), watched).ok);
+  ASSERT_TRUE(vao::surfaceShadow(streamed, points.data(), normals.data(), n, light, {}, shadow.data(), watched).ok);
+  EXPECT_EQ(ao, expectedAo);
+  EXPECT_EQ(shadow, expectedShadow);
+  EXPECT_GT(peak, 0);
+  EXPECT_LT(peak, reached / 2) << "held " << peak << " of the " << reached << " tiles reached";
+  EXPECT_LT(held(streamed), reached / 2);
+
+  vao::SurfacePyramid half = surfacePyramidOf(f, pp);
+  const std::size_t kept = static_cast<std::size_t>(reached / 2) * vao::detail::PyramidTiles::kTileBytes;
+  half.setKeptTileBytes(kept);
+  EXPECT_EQ(half.keptTileBytes(), kept);
+  ASSERT_TRUE(vao::surfaceShadow(half, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
+  EXPECT_EQ(shadow, expectedShadow);
+  EXPECT_LE(static_cast<std::size_t>(held(half)) * vao::detail::PyramidTiles::kTileBytes, kept);
+  const std::int64_t first = made(half);
+  ASSERT_TRUE(vao::surfaceShadow(half, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
+  EXPECT_EQ(shadow, expectedShadow);
+  EXPECT_LT(made(half) - first, first * 3 / 4) << "the second query finds the tiles the first kept";
+}
+
 TEST(SurfacePyramid, BadInputFailsWithMessage)
 {
   vao::SurfacePyramid empty;

@@ -131,9 +131,13 @@ class PyramidTiles;
 
 /// A moment pyramid for the surface queries that holds levels 0 and 1 only where they
 /// sample them. Those levels (96% of a whole pyramid's bytes) are kept in tiles of 8^3
-/// voxels: each query first builds the tiles its samples reach (its points' AO offsets,
-/// the half-voxel query, the shadow march's steps on those levels), so a surface holds a
-/// small part of them. Levels 2 and up are whole. Every result equals the one from
+/// voxels: a query builds the tiles its samples reach (its points' AO offsets, the
+/// half-voxel query, the shadow march's steps on those levels), so a surface holds a
+/// small part of them. It sweeps its points in slabs along z, building a slab's tiles
+/// before sampling it, and gives back the tiles it has left behind while more than
+/// keptTileBytes() are built (by default a fifth of the volume's bytes): a large surface
+/// holds the tiles near one slab plus those kept, which the next query finds built.
+/// Levels 2 and up are whole. Every result equals the one from
 /// buildMomentPyramid's whole pyramid bit for bit. Tiles are built from the volume: the
 /// volume the pyramid was built from must outlive it, unchanged. A query builds tiles, so
 /// queries on one pyramid must not run at the same time (each runs on all the threads of
@@ -153,6 +157,9 @@ public:
   /// Level l's tiles built so far, and in all (0 for a whole level).
   std::int64_t builtTiles(int level) const;
   std::int64_t tileCount(int level) const;
+  /// The tiles' bytes a query keeps built (past them it releases the ones it left behind).
+  std::size_t keptTileBytes() const;
+  void setKeptTileBytes(std::size_t bytes);
 
 private:
   friend struct SurfacePyramidAccess; // the builder's and the queries' way in
@@ -167,7 +174,8 @@ Status buildSurfacePyramid(const VolumeView& volume, const std::array<double, 3>
   const Execution& execution = {});
 
 /// surfaceAmbientOcclusion and surfaceShadow on a SurfacePyramid: the tiles the points
-/// reach are built first (kept for later queries).
+/// reach are built as the query sweeps them (kept for later queries up to the pyramid's
+/// keptTileBytes()).
 Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const double* points, const double* normals, std::int64_t count,
   const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution = {});

@@ -40,6 +40,7 @@ LevelTiles::LevelTiles(const VolumeView& volume, const MomentLevel& geometry, in
     throw std::bad_alloc();
   }
   this->prepareGrid();
+  this->forgetMarks();
 }
 
 LevelTiles::~LevelTiles()
@@ -87,6 +88,10 @@ void LevelTiles::markAround(double x, double y, double z)
     lo[a] = lower >> kTileShift;
     hi[a] = std::min<std::int64_t>(this->Geometry.dims[a] - 1, lower + 1) >> kTileShift;
   }
+  std::int64_t lowest = this->LowestMarked.load(std::memory_order_relaxed);
+  while (lo[2] < lowest && !this->LowestMarked.compare_exchange_weak(lowest, lo[2], std::memory_order_relaxed))
+  {
+  }
   for (std::int64_t tz = lo[2]; tz <= hi[2]; ++tz)
     for (std::int64_t ty = lo[1]; ty <= hi[1]; ++ty)
       for (std::int64_t tx = lo[0]; tx <= hi[0]; ++tx)
@@ -95,6 +100,38 @@ void LevelTiles::markAround(double x, double y, double z)
         if (state.load(std::memory_order_relaxed) == 0)
           state.store(1, std::memory_order_relaxed);
       }
+}
+
+std::int64_t LevelTiles::layerOf(double z) const
+{
+  const LevelGrid& g = this->Grid;
+  const double u = std::min(std::max((z - g.origin[2]) * g.inverseSpacing[2], 0.0), g.maxIndex[2]);
+  return static_cast<std::int64_t>(u) >> kTileShift;
+}
+
+void LevelTiles::forgetMarks()
+{
+  this->LowestMarked.store(this->Tiles[2], std::memory_order_relaxed);
+}
+
+void LevelTiles::releaseLayer(std::int64_t layer)
+{
+  const std::int64_t perLayer = this->Tiles[0] * this->Tiles[1];
+  std::int64_t released = 0;
+  for (std::int64_t t = layer * perLayer; t < (layer + 1) * perLayer; ++t)
+  {
+    if (this->State[t].load(std::memory_order_relaxed) == 2)
+    {
+      this->State[t].store(0, std::memory_order_relaxed);
+      ++released;
+    }
+  }
+  if (released > 0)
+  {
+    releaseSparseStorage(this->Pool + layer * perLayer * 2 * kTileVoxels,
+      static_cast<std::size_t>(perLayer) * PyramidTiles::kTileBytes);
+    this->Built.fetch_sub(released, std::memory_order_relaxed);
+  }
 }
 
 bool LevelTiles::buildMarked(const Execution& execution)
@@ -225,6 +262,8 @@ bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execut
             }
         this->State[run.first + k].store(2, std::memory_order_release);
       }
+      this->Built.fetch_add(run.count, std::memory_order_relaxed);
+      this->Made.fetch_add(run.count, std::memory_order_relaxed);
       if (!progress.advance())
       {
         return;
@@ -233,15 +272,6 @@ bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execut
   });
 }
 
-std::int64_t LevelTiles::builtTiles() const
-{
-  std::int64_t built = 0;
-  for (std::int64_t t = 0; t < this->tileCount(); ++t)
-  {
-    built += this->State[t].load(std::memory_order_relaxed) == 2;
-  }
-  return built;
-}
 
 bool PyramidTiles::buildMarked(const Execution& execution)
 {
@@ -252,6 +282,39 @@ bool PyramidTiles::buildMarked(const Execution& execution)
       return false;
   }
   return true;
+}
+
+std::size_t PyramidTiles::builtBytes() const
+{
+  std::size_t bytes = 0;
+  for (const auto& level : this->levels)
+    bytes += static_cast<std::size_t>(level->builtTiles()) * kTileBytes;
+  return bytes;
+}
+
+void PyramidTiles::forgetMarks()
+{
+  for (const auto& level : this->levels)
+    level->forgetMarks();
+}
+
+void PyramidTiles::releaseBelowMarks()
+{
+  // Level l goes while its tiles and the coarser ones' take more than keptBytes: a finer
+  // level's tiles are released to keep the coarser ones, never the other way.
+  for (std::size_t l = 0; l < this->levels.size(); ++l)
+  {
+    auto heldFrom = [&] {
+      std::size_t bytes = 0;
+      for (std::size_t m = l; m < this->levels.size(); ++m)
+        bytes += static_cast<std::size_t>(this->levels[m]->builtTiles()) * kTileBytes;
+      return bytes;
+    };
+    LevelTiles& level = *this->levels[l];
+    const std::int64_t below = std::min(level.lowestMarked(), level.layerCount());
+    for (std::int64_t layer = 0; layer < below && heldFrom() > this->keptBytes; ++layer)
+      level.releaseLayer(layer);
+  }
 }
 
 } // namespace detail

@@ -2,8 +2,10 @@
 // voxels built only where the surface queries sample: a query first marks the tiles its
 // samples touch, then buildMarked blurs those tiles from the volume (PyramidBlur.h, the
 // same arithmetic as the whole level: level 1's tiles blur a block of level 0 computed
-// for them), then the query samples. The bone surface of the CT head reaches a tenth of
-// level 0's tiles and a fifth of level 1's; the two levels held 96% of a whole pyramid.
+// for them), then the query samples; SurfaceSweep.h does this slab by slab and releases
+// the layers of tiles a sweep leaves behind. The bone surface of the CT head reaches a
+// tenth of level 0's tiles and a fifth of level 1's; the two levels held 96% of a whole
+// pyramid.
 //
 // Layout. Tile (tx, ty, tz), x fastest, is 1024 floats: the (mean, variance) pairs of its
 // voxels, x fastest within the tile, so a tile is one 4 KiB page and a corner's two
@@ -59,7 +61,19 @@ public:
   /// when cancelled (the tiles finished stay built).
   bool buildMarked(const Execution& execution);
 
-  std::int64_t builtTiles() const;
+  /// The layer of tiles (along z) holding world z, clamped to the level.
+  std::int64_t layerOf(double z) const;
+  std::int64_t layerCount() const { return this->Tiles[2]; }
+  /// The lowest layer markAround reached since forgetMarks (layerCount() when none).
+  std::int64_t lowestMarked() const { return this->LowestMarked.load(std::memory_order_relaxed); }
+  void forgetMarks();
+  /// Gives the memory of layer `layer`'s built tiles back; they are built again when
+  /// marked again. Not while tiles are being marked, built or sampled.
+  void releaseLayer(std::int64_t layer);
+
+  std::int64_t builtTiles() const { return this->Built.load(std::memory_order_relaxed); }
+  /// Tiles built since construction, those built again after a release included.
+  std::int64_t madeTiles() const { return this->Made.load(std::memory_order_relaxed); }
   std::int64_t tileCount() const { return this->Tiles[0] * this->Tiles[1] * this->Tiles[2]; }
 
 private:
@@ -79,6 +93,8 @@ private:
   double Shift;
   Index3 Tiles;
   std::unique_ptr<std::atomic<std::uint8_t>[]> State; // 0 absent, 1 marked, 2 built
+  std::atomic<std::int64_t> Built{ 0 }, Made{ 0 };
+  std::atomic<std::int64_t> LowestMarked{ 0 };
   float* Pool = nullptr;
   std::size_t PoolBytes = 0;
   LevelGrid Grid;
@@ -89,13 +105,24 @@ class PyramidTiles
 {
 public:
   static constexpr int kLevels = 2;
+  static constexpr std::size_t kTileBytes = 2 * kTileVoxels * sizeof(float);
   std::vector<std::unique_ptr<LevelTiles>> levels;
+  /// The built tiles' memory a query keeps (SurfaceSweep.h): past it, it releases the
+  /// layers its sweep has left behind.
+  std::size_t keptBytes = static_cast<std::size_t>(-1);
 
   /// Level l's tiles, or nullptr when level l is whole.
   LevelTiles* at(int l) const { return l >= 0 && l < static_cast<int>(this->levels.size()) ? this->levels[l].get() : nullptr; }
   int count() const { return static_cast<int>(this->levels.size()); }
   /// buildMarked of every tiled level.
   bool buildMarked(const Execution& execution);
+  std::size_t builtBytes() const;
+  void forgetMarks();
+  /// Releases the layers below each level's lowest marked one (those a sweep up along z
+  /// has left behind), lowest first: level 0's while more than keptBytes are built, then
+  /// level 1's while level 1 alone takes more. (A tile of level 1 costs about fifteen of
+  /// level 0 to build: it blurs the block of level 0 under it.)
+  void releaseBelowMarks();
 };
 
 } // namespace detail

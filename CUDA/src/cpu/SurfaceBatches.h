@@ -16,29 +16,40 @@ namespace vao
 namespace detail
 {
 
+/// Which points a loop takes: [begin, begin + count) of `order` (a permutation of the
+/// points), or of the points themselves without one.
+struct PointRange
+{
+  const std::uint32_t* order = nullptr;
+  std::int64_t begin = 0;
+  std::int64_t count = 0;
+
+  std::int64_t operator[](std::int64_t i) const { return order ? order[begin + i] : begin + i; }
+};
+
 /// kLanes points at a time (the last batch padded with copies of its last point): their
-/// positions, unit normals and queries, structure of arrays.
+/// indices, positions, unit normals and queries, structure of arrays.
 struct PointLanes
 {
-  std::int64_t first = 0;
   int used = 0; // real points in the batch
+  std::int64_t index[kLanes];
   double x[kLanes], y[kLanes], z[kLanes];
   double nx[kLanes], ny[kLanes], nz[kLanes];
   double query[kLanes];
 
   template <class P>
-  PointLanes(const P* points, const P* normals, std::int64_t count, std::int64_t batch)
-    : first(batch * kLanes)
-    , used(static_cast<int>(std::min<std::int64_t>(kLanes, count - batch * kLanes)))
+  PointLanes(const P* points, const P* normals, const PointRange& range, std::int64_t batch)
+    : used(static_cast<int>(std::min<std::int64_t>(kLanes, range.count - batch * kLanes)))
   {
     for (int k = 0; k < kLanes; ++k)
     {
-      const std::int64_t i = this->first + std::min(k, this->used - 1);
+      const std::int64_t i = range[batch * kLanes + std::min(k, this->used - 1)];
       const double p[3] = { static_cast<double>(points[3 * i]), static_cast<double>(points[3 * i + 1]),
         static_cast<double>(points[3 * i + 2]) };
       const double n[3] = { static_cast<double>(normals[3 * i]), static_cast<double>(normals[3 * i + 1]),
         static_cast<double>(normals[3 * i + 2]) };
       const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      this->index[k] = i;
       this->x[k] = p[0];
       this->y[k] = p[1];
       this->z[k] = p[2];
@@ -55,21 +66,21 @@ struct PointLanes
   }
 };
 
-/// f(lanes) for every batch of kLanes points, on every thread, reporting progress every
-/// 64 batches. Returns false when cancelled.
+/// f(lanes) for every batch of kLanes points of `range`, on every thread, reporting
+/// progress every 64 batches. Returns false when cancelled.
 template <class P, class PerBatch>
-bool forEachBatch(const P* points, const P* normals, std::int64_t count, const Execution& execution,
+bool forEachBatch(const P* points, const P* normals, const PointRange& range, const Execution& execution,
   PerBatch&& f)
 {
   constexpr int kProgressBatches = 64;
-  const std::int64_t batches = (count + kLanes - 1) / kLanes;
+  const std::int64_t batches = (range.count + kLanes - 1) / kLanes;
   const int threads = resolveThreadCount(execution.threads);
   const int chunks = static_cast<int>(std::min<std::int64_t>(std::max<std::int64_t>(batches, 1), threads * 8));
   return parallelFor(batches, chunks, threads, execution,
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
       for (std::int64_t b = begin; b < end; ++b)
       {
-        PointLanes lanes(points, normals, count, b);
+        PointLanes lanes(points, normals, range, b);
         f(lanes);
         if ((b - begin) % kProgressBatches == kProgressBatches - 1 && !progress.advance(kProgressBatches))
         {

@@ -8,6 +8,7 @@
 #include "SurfaceBatches.h"
 #include "SurfaceChecks.h"
 #include "SurfaceLanes.h"
+#include "SurfaceSweep.h"
 #include "VolumeAccess.h"
 
 #include <algorithm>
@@ -21,7 +22,6 @@ namespace
 
 using detail::MarchBounds;
 using detail::PointLanes;
-using detail::forEachBatch;
 
 /// The grid cell around a world position, clamped to the grid: lower and upper corner
 /// indices and the fractions towards the upper one, per axis.
@@ -212,23 +212,6 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int l
   }
 }
 
-/// With tiled levels: marks the tiles that mark(lanes, tiles) names for every batch,
-/// builds them, and gives the execution left for the samples (progress 0.3 to 1).
-template <class P, class Mark>
-bool reachTiles(detail::PyramidTiles* tiles, const P* points, const P* normals, std::int64_t count,
-  const Execution& execution, Execution& sampling, Mark&& mark)
-{
-  sampling = execution;
-  if (!tiles)
-  {
-    return true;
-  }
-  sampling = detail::stageExecution(execution, 0.3, 1.0);
-  return forEachBatch(points, normals, count, detail::stageExecution(execution, 0.0, 0.1),
-           [&](PointLanes& lanes) { mark(lanes, *tiles); }) &&
-    tiles->buildMarked(detail::stageExecution(execution, 0.1, 0.3));
-}
-
 /// `tiles`: a SurfacePyramid's tiled levels; the tiles the samples reach are built first.
 template <class P>
 Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles, const VolumeView& volume,
@@ -255,25 +238,21 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles
   }
   const double h = std::min(spacing[0], std::min(spacing[1], spacing[2]));
   // The tiled levels' samples: at p + k r_l n (batchOcclusion's positions).
-  Execution sampling;
-  if (!reachTiles(tiles, points, normals, count, execution, sampling, [&](const PointLanes& lanes, detail::PyramidTiles& t) {
-        for (int l = 0; l < std::min(levels, t.count()); ++l)
-        {
-          const double offset = parameters.offsetFactor * pyramid[l].kernelRadius;
-          for (int k = 0; k < lanes.used; ++k)
-          {
-            const std::array<double, 3> at = lanes.along(k, offset);
-            t.at(l)->markAround(at[0], at[1], at[2]);
-          }
-        }
-      }))
-  {
-    return Status::cancelled();
-  }
+  const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t) {
+    for (int l = 0; l < std::min(levels, t.count()); ++l)
+    {
+      const double offset = parameters.offsetFactor * pyramid[l].kernelRadius;
+      for (int k = 0; k < lanes.used; ++k)
+      {
+        const std::array<double, 3> at = lanes.along(k, offset);
+        t.at(l)->markAround(at[0], at[1], at[2]);
+      }
+    }
+  };
   const PreparedPyramid prepared(pyramid, levels, tiles);
   const bool finished = detail::dispatchScalarType(half ? volume.type : ScalarType::Float32, [&](auto tag) {
     const detail::TypedVolume<decltype(tag)> typed(half ? volume : VolumeView{});
-    return forEachBatch(points, normals, count, sampling, [&](PointLanes& lanes) {
+    return detail::sweepPoints(tiles, points, normals, count, execution, mark, [&](PointLanes& lanes) {
       for (int k = 0; k < detail::kLanes; ++k)
       {
         lanes.query[k] = half ? trilinear(typed, origin, spacing, lanes.along(k, -0.5 * h)) : parameters.isoValue;
@@ -282,7 +261,7 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles
       batchOcclusion(prepared, levels, lanes, parameters, occlusion);
       for (int k = 0; k < lanes.used; ++k)
       {
-        out[lanes.first + k] = static_cast<float>(1.0 - clamp01(occlusion[k]));
+        out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
       }
     });
   });
@@ -327,29 +306,25 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
     steps.emplace_back(s, tiles->at(l));
     s += detail::kMarchStepFraction * pyramid[l].kernelRadius;
   }
-  Execution sampling;
-  if (!reachTiles(tiles, points, normals, count, execution, sampling, [&](const PointLanes& lanes, detail::PyramidTiles& t) {
-        for (int k = 0; k < lanes.used; ++k)
-        {
-          const std::array<double, 3> inside = lanes.along(k, -0.5 * h);
-          const std::array<double, 3> start = lanes.along(k, r0);
-          t.at(0)->markAround(inside[0], inside[1], inside[2]);
-          for (const auto& step : steps)
-          {
-            const double s = step.first;
-            const double at[3] = { start[0] + s * light[0], start[1] + s * light[1], start[2] + s * light[2] };
-            if (!bounds.contains(at))
-              break;
-            step.second->markAround(at[0], at[1], at[2]);
-          }
-        }
-      }))
-  {
-    return Status::cancelled();
-  }
+  const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t) {
+    for (int k = 0; k < lanes.used; ++k)
+    {
+      const std::array<double, 3> inside = lanes.along(k, -0.5 * h);
+      const std::array<double, 3> start = lanes.along(k, r0);
+      t.at(0)->markAround(inside[0], inside[1], inside[2]);
+      for (const auto& step : steps)
+      {
+        const double s = step.first;
+        const double at[3] = { start[0] + s * light[0], start[1] + s * light[1], start[2] + s * light[2] };
+        if (!bounds.contains(at))
+          break;
+        step.second->markAround(at[0], at[1], at[2]);
+      }
+    }
+  };
   PreparedPyramid prepared(pyramid, levels, tiles);
   prepared.boundCells(count);
-  const bool finished = forEachBatch(points, normals, count, sampling, [&](PointLanes& lanes) {
+  const bool finished = detail::sweepPoints(tiles, points, normals, count, execution, mark, [&](PointLanes& lanes) {
     for (int k = 0; k < detail::kLanes; ++k)
     {
       lanes.query[k] = parameters.isoValue;
@@ -365,7 +340,7 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
     batchMarch(prepared, bounds, levels, lanes, light, parameters.estimator, occlusion);
     for (int k = 0; k < lanes.used; ++k)
     {
-      out[lanes.first + k] = static_cast<float>(1.0 - clamp01(occlusion[k]));
+      out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
     }
   });
   return finished ? Status::success() : Status::cancelled();
