@@ -58,9 +58,10 @@ vao::SurfacePyramid surfacePyramidOf(const Field& f, const vao::PyramidParameter
 
 TEST(SurfacePyramid, TilesHoldTheWholeLevelsVoxels)
 {
-  // Every tile of levels 0 and 1 built, read back in the layout of LevelTiles.h (tiles of
-  // 8^3 voxels x fastest, each the (mean, variance) pairs of its voxels): each voxel equals
-  // the whole level's, at full and half resolution. Level 2, blurred from the two levels
+  // Every tile of levels 0 and 1 built, read back in the layout of LevelTiles.h (tile
+  // (tx, ty, tz) at its offset, the (mean, variance) pairs of voxels [8 tx, 8 tx + 9) x
+  // ..., x fastest): each voxel, the ninth ones shared with the next tile included,
+  // equals the whole level's, at full and half resolution. Level 2, blurred from the two levels
   // streamed slice by slice, equals the whole build's level 2, and so does level 3.
   const Field f = shellScene({ 37, 19, 26 });
   for (bool half : { false, true })
@@ -89,18 +90,25 @@ TEST(SurfacePyramid, TilesHoldTheWholeLevelsVoxels)
       const vao::MomentLevel& level = whole[l];
       EXPECT_EQ(surface.builtTiles(l), surface.tileCount(l));
       const vao::detail::LevelGrid grid = tiles.at(l)->grid();
-      const std::int64_t tx = (level.dims[0] + 7) / 8, ty = (level.dims[1] + 7) / 8;
-      for (std::int64_t z = 0; z < level.dims[2]; ++z)
-        for (std::int64_t y = 0; y < level.dims[1]; ++y)
-          for (std::int64_t x = 0; x < level.dims[0]; ++x)
-          {
-            const std::int64_t tile = ((z / 8) * ty + y / 8) * tx + x / 8;
-            const std::int64_t at = tile * 1024 + 2 * (((z % 8) * 8 + y % 8) * 8 + x % 8);
-            const std::int64_t i = (z * level.dims[1] + y) * level.dims[0] + x;
-            ASSERT_EQ(grid.mean[at], level.mean[i]) << "level " << l << " half " << half << " voxel " << x << " " << y << " " << z;
-            ASSERT_EQ(grid.mean[at + 1], level.variance[i])
-              << "level " << l << " half " << half << " voxel " << x << " " << y << " " << z;
-          }
+      const std::int64_t tx = (level.dims[0] + 7) / 8, ty = (level.dims[1] + 7) / 8, tz = (level.dims[2] + 7) / 8;
+      std::int64_t checked = 0;
+      for (std::int64_t tile = 0; tile < tx * ty * tz; ++tile)
+      {
+        const std::int64_t first[3] = { 8 * (tile % tx), 8 * ((tile / tx) % ty), 8 * (tile / (tx * ty)) };
+        for (std::int64_t k = 0; k < 9 && first[2] + k < level.dims[2]; ++k)
+          for (std::int64_t j = 0; j < 9 && first[1] + j < level.dims[1]; ++j)
+            for (std::int64_t i = 0; i < 9 && first[0] + i < level.dims[0]; ++i)
+            {
+              const std::int64_t at = grid.tileOffsets[tile] + 2 * ((k * 9 + j) * 9 + i);
+              const std::int64_t x = first[0] + i, y = first[1] + j, z = first[2] + k;
+              const std::int64_t v = (z * level.dims[1] + y) * level.dims[0] + x;
+              ASSERT_EQ(grid.mean[at], level.mean[v]) << "level " << l << " half " << half << " voxel " << x << " " << y << " " << z;
+              ASSERT_EQ(grid.mean[at + 1], level.variance[v])
+                << "level " << l << " half " << half << " voxel " << x << " " << y << " " << z;
+              ++checked;
+            }
+      }
+      EXPECT_GT(checked, level.dims[0] * level.dims[1] * level.dims[2]); // the shared ninth voxels too
     }
     for (int l = 2; l < 4; ++l)
     {

@@ -131,7 +131,7 @@ class PyramidTiles;
 
 /// A moment pyramid for the surface queries that holds levels 0 and 1 only where they
 /// sample them. Those levels (96% of a whole pyramid's bytes) are kept in tiles of 8^3
-/// voxels: a query builds the tiles its samples reach (its points' AO offsets, the
+/// cells (9^3 voxels, the ninth shared with the next tile): a query builds the tiles its samples reach (its points' AO offsets, the
 /// half-voxel query, the shadow march's steps on those levels), so a surface holds a
 /// small part of them. It sweeps its points in slabs along z, building a slab's tiles
 /// before sampling it, and gives back the tiles it has left behind while more than
@@ -157,6 +157,9 @@ public:
   /// Level l's tiles built so far, and in all (0 for a whole level).
   std::int64_t builtTiles(int level) const;
   std::int64_t tileCount(int level) const;
+  /// The memory of the tiles: the most held at once (released tiles leave their room to
+  /// the next ones built).
+  std::size_t tileMemory() const;
   /// The tiles' bytes a query keeps built (past them it releases the ones it left behind).
   std::size_t keptTileBytes() const;
   void setKeptTileBytes(std::size_t bytes);

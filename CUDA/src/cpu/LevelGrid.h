@@ -38,12 +38,14 @@ struct LevelGrid
   bool pairedRows = false;
   // Optional: the CellBounds below.
   const float* cellBounds = nullptr;
-  // Tiled (LevelTiles.h): voxel (i, j, k)'s index is the sum over the axes of
-  // (c >> 3) * tileStride[a] + (c & 7) * stride[a], c its coordinate; a cell's upper
-  // corner may then lie in the next tile. The variance follows its mean (variance =
-  // mean + 1, the strides in floats).
+  // Tiled (LevelTiles.h): the cell whose lower corner is (i, j, k) lies in tile
+  // t = sum over the axes of (c >> 3) * tileStride[a], c its coordinate, and its lower
+  // corner at tileOffsets[t] + sum of (c & 7) * stride[a]; its other corners follow with
+  // the strides, in the same tile. The variance follows its mean (variance = mean + 1,
+  // the strides in floats).
   bool tiled = false;
   std::int64_t tileStride[3] = { 0, 0, 0 };
+  const std::int32_t* tileOffsets = nullptr;
 
   LevelGrid() = default;
   explicit LevelGrid(const MomentLevel& level)
@@ -113,7 +115,7 @@ inline void trilinearSample(const LevelGrid& g, double x, double y, double z, do
 {
   using IndexT = std::int64_t;
   const double p[3] = { x, y, z };
-  IndexT base = 0;
+  IndexT base = 0, tile = 0;
   IndexT step[3];
   double f[3];
   for (int a = 0; a < 3; ++a)
@@ -121,19 +123,19 @@ inline void trilinearSample(const LevelGrid& g, double x, double y, double z, do
     const double u = std::min(std::max((p[a] - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
     const IndexT lower = static_cast<IndexT>(u); // u >= 0: truncation is the floor
     f[a] = u - static_cast<double>(lower);
-    IndexT up = g.stride[a];
     if (g.tiled)
     {
-      const IndexT inTile = lower & 7;
-      base += (lower >> 3) * g.tileStride[a] + inTile * g.stride[a];
-      up = inTile == 7 ? g.tileStride[a] - 7 * g.stride[a] : g.stride[a];
+      tile += (lower >> 3) * g.tileStride[a];
+      base += (lower & 7) * g.stride[a];
     }
     else
     {
       base += lower * g.stride[a];
     }
-    step[a] = u < g.maxIndex[a] ? up : IndexT(0); // upper corner, clamped
+    step[a] = u < g.maxIndex[a] ? g.stride[a] : IndexT(0); // upper corner, clamped
   }
+  if (g.tiled)
+    base += g.tileOffsets[tile];
   auto blend = [&](const float* c) {
     auto lerp = [](double a, double b, double t) { return a + t * (b - a); };
     auto row = [&](IndexT i) { return lerp(c[i], c[i + step[0]], f[0]); };

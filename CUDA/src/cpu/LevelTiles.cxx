@@ -16,11 +16,13 @@ namespace detail
 {
 using namespace pyramid;
 
-LevelTiles::LevelTiles(const VolumeView& volume, const MomentLevel& geometry, int level, int firstStep, double shift)
+LevelTiles::LevelTiles(
+  TilePool& pool, const VolumeView& volume, const MomentLevel& geometry, int level, int firstStep, double shift)
   : Volume(volume)
   , Level(level)
   , FirstStep(firstStep)
   , Shift(shift)
+  , Pool(pool)
 {
   this->setGeometry(geometry);
   for (int a = 0; a < 3; ++a)
@@ -31,21 +33,68 @@ LevelTiles::LevelTiles(const VolumeView& volume, const MomentLevel& geometry, in
   this->State.reset(new std::atomic<std::uint8_t>[static_cast<std::size_t>(count)]);
   for (std::int64_t t = 0; t < count; ++t)
   {
-    this->State[t].store(0, std::memory_order_relaxed);
+    this->State[t].store(kAbsent, std::memory_order_relaxed);
   }
-  this->PoolBytes = static_cast<std::size_t>(count) * 2 * kTileVoxels * sizeof(float);
-  this->Pool = static_cast<float*>(allocateSparseStorage(this->PoolBytes));
-  if (!this->Pool)
-  {
-    throw std::bad_alloc();
-  }
+  this->Offsets.reset(new std::int32_t[static_cast<std::size_t>(count)]());
   this->prepareGrid();
   this->forgetMarks();
 }
 
-LevelTiles::~LevelTiles()
+LevelTiles::~LevelTiles() = default;
+
+std::int64_t LevelTiles::tilesOf(const Index3& dims)
 {
-  freeSparseStorage(this->Pool, this->PoolBytes);
+  std::int64_t count = 1;
+  for (int a = 0; a < 3; ++a)
+    count *= (dims[a] + kTileSide - 1) / kTileSide;
+  return count;
+}
+
+TilePool::TilePool(std::int64_t tiles)
+  : Capacity(static_cast<std::int32_t>(
+      std::min<std::int64_t>(tiles, std::numeric_limits<std::int32_t>::max() / kTileFloats)))
+{
+  this->Bytes = static_cast<std::size_t>(this->Capacity) * PyramidTiles::kTileBytes;
+  this->Pool = static_cast<float*>(allocateSparseStorage(this->Bytes));
+  if (!this->Pool)
+  {
+    throw std::bad_alloc();
+  }
+}
+
+TilePool::~TilePool()
+{
+  freeSparseStorage(this->Pool, this->Bytes);
+}
+
+std::int32_t TilePool::take()
+{
+  if (!this->Free.empty())
+  {
+    const std::int32_t offset = this->Free.back();
+    this->Free.pop_back();
+    return offset;
+  }
+  if (this->Used == this->Capacity)
+    throw std::bad_alloc();
+  return static_cast<std::int32_t>(this->Used++ * kTileFloats);
+}
+
+void TilePool::prepare()
+{
+  if (this->Used == this->Prepared)
+    return;
+  constexpr std::size_t kPage = 4096;
+  const std::size_t from = static_cast<std::size_t>(this->Prepared) * PyramidTiles::kTileBytes / kPage * kPage;
+  const std::size_t to = std::min(this->Bytes, (this->bytes() + kPage - 1) / kPage * kPage);
+  if (!prepareSparseStorage(reinterpret_cast<char*>(this->Pool) + from, to - from))
+    throw std::bad_alloc();
+  this->Prepared = this->Used;
+}
+
+std::size_t TilePool::bytes() const
+{
+  return static_cast<std::size_t>(this->Used) * PyramidTiles::kTileBytes;
 }
 
 void LevelTiles::setGeometry(const MomentLevel& geometry)
@@ -62,44 +111,46 @@ void LevelTiles::prepareGrid()
 {
   LevelGrid& g = this->Grid;
   g = LevelGrid(this->Geometry); // the geometry; the pointers and strides are the tiles'
-  g.mean = this->Pool; // (mean, variance) pairs: every index and stride counts floats
-  g.variance = this->Pool + 1;
+  g.mean = this->Pool.data(); // (mean, variance) pairs: every index and stride counts floats
+  g.variance = this->Pool.data() + 1;
   g.tiled = true;
   g.stride[0] = 2;
-  g.stride[1] = 2 * kTileSide;
-  g.stride[2] = 2 * kTileSide * kTileSide;
-  g.tileStride[0] = 2 * kTileVoxels;
-  g.tileStride[1] = g.tileStride[0] * this->Tiles[0];
-  g.tileStride[2] = g.tileStride[1] * this->Tiles[1];
-  g.narrowIndices = this->PoolBytes / sizeof(float) <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+  g.stride[1] = 2 * kTileSpan;
+  g.stride[2] = 2 * kTileSpan * kTileSpan;
+  g.tileStride[0] = 1;
+  g.tileStride[1] = this->Tiles[0];
+  g.tileStride[2] = this->Tiles[0] * this->Tiles[1];
+  g.tileOffsets = this->Offsets.get();
+  g.narrowIndices = this->tileCount() <= std::numeric_limits<std::int32_t>::max(); // offsets are 32-bit
   g.pairedRows = false;
 }
 
 void LevelTiles::markAround(double x, double y, double z)
 {
-  // The cell's lower corner as trilinearSample finds it, from the same grid numbers.
+  // The cell's lower corner as trilinearSample finds it, from the same grid numbers: the
+  // cell's tile holds all its corners.
   const LevelGrid& g = this->Grid;
   const double p[3] = { x, y, z };
-  std::int64_t lo[3], hi[3];
+  std::int64_t tile[3];
   for (int a = 0; a < 3; ++a)
   {
     const double u = std::min(std::max((p[a] - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
-    const std::int64_t lower = static_cast<std::int64_t>(u);
-    lo[a] = lower >> kTileShift;
-    hi[a] = std::min<std::int64_t>(this->Geometry.dims[a] - 1, lower + 1) >> kTileShift;
+    tile[a] = static_cast<std::int64_t>(u) >> kTileShift;
   }
   std::int64_t lowest = this->LowestMarked.load(std::memory_order_relaxed);
-  while (lo[2] < lowest && !this->LowestMarked.compare_exchange_weak(lowest, lo[2], std::memory_order_relaxed))
+  while (tile[2] < lowest && !this->LowestMarked.compare_exchange_weak(lowest, tile[2], std::memory_order_relaxed))
   {
   }
-  for (std::int64_t tz = lo[2]; tz <= hi[2]; ++tz)
-    for (std::int64_t ty = lo[1]; ty <= hi[1]; ++ty)
-      for (std::int64_t tx = lo[0]; tx <= hi[0]; ++tx)
-      {
-        std::atomic<std::uint8_t>& state = this->State[(tz * this->Tiles[1] + ty) * this->Tiles[0] + tx];
-        if (state.load(std::memory_order_relaxed) == 0)
-          state.store(1, std::memory_order_relaxed);
-      }
+  std::int64_t highest = this->HighestMarked.load(std::memory_order_relaxed);
+  while (tile[2] > highest && !this->HighestMarked.compare_exchange_weak(highest, tile[2], std::memory_order_relaxed))
+  {
+  }
+  std::atomic<std::uint8_t>& state = this->State[(tile[2] * this->Tiles[1] + tile[1]) * this->Tiles[0] + tile[0]];
+  const std::uint8_t now = state.load(std::memory_order_relaxed);
+  if (now == kAbsent)
+    state.store(kMarked, std::memory_order_relaxed);
+  else if (now == kBuilt)
+    state.store(kInUse, std::memory_order_relaxed);
 }
 
 std::int64_t LevelTiles::layerOf(double z) const
@@ -111,47 +162,51 @@ std::int64_t LevelTiles::layerOf(double z) const
 
 void LevelTiles::forgetMarks()
 {
+  // Tiles in use lie in the layers marked (built ones were marked first).
+  const std::int64_t perLayer = this->Tiles[0] * this->Tiles[1];
+  for (std::int64_t t = this->lowestMarked() * perLayer; t < (this->highestMarked() + 1) * perLayer; ++t)
+  {
+    if (this->State[t].load(std::memory_order_relaxed) == kInUse)
+      this->State[t].store(kBuilt, std::memory_order_relaxed);
+  }
   this->LowestMarked.store(this->Tiles[2], std::memory_order_relaxed);
+  this->HighestMarked.store(-1, std::memory_order_relaxed);
 }
 
 void LevelTiles::releaseLayer(std::int64_t layer)
 {
   const std::int64_t perLayer = this->Tiles[0] * this->Tiles[1];
-  std::int64_t released = 0;
   for (std::int64_t t = layer * perLayer; t < (layer + 1) * perLayer; ++t)
   {
-    if (this->State[t].load(std::memory_order_relaxed) == 2)
+    if (this->State[t].load(std::memory_order_relaxed) == kBuilt)
     {
-      this->State[t].store(0, std::memory_order_relaxed);
-      ++released;
+      this->State[t].store(kAbsent, std::memory_order_relaxed);
+      this->Pool.give(this->Offsets[t]);
+      this->Built.fetch_sub(1, std::memory_order_relaxed);
     }
-  }
-  if (released > 0)
-  {
-    releaseSparseStorage(this->Pool + layer * perLayer * 2 * kTileVoxels,
-      static_cast<std::size_t>(perLayer) * PyramidTiles::kTileBytes);
-    this->Built.fetch_sub(released, std::memory_order_relaxed);
   }
 }
 
 bool LevelTiles::buildMarked(const Execution& execution)
 {
-  // Runs of marked tiles along x (consecutive in memory): one window and one page
-  // preparation per run.
+  // Runs of marked tiles along x: one blurred block per run. Each tile takes a free slot,
+  // else the next one of the pool.
   std::vector<TileRun> runs;
   for (std::int64_t t = 0; t < this->tileCount(); ++t)
   {
-    if (this->State[t].load(std::memory_order_relaxed) != 1)
+    if (this->State[t].load(std::memory_order_relaxed) != kMarked)
       continue;
     if (!runs.empty() && runs.back().first + runs.back().count == t && t % this->Tiles[0] != 0)
       ++runs.back().count;
     else
       runs.push_back({ t, 1 });
+    this->Offsets[t] = this->Pool.take();
   }
   if (runs.empty())
   {
     return true;
   }
+  this->Pool.prepare();
   return dispatchScalarType(this->Volume.type, [&](auto tag) { return this->build<decltype(tag)>(runs, execution); });
 }
 
@@ -210,18 +265,13 @@ bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execut
     for (std::int64_t r = begin; r < end; ++r)
     {
       const TileRun& run = runs[static_cast<std::size_t>(r)];
-      float* first = this->Pool + run.first * 2 * kTileVoxels;
-      // The run's pages in one call, not a fault each: on some virtual machines a fault
-      // costs 17 us, more than blurring the tile.
-      if (!prepareSparseStorage(first, static_cast<std::size_t>(run.count) * 2 * kTileVoxels * sizeof(float)))
-        throw std::bad_alloc();
       const std::int64_t c[3] = { run.first % this->Tiles[0], (run.first / this->Tiles[0]) % this->Tiles[1],
         run.first / (this->Tiles[0] * this->Tiles[1]) };
       std::int64_t lo[3], hi[3];
       for (int a = 0; a < 3; ++a)
       {
         lo[a] = c[a] * kTileSide;
-        hi[a] = std::min(lo[a] + kTileSide * (a == 0 ? run.count : 1), n[a]);
+        hi[a] = std::min(lo[a] + kTileSide * (a == 0 ? run.count : 1) + 1, n[a]);
       }
       const std::int64_t width = hi[0] - lo[0], rows = (hi[1] - lo[1]) * (hi[2] - lo[2]);
       block.resize(static_cast<std::size_t>(2 * width * rows));
@@ -245,22 +295,26 @@ bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execut
         block0.mean = baseBlock.data();
         blurBlock(blur1, lo, hi, block.data());
       }
-      // Rows of the block to rows of its tiles (a partial tile's other voxels are never read).
-      const std::int64_t plane = width * rows;
+      // Rows of the block to rows of its tiles, (mean, variance) pairs (a partial tile's
+      // other voxels are never read).
+      const std::int64_t plane = width * rows, ny = hi[1] - lo[1];
       for (std::int64_t k = 0; k < run.count; ++k)
       {
-        float* tile = first + k * 2 * kTileVoxels;
-        const std::int64_t x0 = k * kTileSide, x1 = std::min(width, x0 + kTileSide);
+        float* tile = this->Pool.data() + this->Offsets[run.first + k];
+        const std::int64_t x0 = k * kTileSide, x1 = std::min(width, x0 + kTileSpan);
         for (std::int64_t z = 0; z < hi[2] - lo[2]; ++z)
-          for (std::int64_t y = 0; y < hi[1] - lo[1]; ++y)
+          for (std::int64_t y = 0; y < ny; ++y)
+          {
+            const float* mean = block.data() + (z * ny + y) * width;
+            const float* variance = mean + plane;
+            float* to = tile + 2 * (z * kTileSpan + y) * kTileSpan;
             for (std::int64_t x = x0; x < x1; ++x)
             {
-              const std::int64_t from = (z * (hi[1] - lo[1]) + y) * width + x;
-              const std::int64_t to = (z * kTileSide + y) * kTileSide + (x - x0);
-              tile[2 * to] = block[from];
-              tile[2 * to + 1] = block[plane + from];
+              to[2 * (x - x0)] = mean[x];
+              to[2 * (x - x0) + 1] = variance[x];
             }
-        this->State[run.first + k].store(2, std::memory_order_release);
+          }
+        this->State[run.first + k].store(kInUse, std::memory_order_release);
       }
       this->Built.fetch_add(run.count, std::memory_order_relaxed);
       this->Made.fetch_add(run.count, std::memory_order_relaxed);
@@ -298,7 +352,7 @@ void PyramidTiles::forgetMarks()
     level->forgetMarks();
 }
 
-void PyramidTiles::releaseBelowMarks()
+void PyramidTiles::releaseBehind(bool up)
 {
   // Level l goes while its tiles and the coarser ones' take more than keptBytes: a finer
   // level's tiles are released to keep the coarser ones, never the other way.
@@ -310,10 +364,13 @@ void PyramidTiles::releaseBelowMarks()
         bytes += static_cast<std::size_t>(this->levels[m]->builtTiles()) * kTileBytes;
       return bytes;
     };
+    // From the farthest layer behind to the farthest one marked (none: every layer).
     LevelTiles& level = *this->levels[l];
-    const std::int64_t below = std::min(level.lowestMarked(), level.layerCount());
-    for (std::int64_t layer = 0; layer < below && heldFrom() > this->keptBytes; ++layer)
-      level.releaseLayer(layer);
+    const std::int64_t top = level.layerCount() - 1;
+    const bool marked = level.highestMarked() >= 0;
+    const std::int64_t layers = up ? (marked ? level.highestMarked() + 1 : top + 1) : (marked ? top + 1 - level.lowestMarked() : top + 1);
+    for (std::int64_t k = 0; k < layers && heldFrom() > this->keptBytes; ++k)
+      level.releaseLayer(up ? k : top - k);
   }
 }
 

@@ -1,5 +1,5 @@
 // Levels 0 and 1 of a SurfacePyramid (vao/VarianceOcclusionMap.h), kept in tiles of 8^3
-// voxels built only where the surface queries sample: a query first marks the tiles its
+// cells built only where the surface queries sample: a query first marks the tiles its
 // samples touch, then buildMarked blurs those tiles from the volume (PyramidBlur.h, the
 // same arithmetic as the whole level: level 1's tiles blur a block of level 0 computed
 // for them), then the query samples; SurfaceSweep.h does this slab by slab and releases
@@ -7,11 +7,15 @@
 // tenth of level 0's tiles and a fifth of level 1's; the two levels held 96% of a whole
 // pyramid.
 //
-// Layout. Tile (tx, ty, tz), x fastest, is 1024 floats: the (mean, variance) pairs of its
-// voxels, x fastest within the tile, so a tile is one 4 KiB page and a corner's two
-// numbers are one 8-byte load. The tiles live at fixed places in one reservation of the whole level's size whose
-// pages the system backs only when written (allocateSparseStorage): the index of a voxel
-// is arithmetic (LevelGrid's tiled form), and the memory used is the tiles built.
+// Layout. Tile (tx, ty, tz) serves the trilinear cells whose lower corner lies in
+// [8 tx, 8 tx + 8) x ... and holds the 9^3 voxels those cells read, [8 tx, 8 tx + 9) x
+// ... (the ninth is the next tile's first again): 1458 floats, the (mean, variance) pairs
+// of its voxels, x fastest, so a sample reads one tile and a corner's two numbers are
+// one 8-byte load. Built tiles take slots of one pool, found through a table of float
+// offsets (LevelGrid's tileOffsets); a released tile's slot goes to the next tile built.
+// The pool is a reservation whose pages the system backs when first written
+// (allocateSparseStorage): its memory is the most tiles held at once, and reusing slots
+// costs no page fault (17 us each on some virtual machines, more than a tile's blur).
 #pragma once
 
 #include "vao/VarianceOcclusionMap.h"
@@ -29,18 +33,52 @@ namespace detail
 {
 
 constexpr int kTileShift = 3;
-constexpr std::int64_t kTileSide = 1 << kTileShift;
-constexpr std::int64_t kTileVoxels = kTileSide * kTileSide * kTileSide;
+constexpr std::int64_t kTileSide = 1 << kTileShift;  // cells per tile and axis
+constexpr std::int64_t kTileSpan = kTileSide + 1;    // voxels per tile and axis
+constexpr std::int64_t kTileFloats = 2 * kTileSpan * kTileSpan * kTileSpan;
+
+/// The slots that the tiled levels' tiles take (kTileFloats floats each): a reservation
+/// backed as far as slots were ever handed out, released slots going to the next tiles.
+class TilePool
+{
+public:
+  /// Room for `tiles` tiles, or for as many as 32-bit float offsets reach (1.47 M tiles,
+  /// 8.6 GB held at once). Throws std::bad_alloc when the address space is not there.
+  explicit TilePool(std::int64_t tiles);
+  ~TilePool();
+  TilePool(const TilePool&) = delete;
+  TilePool& operator=(const TilePool&) = delete;
+
+  float* data() const { return this->Pool; }
+  /// A slot's first float. Throws std::bad_alloc when the pool is full.
+  std::int32_t take();
+  void give(std::int32_t offset) { this->Free.push_back(offset); }
+  /// Backs the slots handed out since the last call, in one call, not a fault a page (on
+  /// some virtual machines a fault costs 17 us, more than blurring a tile). Throws
+  /// std::bad_alloc when the system has no memory for them.
+  void prepare();
+  /// The memory of the slots ever handed out: the most tiles held at once.
+  std::size_t bytes() const;
+
+private:
+  float* Pool = nullptr;
+  std::size_t Bytes = 0;
+  std::int32_t Capacity = 0; // slots
+  std::int32_t Used = 0;     // slots ever handed out
+  std::int32_t Prepared = 0; // slots backed
+  std::vector<std::int32_t> Free;
+};
 
 class LevelTiles
 {
 public:
   /// Level `level` (0 or 1) of the pyramid of `volume` whose level 0 keeps every
   /// `firstStep`-th voxel (its dims in `geometry`, whose arrays stay empty), moments
-  /// shifted by `shift`. Reserves the whole level's address space (throws std::bad_alloc
+  /// shifted by `shift`, its tiles in `pool` (which must outlive it). Throws std::bad_alloc
   /// when it cannot); builds nothing. The volume is read whenever tiles are built: it must
   /// outlive this object, unchanged.
-  LevelTiles(const VolumeView& volume, const MomentLevel& geometry, int level, int firstStep, double shift);
+  LevelTiles(TilePool& pool, const VolumeView& volume, const MomentLevel& geometry, int level, int firstStep,
+    double shift);
   ~LevelTiles();
   LevelTiles(const LevelTiles&) = delete;
   LevelTiles& operator=(const LevelTiles&) = delete;
@@ -64,17 +102,21 @@ public:
   /// The layer of tiles (along z) holding world z, clamped to the level.
   std::int64_t layerOf(double z) const;
   std::int64_t layerCount() const { return this->Tiles[2]; }
-  /// The lowest layer markAround reached since forgetMarks (layerCount() when none).
+  /// The lowest and highest layers markAround reached since forgetMarks (layerCount()
+  /// and -1 when none). forgetMarks also ends the use of the tiles marked.
   std::int64_t lowestMarked() const { return this->LowestMarked.load(std::memory_order_relaxed); }
+  std::int64_t highestMarked() const { return this->HighestMarked.load(std::memory_order_relaxed); }
   void forgetMarks();
-  /// Gives the memory of layer `layer`'s built tiles back; they are built again when
-  /// marked again. Not while tiles are being marked, built or sampled.
+  /// Frees the slots of layer `layer`'s built tiles not in use for other tiles; they are
+  /// built again when marked again. Not while tiles are being marked, built or sampled.
   void releaseLayer(std::int64_t layer);
 
   std::int64_t builtTiles() const { return this->Built.load(std::memory_order_relaxed); }
   /// Tiles built since construction, those built again after a release included.
   std::int64_t madeTiles() const { return this->Made.load(std::memory_order_relaxed); }
   std::int64_t tileCount() const { return this->Tiles[0] * this->Tiles[1] * this->Tiles[2]; }
+  /// The tiles of a level of `dims` voxels.
+  static std::int64_t tilesOf(const Index3& dims);
 
 private:
   struct TileRun
@@ -92,11 +134,20 @@ private:
   int FirstStep;
   double Shift;
   Index3 Tiles;
-  std::unique_ptr<std::atomic<std::uint8_t>[]> State; // 0 absent, 1 marked, 2 built
+  // A tile is absent, marked (to build), built, or in use (built and marked since
+  // forgetMarks: the samples to come read it).
+  enum : std::uint8_t
+  {
+    kAbsent,
+    kMarked,
+    kBuilt,
+    kInUse
+  };
+  std::unique_ptr<std::atomic<std::uint8_t>[]> State;
+  std::unique_ptr<std::int32_t[]> Offsets;            // a built tile's first float in the pool
   std::atomic<std::int64_t> Built{ 0 }, Made{ 0 };
-  std::atomic<std::int64_t> LowestMarked{ 0 };
-  float* Pool = nullptr;
-  std::size_t PoolBytes = 0;
+  std::atomic<std::int64_t> LowestMarked{ 0 }, HighestMarked{ -1 };
+  TilePool& Pool;
   LevelGrid Grid;
 };
 
@@ -105,11 +156,16 @@ class PyramidTiles
 {
 public:
   static constexpr int kLevels = 2;
-  static constexpr std::size_t kTileBytes = 2 * kTileVoxels * sizeof(float);
+  static constexpr std::size_t kTileBytes = kTileFloats * sizeof(float);
+  std::unique_ptr<TilePool> pool; // the levels' tiles, declared first: it outlives them
   std::vector<std::unique_ptr<LevelTiles>> levels;
   /// The built tiles' memory a query keeps (SurfaceSweep.h): past it, it releases the
   /// layers its sweep has left behind.
   std::size_t keptBytes = static_cast<std::size_t>(-1);
+  /// The direction of the next sweep along z. Each turns back: it starts where the last
+  /// one ended, among the tiles that one kept, so those take no room beside the ones it
+  /// builds first.
+  bool upward = true;
 
   /// Level l's tiles, or nullptr when level l is whole.
   LevelTiles* at(int l) const { return l >= 0 && l < static_cast<int>(this->levels.size()) ? this->levels[l].get() : nullptr; }
@@ -118,11 +174,12 @@ public:
   bool buildMarked(const Execution& execution);
   std::size_t builtBytes() const;
   void forgetMarks();
-  /// Releases the layers below each level's lowest marked one (those a sweep up along z
-  /// has left behind), lowest first: level 0's while more than keptBytes are built, then
-  /// level 1's while level 1 alone takes more. (A tile of level 1 costs about fifteen of
-  /// level 0 to build: it blurs the block of level 0 under it.)
-  void releaseBelowMarks();
+  /// Releases the tiles not in use that a sweep along z going `up` has left behind or
+  /// passes (in the layers up to its highest marked one; going down, down to its lowest;
+  /// every layer when none is marked), farthest first: level 0's while more than
+  /// keptBytes are built, then level 1's while level 1 alone takes more. (A tile of level
+  /// 1 costs about fifteen of level 0 to build: it blurs the block of level 0 under it.)
+  void releaseBehind(bool up);
 };
 
 } // namespace detail

@@ -112,6 +112,7 @@ VAO_AVX2_HELPER CellsAvx2 cellsAvx2(const LevelGrid& g, const __m256d* position)
   const __m256d zero = _mm256_setzero_pd();
   CellsAvx2 c;
   c.base = _mm_setzero_si128();
+  __m128i tile = _mm_setzero_si128();
   for (int a = 0; a < 3; ++a)
   {
     const __m256d maxIndex = _mm256_set1_pd(g.maxIndex[a]);
@@ -123,16 +124,12 @@ VAO_AVX2_HELPER CellsAvx2 cellsAvx2(const LevelGrid& g, const __m256d* position)
       lower = _mm_min_epi32(lower, _mm_set1_epi32(static_cast<int>(g.maxIndex[0]) - 1));
     c.lower[a] = lower;
     c.f[a] = _mm256_sub_pd(u, _mm256_cvtepi32_pd(lower));
-    __m128i stride = _mm_set1_epi32(static_cast<int>(g.stride[a]));
-    if (g.tiled) // trilinearSample's tiled index; the step to the next tile where the cell crosses
+    const __m128i stride = _mm_set1_epi32(static_cast<int>(g.stride[a]));
+    if (g.tiled) // trilinearSample's tiled index: the tile, and the corner within it
     {
-      const __m128i seven = _mm_set1_epi32(7);
-      const __m128i inTile = _mm_and_si128(lower, seven);
       const __m128i tileStride = _mm_set1_epi32(static_cast<int>(g.tileStride[a]));
-      c.base = _mm_add_epi32(c.base, _mm_add_epi32(_mm_mullo_epi32(_mm_srli_epi32(lower, 3), tileStride),
-                                       _mm_mullo_epi32(inTile, stride)));
-      const __m128i across = _mm_sub_epi32(tileStride, _mm_mullo_epi32(seven, stride));
-      stride = _mm_blendv_epi8(stride, across, _mm_cmpeq_epi32(inTile, seven));
+      tile = _mm_add_epi32(tile, _mm_mullo_epi32(_mm_srli_epi32(lower, 3), tileStride));
+      c.base = _mm_add_epi32(c.base, _mm_mullo_epi32(_mm_and_si128(lower, _mm_set1_epi32(7)), stride));
     }
     else
       c.base = _mm_add_epi32(c.base, _mm_mullo_epi32(lower, stride));
@@ -142,6 +139,8 @@ VAO_AVX2_HELPER CellsAvx2 cellsAvx2(const LevelGrid& g, const __m256d* position)
       _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(below, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
     c.step[a] = _mm_and_si128(narrow, stride);
   }
+  if (g.tiled)
+    c.base = _mm_add_epi32(c.base, _mm_i32gather_epi32(g.tileOffsets, tile, 4));
   return c;
 }
 

@@ -179,9 +179,15 @@ Status buildSurfaceLevels(const VolumeView& volume, const std::array<double, 3>&
   auto tiles = std::make_unique<PyramidTiles>();
   tiles->keptBytes = static_cast<std::size_t>(volume.voxelCount()) *
     dispatchScalarType(volume.type, [](auto tag) { return sizeof(tag); }) / kKeptTilesPerInputByte;
+  std::int64_t tileCount = 0;
   for (int l = 0; l < tiled; ++l)
   {
-    tiles->levels.emplace_back(new LevelTiles(volume, result[l], l, setup.firstStep, shift));
+    tileCount += LevelTiles::tilesOf(result[l].dims);
+  }
+  tiles->pool = std::make_unique<TilePool>(tileCount);
+  for (int l = 0; l < tiled; ++l)
+  {
+    tiles->levels.emplace_back(new LevelTiles(*tiles->pool, volume, result[l], l, setup.firstStep, shift));
   }
   SurfacePyramidAccess::tiles(pyramid) = std::move(tiles);
   SurfacePyramidAccess::levels(pyramid) = std::move(result);
@@ -205,6 +211,11 @@ std::int64_t SurfacePyramid::builtTiles(int level) const
 {
   const detail::LevelTiles* tiles = this->Tiles ? this->Tiles->at(level) : nullptr;
   return tiles ? tiles->builtTiles() : 0;
+}
+
+std::size_t SurfacePyramid::tileMemory() const
+{
+  return this->Tiles && this->Tiles->pool ? this->Tiles->pool->bytes() : 0;
 }
 
 std::size_t SurfacePyramid::keptTileBytes() const

@@ -46,8 +46,8 @@ SlabOrder slabOrder(const LevelTiles& level, const P* points, std::int64_t count
 }
 
 /// sample(lanes) for every batch of the points. With `tiles`, slab by slab: first
-/// mark(lanes, *tiles) for the slab's batches and the marked tiles built, and the layers
-/// left behind released after. Progress: each slab its share of the points (marking
+/// mark(lanes, *tiles) for the slab's batches, the layers left behind released, and the
+/// marked tiles built. Progress: each slab its share of the points (marking
 /// the first tenth of it, building to 0.3, sampling the rest). Returns false when
 /// cancelled.
 template <class P, class Mark, class Sample>
@@ -65,10 +65,12 @@ bool sweepPoints(PyramidTiles* tiles, const P* points, const P* normals, std::in
   else
     slabs.begin = { 0, count };
   const std::int64_t slabCount = static_cast<std::int64_t>(slabs.begin.size()) - 1;
+  const bool up = tiles->upward;
+  tiles->upward = !up;
   std::int64_t done = 0;
   for (std::int64_t s = 0; s < slabCount; ++s)
   {
-    const std::size_t i = static_cast<std::size_t>(s);
+    const std::size_t i = static_cast<std::size_t>(up ? s : slabCount - 1 - s);
     const PointRange range{ slabs.order.empty() ? nullptr : slabs.order.data(), slabs.begin[i],
       slabs.begin[i + 1] - slabs.begin[i] };
     if (range.count == 0)
@@ -78,17 +80,21 @@ bool sweepPoints(PyramidTiles* tiles, const P* points, const P* normals, std::in
     done += range.count;
     tiles->forgetMarks();
     if (!forEachBatch(points, normals, range, stageExecution(slab, 0.0, 0.1),
-          [&](const PointLanes& lanes) { mark(lanes, *tiles); }) ||
-      !tiles->buildMarked(stageExecution(slab, 0.1, 0.3)) ||
+          [&](const PointLanes& lanes) { mark(lanes, *tiles); }))
+    {
+      return false;
+    }
+    // What the slab does not reach goes before its new tiles come.
+    tiles->releaseBehind(up);
+    if (!tiles->buildMarked(stageExecution(slab, 0.1, 0.3)) ||
       !forEachBatch(points, normals, range, stageExecution(slab, 0.3, 1.0), sample))
     {
       return false;
     }
-    tiles->releaseBelowMarks();
   }
   // Every layer is behind the sweep now.
   tiles->forgetMarks();
-  tiles->releaseBelowMarks();
+  tiles->releaseBehind(up);
   return true;
 }
 
