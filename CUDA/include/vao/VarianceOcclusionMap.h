@@ -135,7 +135,7 @@ class PyramidTiles;
 /// half-voxel query, the shadow march's steps on those levels), so a surface holds a
 /// small part of them. It sweeps its points in slabs along z, building a slab's tiles
 /// before sampling it, and gives back the tiles it has left behind while more than
-/// keptTileBytes() are built (by default a fifth of the volume's bytes): a large surface
+/// keptTileBytes() are built (by default a fifth of the volume's bytes, at least 16 MiB): a large surface
 /// holds the tiles near one slab plus those kept, which the next query finds built.
 /// Levels 2 and up are whole. Every result equals the one from
 /// buildMomentPyramid's whole pyramid bit for bit. Tiles are built from the volume: the
