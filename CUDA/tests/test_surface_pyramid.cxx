@@ -298,6 +298,68 @@ TEST(SurfacePyramid, SweepsInSlabsHoldingLittleMoreThanItKeeps)
   EXPECT_LT(made(half) - first, first * 3 / 4) << "the second query finds the tiles the first kept";
 }
 
+TEST(SurfacePyramid, AQueryAfterAnAbortedOneLosesNothing)
+{
+  // An AO query aborted at each of its checks in turn leaves tiles marked (some with a
+  // slot taken), built or in use. The next, complete query (the AO again, or a shadow of
+  // the sphere's points alone, whose slabs miss the layers of most others) gives the
+  // whole pyramid's results. With every tile kept, each slot taken holds a built tile (a
+  // marked tile's slot taken again would be lost); with none kept, it ends holding none
+  // (a tile left in use would never be released).
+  const Field f = shellScene({ 30, 28, 90 });
+  std::vector<double> points, normals;
+  scenePoints(f, points, normals);
+  const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
+  vao::PyramidParameters pp;
+  std::vector<vao::MomentLevel> whole;
+  ASSERT_TRUE(vao::buildMomentPyramid(f.view(), f.origin, f.spacing, pp, whole).ok);
+  const std::int64_t sphere = n - 150; // scenePoints: the sphere's, then 150 anywhere
+  std::vector<float> expectedAo(n), expectedShadow(n), got(n);
+  const std::array<double, 3> light = { 0.3, -0.2, 1.0 };
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing, points.data(), normals.data(), n,
+    {}, expectedAo.data()).ok);
+  ASSERT_TRUE(vao::surfaceShadow(whole, points.data(), normals.data(), n, light, {}, expectedShadow.data()).ok);
+  for (std::size_t kept : { static_cast<std::size_t>(-1), std::size_t(0) })
+  {
+    int aborted = 0;
+    for (int checks = 0; checks < 1000; ++checks)
+    {
+      vao::SurfacePyramid surface = surfacePyramidOf(f, pp);
+      surface.setKeptTileBytes(kept);
+      int calls = 0;
+      vao::Execution abort;
+      abort.threads = 2;
+      abort.abortRequested = [&] { return ++calls > checks; };
+      if (vao::surfaceAmbientOcclusion(surface, f.view(), f.origin, f.spacing, points.data(), normals.data(), n, {},
+            got.data(), abort).ok)
+        break;
+      ++aborted;
+      for (bool shadow : { false, true })
+      {
+        vao::SurfacePyramid again = surfacePyramidOf(f, pp);
+        again.setKeptTileBytes(kept);
+        calls = 0;
+        ASSERT_FALSE(vao::surfaceAmbientOcclusion(again, f.view(), f.origin, f.spacing, points.data(),
+          normals.data(), n, {}, got.data(), abort).ok);
+        std::fill(got.begin(), got.end(), -1.0f);
+        const std::int64_t m = shadow ? sphere : n;
+        ASSERT_TRUE(shadow ? vao::surfaceShadow(again, points.data(), normals.data(), m, light, {}, got.data()).ok
+                           : vao::surfaceAmbientOcclusion(again, f.view(), f.origin, f.spacing, points.data(),
+                               normals.data(), m, {}, got.data()).ok);
+        const std::vector<float>& expected = shadow ? expectedShadow : expectedAo;
+        ASSERT_TRUE(std::equal(got.begin(), got.begin() + m, expected.begin())) << "after an abort at check " << checks;
+        const std::int64_t held = again.builtTiles(0) + again.builtTiles(1);
+        if (kept == 0)
+          ASSERT_EQ(held, 0) << "after an abort at check " << checks << ", shadow " << shadow;
+        else
+          ASSERT_EQ(vao::SurfacePyramidAccess::tiles(again)->pool->taken(), held)
+            << "after an abort at check " << checks << ", shadow " << shadow;
+      }
+    }
+    EXPECT_GT(aborted, 10);
+  }
+}
+
 TEST(SurfacePyramid, BadInputFailsWithMessage)
 {
   vao::SurfacePyramid empty;

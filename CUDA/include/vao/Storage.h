@@ -30,9 +30,6 @@ void freeSparseStorage(void* block, std::size_t bytes) noexcept;
 /// False when the system has no memory left for them (writing them would bring the
 /// out-of-memory killer): the caller fails cleanly instead.
 bool prepareSparseStorage(void* at, std::size_t bytes) noexcept;
-/// Gives [at, at + bytes) of a sparse reservation (page aligned) back to the system where
-/// it can (Linux): the pages take memory only once written again. Their contents are lost.
-void releaseSparseStorage(void* at, std::size_t bytes) noexcept;
 } // namespace detail
 
 /// An array of T in storage. resize leaves the elements uninitialised: the kernels write

@@ -121,7 +121,9 @@ void LevelTiles::prepareGrid()
   g.tileStride[1] = this->Tiles[0];
   g.tileStride[2] = this->Tiles[0] * this->Tiles[1];
   g.tileOffsets = this->Offsets.get();
-  g.narrowIndices = this->tileCount() <= std::numeric_limits<std::int32_t>::max(); // offsets are 32-bit
+  // The gathers take tile indices and float offsets in 32 bits; the pool's capacity
+  // bounds the offsets.
+  g.narrowIndices = this->tileCount() <= std::numeric_limits<std::int32_t>::max();
   g.pairedRows = false;
 }
 
@@ -173,6 +175,25 @@ void LevelTiles::forgetMarks()
   this->HighestMarked.store(-1, std::memory_order_relaxed);
 }
 
+void LevelTiles::settle()
+{
+  for (std::int64_t t = 0; t < this->tileCount(); ++t)
+  {
+    const std::uint8_t state = this->State[t].load(std::memory_order_relaxed);
+    if (state == kInUse)
+      this->State[t].store(kBuilt, std::memory_order_relaxed);
+    else if (state == kMarked || state == kSlotted)
+    {
+      if (state == kSlotted)
+        this->Pool.give(this->Offsets[t]);
+      this->Offsets[t] = 0;
+      this->State[t].store(kAbsent, std::memory_order_relaxed);
+    }
+  }
+  this->LowestMarked.store(this->Tiles[2], std::memory_order_relaxed);
+  this->HighestMarked.store(-1, std::memory_order_relaxed);
+}
+
 void LevelTiles::releaseLayer(std::int64_t layer)
 {
   const std::int64_t perLayer = this->Tiles[0] * this->Tiles[1];
@@ -182,6 +203,7 @@ void LevelTiles::releaseLayer(std::int64_t layer)
     {
       this->State[t].store(kAbsent, std::memory_order_relaxed);
       this->Pool.give(this->Offsets[t]);
+      this->Offsets[t] = 0;
       this->Built.fetch_sub(1, std::memory_order_relaxed);
     }
   }
@@ -201,6 +223,7 @@ bool LevelTiles::buildMarked(const Execution& execution)
     else
       runs.push_back({ t, 1 });
     this->Offsets[t] = this->Pool.take();
+    this->State[t].store(kSlotted, std::memory_order_relaxed);
   }
   if (runs.empty())
   {
@@ -338,11 +361,11 @@ bool PyramidTiles::buildMarked(const Execution& execution)
   return true;
 }
 
-std::size_t PyramidTiles::builtBytes() const
+std::size_t PyramidTiles::builtBytes(std::size_t from) const
 {
   std::size_t bytes = 0;
-  for (const auto& level : this->levels)
-    bytes += static_cast<std::size_t>(level->builtTiles()) * kTileBytes;
+  for (std::size_t l = from; l < this->levels.size(); ++l)
+    bytes += static_cast<std::size_t>(this->levels[l]->builtTiles()) * kTileBytes;
   return bytes;
 }
 
@@ -352,24 +375,25 @@ void PyramidTiles::forgetMarks()
     level->forgetMarks();
 }
 
+void PyramidTiles::settle()
+{
+  for (const auto& level : this->levels)
+    level->settle();
+}
+
 void PyramidTiles::releaseBehind(bool up)
 {
   // Level l goes while its tiles and the coarser ones' take more than keptBytes: a finer
   // level's tiles are released to keep the coarser ones, never the other way.
   for (std::size_t l = 0; l < this->levels.size(); ++l)
   {
-    auto heldFrom = [&] {
-      std::size_t bytes = 0;
-      for (std::size_t m = l; m < this->levels.size(); ++m)
-        bytes += static_cast<std::size_t>(this->levels[m]->builtTiles()) * kTileBytes;
-      return bytes;
-    };
     // From the farthest layer behind to the farthest one marked (none: every layer).
     LevelTiles& level = *this->levels[l];
     const std::int64_t top = level.layerCount() - 1;
     const bool marked = level.highestMarked() >= 0;
-    const std::int64_t layers = up ? (marked ? level.highestMarked() + 1 : top + 1) : (marked ? top + 1 - level.lowestMarked() : top + 1);
-    for (std::int64_t k = 0; k < layers && heldFrom() > this->keptBytes; ++k)
+    const std::int64_t layers =
+      !marked ? top + 1 : up ? level.highestMarked() + 1 : top + 1 - level.lowestMarked();
+    for (std::int64_t k = 0; k < layers && this->builtBytes(l) > this->keptBytes; ++k)
       level.releaseLayer(up ? k : top - k);
   }
 }

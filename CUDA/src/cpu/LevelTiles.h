@@ -59,6 +59,8 @@ public:
   void prepare();
   /// The memory of the slots ever handed out: the most tiles held at once.
   std::size_t bytes() const;
+  /// The slots handed out and not given back.
+  std::int64_t taken() const { return this->Used - static_cast<std::int64_t>(this->Free.size()); }
 
 private:
   float* Pool = nullptr;
@@ -107,6 +109,9 @@ public:
   std::int64_t lowestMarked() const { return this->LowestMarked.load(std::memory_order_relaxed); }
   std::int64_t highestMarked() const { return this->HighestMarked.load(std::memory_order_relaxed); }
   void forgetMarks();
+  /// Leaves every tile absent or built, as a query finds them: what an aborted one left
+  /// marked goes (giving back its slot if it had one), what it left in use is built.
+  void settle();
   /// Frees the slots of layer `layer`'s built tiles not in use for other tiles; they are
   /// built again when marked again. Not while tiles are being marked, built or sampled.
   void releaseLayer(std::int64_t layer);
@@ -134,17 +139,21 @@ private:
   int FirstStep;
   double Shift;
   Index3 Tiles;
-  // A tile is absent, marked (to build), built, or in use (built and marked since
-  // forgetMarks: the samples to come read it).
+  // A tile is absent, marked (to build), slotted (given its slot, being built), built, or
+  // in use (built and marked since forgetMarks: the samples to come read it).
   enum : std::uint8_t
   {
     kAbsent,
     kMarked,
+    kSlotted,
     kBuilt,
     kInUse
   };
   std::unique_ptr<std::atomic<std::uint8_t>[]> State;
-  std::unique_ptr<std::int32_t[]> Offsets;            // a built tile's first float in the pool
+  // A tile's first float in the pool; 0 (a slot that can be read) for a tile without one:
+  // lanes that pad a batch or have left the volume read their clamped cell's tile, and
+  // their samples are discarded.
+  std::unique_ptr<std::int32_t[]> Offsets;
   std::atomic<std::int64_t> Built{ 0 }, Made{ 0 };
   std::atomic<std::int64_t> LowestMarked{ 0 }, HighestMarked{ -1 };
   TilePool& Pool;
@@ -172,8 +181,11 @@ public:
   int count() const { return static_cast<int>(this->levels.size()); }
   /// buildMarked of every tiled level.
   bool buildMarked(const Execution& execution);
-  std::size_t builtBytes() const;
+  /// The bytes of the built tiles of levels `from` and up.
+  std::size_t builtBytes(std::size_t from = 0) const;
   void forgetMarks();
+  /// settle of every tiled level.
+  void settle();
   /// Releases the tiles not in use that a sweep along z going `up` has left behind or
   /// passes (in the layers up to its highest marked one; going down, down to its lowest;
   /// every layer when none is marked), farthest first: level 0's while more than

@@ -88,16 +88,6 @@ void freeSparseStorage(void* block, std::size_t bytes) noexcept
 #endif
 }
 
-void releaseSparseStorage(void* at, std::size_t bytes) noexcept
-{
-#if defined(__linux__)
-  madvise(at, bytes, MADV_DONTNEED);
-#else
-  (void)at; // the reservation is an ordinary block here
-  (void)bytes;
-#endif
-}
-
 bool prepareSparseStorage(void* at, std::size_t bytes) noexcept
 {
 #if defined(__linux__)
