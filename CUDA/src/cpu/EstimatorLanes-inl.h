@@ -202,3 +202,20 @@ VAO_LANES_ENTRY void opennessFromExactSumsLanes(const std::int64_t* sum, const s
   }
   plain(n, n - n % kWidth);
 }
+
+/// This width's row loops for a dispatch written once over the widths (EstimatorRows.cxx):
+/// on a row's statistics, and on its exact sums.
+struct RowLoops
+{
+  template <Method M, class Row, class Plain>
+  static void onStatistics(const Row& row, const double* query, double isoValue, float* openness, Plain&& plain)
+  {
+    opennessRowLanes<M>(row, query, isoValue, openness, plain);
+  }
+  template <Method M, class Row, class Plain>
+  static void onExactSums(const Row& row, const double* query, double isoValue, float* openness, Plain&& plain)
+  {
+    opennessFromExactSumsLanes<M>(
+      row.sum, row.sumSquares, row.countX, row.countYZ, row.size, query, isoValue, openness, plain);
+  }
+};

@@ -8,8 +8,6 @@
 
 #include "EstimatorLanes.h"
 
-#include <type_traits>
-
 namespace vao
 {
 namespace detail
@@ -44,11 +42,11 @@ void opennessRange(Method method, ErfMode erfMode, const NeighbourhoodRow& row, 
 }
 
 #if VAO_HAVE_AVX2_TARGET
-/// The lane loops of the tier's namespace (avx2 or avx512), by method: `sumLanes` on exact
-/// sums, else `lanes`.
-template <class Lanes, class SumLanes>
-void opennessRowVector(Method method, const NeighbourhoodRow& row, const double* query, double isoValue,
-  float* openness, Lanes lanes, SumLanes sumLanes)
+/// The row loops of a width (avx2::RowLoops or avx512::RowLoops) by method: on exact sums
+/// where the row has them for it, else on its statistics.
+template <class Loops>
+void opennessRowVector(
+  Method method, const NeighbourhoodRow& row, const double* query, double isoValue, float* openness)
 {
   if (takesExactSums(method, row))
   {
@@ -56,20 +54,20 @@ void opennessRowVector(Method method, const NeighbourhoodRow& row, const double*
       opennessRange(method, ErfMode::Exact, row, query, isoValue, openness, begin, end);
     };
     if (method == Method::Chebyshev)
-      sumLanes(std::integral_constant<Method, Method::Chebyshev>(), plain);
+      Loops::template onExactSums<Method::Chebyshev>(row, query, isoValue, openness, plain);
     else
-      sumLanes(std::integral_constant<Method, Method::GaussianCdf>(), plain);
+      Loops::template onExactSums<Method::GaussianCdf>(row, query, isoValue, openness, plain);
     return;
   }
   const auto plain = [&](std::int64_t begin) {
     opennessRange(method, ErfMode::Exact, row, query, isoValue, openness, begin, row.size);
   };
   if (method == Method::Chebyshev)
-    lanes(std::integral_constant<Method, Method::Chebyshev>(), plain);
+    Loops::template onStatistics<Method::Chebyshev>(row, query, isoValue, openness, plain);
   else if (method == Method::CdfReconstruction)
-    lanes(std::integral_constant<Method, Method::CdfReconstruction>(), plain);
+    Loops::template onStatistics<Method::CdfReconstruction>(row, query, isoValue, openness, plain);
   else
-    lanes(std::integral_constant<Method, Method::GaussianCdf>(), plain);
+    Loops::template onStatistics<Method::GaussianCdf>(row, query, isoValue, openness, plain);
 }
 #endif
 
@@ -96,21 +94,9 @@ void opennessRow(Method method, ErfMode erfMode, const NeighbourhoodRow& row, co
   if (opennessRowIsVector(method, erfMode))
   {
     if (cpuSimdTier() >= SimdTier::Avx512)
-      opennessRowVector(
-        method, row, query, isoValue, openness,
-        [&](auto m, auto& plain) { avx512::opennessRowLanes<decltype(m)::value>(row, query, isoValue, openness, plain); },
-        [&](auto m, auto& plain) {
-          avx512::opennessFromExactSumsLanes<decltype(m)::value>(
-            row.sum, row.sumSquares, row.countX, row.countYZ, row.size, query, isoValue, openness, plain);
-        });
+      opennessRowVector<avx512::RowLoops>(method, row, query, isoValue, openness);
     else
-      opennessRowVector(
-        method, row, query, isoValue, openness,
-        [&](auto m, auto& plain) { avx2::opennessRowLanes<decltype(m)::value>(row, query, isoValue, openness, plain); },
-        [&](auto m, auto& plain) {
-          avx2::opennessFromExactSumsLanes<decltype(m)::value>(
-            row.sum, row.sumSquares, row.countX, row.countYZ, row.size, query, isoValue, openness, plain);
-        });
+      opennessRowVector<avx2::RowLoops>(method, row, query, isoValue, openness);
     return;
   }
 #endif
