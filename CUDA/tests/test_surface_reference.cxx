@@ -261,14 +261,20 @@ TEST(SurfaceLanes, VectorPathEqualsThePlainLoop)
       }
       double plain[vao::detail::kLanes], vector[vao::detail::kLanes];
       vao::detail::occlusionLanesPlain(grid, vao::Method::Chebyshev, x, y, z, q, plain);
-      vao::detail::occlusionLanes(grid, vao::Method::Chebyshev, x, y, z, q, vector);
-      for (int k = 0; k < vao::detail::kLanes; ++k)
+      // Each vector tier (where the processor has it; above, the widest it has).
+      for (const vao::detail::SimdTier tier : { vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
       {
-        EXPECT_NEAR(vector[k], plain[k], 1e-12) << "lane " << k;
-        ++lanesCompared;
+        vao::detail::limitSimdTier(tier);
+        vao::detail::occlusionLanes(grid, vao::Method::Chebyshev, x, y, z, q, vector);
+        vao::detail::limitSimdTier(vao::detail::SimdTier::Avx512);
+        for (int k = 0; k < vao::detail::kLanes; ++k)
+        {
+          EXPECT_NEAR(vector[k], plain[k], 1e-12) << "lane " << k << ", tier " << static_cast<int>(tier);
+          ++lanesCompared;
+        }
       }
     }
-    EXPECT_EQ(lanesCompared, 200 * vao::detail::kLanes);
+    EXPECT_EQ(lanesCompared, 2 * 200 * vao::detail::kLanes);
   }
 }
 
@@ -337,7 +343,7 @@ TEST(SurfaceLanes, MarchPassingOverBoundedCellsEqualsTheFullMarch)
   }
   std::mt19937 rng(29);
   std::uniform_real_distribution<double> unit(0.0, 1.0), query(-100.0, 600.0), direction(-1.0, 1.0);
-  int lanes = 0, occluded = 0;
+  int lanes = 0, occluded = 0, wideBatches = 0;
   for (int batch = 0; batch < 400; ++batch)
   {
     constexpr int W = vao::detail::kLanes;
@@ -355,15 +361,28 @@ TEST(SurfaceLanes, MarchPassingOverBoundedCellsEqualsTheFullMarch)
       c /= length;
     const double* start[3] = { x, y, z };
     const int levels = 1 + batch % 4;
-    vao::detail::chebyshevMarchAvx2(bare.data(), radius.data(), levels, lo, hi, start, light.data(), q, full);
-    vao::detail::chebyshevMarchAvx2(bounded.data(), radius.data(), levels, lo, hi, start, light.data(), q, passed);
+    using vao::detail::SimdTier;
+    vao::detail::chebyshevMarch(SimdTier::Avx2, bare.data(), radius.data(), levels, lo, hi, start, light.data(), q, full);
+    vao::detail::chebyshevMarch(
+      SimdTier::Avx2, bounded.data(), radius.data(), levels, lo, hi, start, light.data(), q, passed);
     for (int k = 0; k < W; ++k)
     {
       EXPECT_NEAR(passed[k], full[k], 1e-12) << "batch " << batch << ", lane " << k;
       occluded += full[k] > 0.01 && full[k] < 0.99;
       ++lanes;
     }
+    // AVX-512 marches the whole batch in one vector with the same operations per lane.
+    if (vao::detail::cpuSimdTier() == SimdTier::Avx512)
+    {
+      double wide[W];
+      vao::detail::chebyshevMarch(
+        SimdTier::Avx512, bounded.data(), radius.data(), levels, lo, hi, start, light.data(), q, wide);
+      for (int k = 0; k < W; ++k)
+        EXPECT_EQ(wide[k], passed[k]) << "AVX-512, batch " << batch << ", lane " << k;
+      ++wideBatches;
+    }
   }
+  EXPECT_TRUE(wideBatches == 0 || wideBatches == 400);
   EXPECT_EQ(lanes, 400 * vao::detail::kLanes);
   EXPECT_GT(occluded, lanes / 4); // partial occlusions: the bounds decide, not the extremes
 }

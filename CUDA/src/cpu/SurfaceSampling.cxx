@@ -72,8 +72,10 @@ struct PreparedPyramid
   std::vector<detail::LevelGrid> grids;
   std::vector<double> kernelRadius;
 
-  // The AVX2 march applies: the processor has it and every level's indices fit in 32 bits.
-  bool vectorMarch = detail::cpuHasAvx2();
+  // The vector march applies: the processor has AVX2 (or AVX-512, `tier`) and every
+  // level's indices fit in 32 bits.
+  detail::SimdTier tier = detail::cpuSimdTier();
+  bool vectorMarch = tier >= detail::SimdTier::Avx2;
 
   /// `tiles`: a SurfacePyramid's tiled levels (read where their tiles are built).
   PreparedPyramid(const std::vector<MomentLevel>& pyramid, int levels, const detail::PyramidTiles* tiles)
@@ -173,7 +175,7 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int l
   if (estimator == Method::Chebyshev && pyramid.vectorMarch)
   {
     const double* start[3] = { sx, sy, sz };
-    detail::chebyshevMarchAvx2(pyramid.grids.data(), pyramid.kernelRadius.data(), levels, bounds.lo, bounds.hi,
+    detail::chebyshevMarch(pyramid.tier, pyramid.grids.data(), pyramid.kernelRadius.data(), levels, bounds.lo, bounds.hi,
       start, light.data(), lanes.query, occlusion);
     return;
   }

@@ -1,0 +1,102 @@
+// Vectors of 32-bit indices beside DoubleLanes.h's doubles, one index a lane, and the
+// gathers through them, on AVX2 (four lanes, namespace avx2) and AVX-512 (eight, namespace
+// avx512) behind one set of names: the surface lanes (SurfaceLanes-inl.h) are written once
+// over them. A gathered float becomes a double exactly, so both widths give the same bits.
+#pragma once
+
+#include "DoubleLanes.h"
+
+#if VAO_HAVE_AVX2_TARGET
+#include <immintrin.h>
+
+#include <cstdint>
+
+namespace vao
+{
+namespace detail
+{
+namespace avx2
+{
+using Idx = __m128i;
+#define VAO_LANES VAO_AVX2_HELPER
+
+VAO_LANES Idx indices(std::int64_t x) { return _mm_set1_epi32(static_cast<int>(x)); }
+VAO_LANES Idx add(Idx a, Idx b) { return _mm_add_epi32(a, b); }
+VAO_LANES Idx mul(Idx a, Idx b) { return _mm_mullo_epi32(a, b); }
+VAO_LANES Idx min(Idx a, Idx b) { return _mm_min_epi32(a, b); }
+/// x / 8 and x % 8 of non-negative indices (a tile and the place within it).
+VAO_LANES Idx eighth(Idx x) { return _mm_srli_epi32(x, 3); }
+VAO_LANES Idx remainderOfEight(Idx x) { return _mm_and_si128(x, _mm_set1_epi32(7)); }
+/// Truncation of doubles in [0, 2^31) and back.
+VAO_LANES Idx truncate(D u) { return _mm256_cvttpd_epi32(u); }
+VAO_LANES D toDouble(Idx x) { return _mm256_cvtepi32_pd(x); }
+/// x where m, else 0.
+VAO_LANES Idx onlyWhere(Mask m, Idx x)
+{
+  // The 64-bit lane masks narrowed to 32 bits.
+  const __m256i wide = _mm256_castpd_si256(m);
+  const __m128i narrow =
+    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(wide, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
+  return _mm_and_si128(narrow, x);
+}
+VAO_LANES Idx gather(const std::int32_t* base, Idx at) { return _mm_i32gather_epi32(base, at, 4); }
+/// The floats base[at[k]].
+VAO_LANES D gatherFloats(const float* base, Idx at) { return _mm256_cvtps_pd(_mm_i32gather_ps(base, at, 4)); }
+/// The float pairs at byte Scale * at[k] of base: first and second of each.
+template <int Scale>
+VAO_LANES void gatherPairs(const float* base, Idx at, D& first, D& second)
+{
+  const __m256i pairs = _mm256_i32gather_epi64(reinterpret_cast<const long long*>(base), at, Scale);
+  const __m256 grouped =
+    _mm256_permutevar8x32_ps(_mm256_castsi256_ps(pairs), _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7));
+  first = _mm256_cvtps_pd(_mm256_castps256_ps128(grouped));
+  second = _mm256_cvtps_pd(_mm256_extractf128_ps(grouped, 1));
+}
+/// a * b + c rounded once.
+VAO_LANES D fusedMultiplyAdd(D a, D b, D c) { return _mm256_fmadd_pd(a, b, c); }
+VAO_LANES Mask everyLane() { return _mm256_castsi256_pd(_mm256_set1_epi64x(-1)); }
+/// a and not b.
+VAO_LANES Mask butNot(Mask a, Mask b) { return _mm256_andnot_pd(b, a); }
+/// Not NaN.
+VAO_LANES Mask ordered(D a) { return _mm256_cmp_pd(a, a, _CMP_ORD_Q); }
+#undef VAO_LANES
+} // namespace avx2
+
+namespace avx512
+{
+using Idx = __m256i;
+#define VAO_LANES VAO_AVX512_HELPER
+
+VAO_LANES Idx indices(std::int64_t x) { return _mm256_set1_epi32(static_cast<int>(x)); }
+VAO_LANES Idx add(Idx a, Idx b) { return _mm256_add_epi32(a, b); }
+VAO_LANES Idx mul(Idx a, Idx b) { return _mm256_mullo_epi32(a, b); }
+VAO_LANES Idx min(Idx a, Idx b) { return _mm256_min_epi32(a, b); }
+VAO_LANES Idx eighth(Idx x) { return _mm256_srli_epi32(x, 3); }
+VAO_LANES Idx remainderOfEight(Idx x) { return _mm256_and_si256(x, _mm256_set1_epi32(7)); }
+VAO_LANES Idx truncate(D u) { return _mm512_cvttpd_epi32(u); }
+VAO_LANES D toDouble(Idx x) { return _mm512_cvtepi32_pd(x); }
+VAO_LANES Idx onlyWhere(Mask m, Idx x) { return _mm256_maskz_mov_epi32(m, x); }
+VAO_LANES Idx gather(const std::int32_t* base, Idx at)
+{
+  return _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), at, 4);
+}
+VAO_LANES D gatherFloats(const float* base, Idx at) { return _mm512_cvtps_pd(_mm256_i32gather_ps(base, at, 4)); }
+template <int Scale>
+VAO_LANES void gatherPairs(const float* base, Idx at, D& first, D& second)
+{
+  const __m512i pairs = _mm512_i32gather_epi64(at, base, Scale);
+  const __m512 grouped = _mm512_permutexvar_ps(
+    _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 1, 3, 5, 7, 9, 11, 13, 15), _mm512_castsi512_ps(pairs));
+  first = _mm512_cvtps_pd(_mm512_castps512_ps256(grouped));
+  second = _mm512_cvtps_pd(_mm512_extractf32x8_ps(grouped, 1));
+}
+VAO_LANES D fusedMultiplyAdd(D a, D b, D c) { return _mm512_fmadd_pd(a, b, c); }
+VAO_LANES Mask everyLane() { return 0xFF; }
+VAO_LANES Mask butNot(Mask a, Mask b) { return static_cast<Mask>(a & ~b); }
+VAO_LANES Mask ordered(D a) { return _mm512_cmp_pd_mask(a, a, _CMP_ORD_Q); }
+#undef VAO_LANES
+} // namespace avx512
+
+} // namespace detail
+} // namespace vao
+#endif

@@ -1,0 +1,178 @@
+// The surface queries' Chebyshev lanes (LevelGrid.h's definition) on a width of doubles,
+// written once over DoubleLanes.h and GatherLanes.h and included by SurfaceLanes.h into
+// the avx2 and the avx512 namespace: a cell's corners by 32-bit gathers, the trilinear
+// blend and the estimator in vector arithmetic, and the whole shadow march of a batch in
+// registers, so one step is few enough instructions for the processor to overlap the
+// gathers' latency of several. Equal to the plain loops but for the rounding of the
+// blends' fused multiply-adds; the march passes over the samples that their cell's bound
+// (CellBounds) shows cannot raise a lane's occlusion, which changes no maximum.
+// No include guard: included once per namespace, with VAO_LANES its inline target.
+
+/// The vectors of a batch.
+constexpr int kVectors = kLanes / kWidth;
+
+VAO_LANES D lerp(D a, D b, D t)
+{
+  return fusedMultiplyAdd(t, sub(b, a), a);
+}
+
+/// The cells of one level under kWidth positions: the lower corners as flat 32-bit
+/// indices (LevelGrid's layout, tiled or not), the steps to the upper corners per axis
+/// (0 where clamped) and the fractions towards them.
+struct Cells
+{
+  Idx base;
+  Idx step[3];
+  D f[3];
+};
+
+VAO_LANES Cells cellsOf(const LevelGrid& g, const D* position)
+{
+  Cells c;
+  c.base = indices(0);
+  Idx tile = indices(0);
+  for (int a = 0; a < 3; ++a)
+  {
+    const D maxIndex = set1(g.maxIndex[a]);
+    const D u = min(max(mul(sub(position[a], set1(g.origin[a])), set1(g.inverseSpacing[a])), zero()), maxIndex);
+    Idx lower = truncate(u);
+    if (a == 0 && g.pairedRows) // the last voxel as the upper corner of the cell below it
+      lower = min(lower, indices(static_cast<std::int64_t>(g.maxIndex[0]) - 1));
+    c.f[a] = sub(u, toDouble(lower));
+    const Idx stride = indices(g.stride[a]);
+    if (g.tiled) // trilinearSample's tiled index: the tile, and the corner within it
+    {
+      tile = add(tile, mul(eighth(lower), indices(g.tileStride[a])));
+      c.base = add(c.base, mul(remainderOfEight(lower), stride));
+    }
+    else
+      c.base = add(c.base, mul(lower, stride));
+    c.step[a] = onlyWhere(lessThan(u, maxIndex), stride);
+  }
+  if (g.tiled)
+    c.base = add(c.base, gather(g.tileOffsets, tile));
+  return c;
+}
+
+/// The trilinear mean and variance (not yet clamped) of the cells: the four x rows of
+/// each cell, lerped along x, then y, then z (trilinearSample's order).
+VAO_LANES void blend(const LevelGrid& g, const Cells& c, D& mean, D& variance)
+{
+  const Idx row[4] = { c.base, add(c.base, c.step[1]), add(c.base, c.step[2]),
+    add(add(c.base, c.step[2]), c.step[1]) };
+  D means[4], variances[4];
+  for (int r = 0; r < 4; ++r)
+  {
+    const Idx upper = add(row[r], c.step[0]);
+    if (g.tiled) // (mean, variance) pairs: one 64-bit gather per corner
+    {
+      D m[2], v[2];
+      gatherPairs<4>(g.mean, row[r], m[0], v[0]);
+      gatherPairs<4>(g.mean, upper, m[1], v[1]);
+      means[r] = lerp(m[0], m[1], c.f[0]);
+      variances[r] = lerp(v[0], v[1], c.f[0]);
+    }
+    else if (g.pairedRows) // a row's two x corners: one 64-bit gather
+    {
+      D lo, hi;
+      gatherPairs<4>(g.mean, row[r], lo, hi);
+      means[r] = lerp(lo, hi, c.f[0]);
+      gatherPairs<4>(g.variance, row[r], lo, hi);
+      variances[r] = lerp(lo, hi, c.f[0]);
+    }
+    else
+    {
+      means[r] = lerp(gatherFloats(g.mean, row[r]), gatherFloats(g.mean, upper), c.f[0]);
+      variances[r] = lerp(gatherFloats(g.variance, row[r]), gatherFloats(g.variance, upper), c.f[0]);
+    }
+  }
+  mean = lerp(lerp(means[0], means[1], c.f[1]), lerp(means[2], means[3], c.f[1]), c.f[2]);
+  variance = lerp(lerp(variances[0], variances[1], c.f[1]), lerp(variances[2], variances[3], c.f[1]), c.f[2]);
+}
+
+/// The Chebyshev occlusion of q in the cells (occlusionLanesPlain's formula).
+VAO_LANES D chebyshevOcclusion(const LevelGrid& g, const Cells& c, D q)
+{
+  D mean, variance;
+  blend(g, c, mean, variance);
+  return sub(set1(1.0), chebyshevOpenness(q, mean, max(variance, zero()), set1(g.roundingVariance),
+    set1(g.roundingSpread)));
+}
+
+/// Upper bounds of the Chebyshev occlusion of q in the cells, from the level's CellBounds:
+/// 1 where q is not above the cell's largest mean or the bound is NaN.
+VAO_LANES D chebyshevBound(const LevelGrid& g, const Cells& c, D q)
+{
+  D mean, variance;
+  gatherPairs<8>(g.cellBounds, c.base, mean, variance);
+  const D d = sub(q, mean);
+  const D share = div(variance, add(variance, mul(d, d)));
+  return select(both(greaterThan(d, zero()), ordered(share)), share, set1(1.0));
+}
+
+/// occlusionLanesPlain for Chebyshev.
+VAO_LANES_ENTRY void chebyshevLanes(const LevelGrid& g, const double* x, const double* y, const double* z,
+  const double* query, double* occlusion)
+{
+  for (int h = 0; h < kLanes; h += kWidth)
+  {
+    const D position[3] = { load(x + h), load(y + h), load(z + h) };
+    store(occlusion + h, chebyshevOcclusion(g, cellsOf(g, position), load(query + h)));
+  }
+}
+
+/// The Chebyshev shadow march of a batch (batchMarch in SurfaceSampling.cxx, whose rules
+/// it follows lane by lane) with the positions, bounds, occlusions and the lanes still
+/// marching in registers: from start (x, y, z per lane) along the unit light, inside
+/// [lo, hi], on levels whose indices fit in 32 bits.
+VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const double* kernelRadius, int levels, const double* lo,
+  const double* hi, const double* const* start, const double* light, const double* query, double* occlusion)
+{
+  const D full = set1(kMarchFullOcclusion);
+  D occ[kVectors], q[kVectors], from[kVectors][3];
+  Mask alive[kVectors];
+  for (int h = 0; h < kVectors; ++h)
+  {
+    occ[h] = zero();
+    alive[h] = everyLane();
+    q[h] = load(query + kWidth * h);
+    for (int a = 0; a < 3; ++a)
+      from[h][a] = load(start[a] + kWidth * h);
+  }
+  const double r0 = kernelRadius[0];
+  double t = 0.0;
+  for (int s = 0; s < kMarchMaxSteps; ++s)
+  {
+    D at[kVectors][3];
+    bool any = false;
+    for (int h = 0; h < kVectors; ++h)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        // start + t * light rounded as the plain loop does (no fused multiply-add): both
+        // forms stop at the same step on a bound.
+        at[h][a] = add(from[h][a], mul(set1(t), set1(light[a])));
+        alive[h] = both(alive[h], both(greaterEqual(at[h][a], set1(lo[a])), lessEqual(at[h][a], set1(hi[a]))));
+      }
+      any = any || !none(alive[h]);
+    }
+    if (!any)
+      break;
+    const int l = marchLevel(t, r0, levels);
+    const LevelGrid& grid = grids[l];
+    for (int h = 0; h < kVectors; ++h)
+    {
+      const Cells cells = cellsOf(grid, at[h]);
+      // No lane still marching can rise above its occlusion here: the sample is passed
+      // over, as the maximum it would enter is already held.
+      if (grid.cellBounds && none(butNot(alive[h], lessEqual(chebyshevBound(grid, cells, q[h]), occ[h]))))
+        continue;
+      const D sample = chebyshevOcclusion(grid, cells, q[h]);
+      occ[h] = select(alive[h], max(sample, occ[h]), occ[h]);
+      alive[h] = both(alive[h], lessThan(occ[h], full));
+    }
+    t += kMarchStepFraction * kernelRadius[l];
+  }
+  for (int h = 0; h < kVectors; ++h)
+    store(occlusion + kWidth * h, occ[h]);
+}
