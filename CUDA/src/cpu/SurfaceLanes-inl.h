@@ -162,6 +162,8 @@ VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const double* kernel
     const LevelGrid& grid = grids[l];
     for (int h = 0; h < kVectors; ++h)
     {
+      if (none(alive[h]))
+        continue;
       const Cells cells = cellsOf(grid, at[h]);
       // No lane still marching can rise above its occlusion here: the sample is passed
       // over, as the maximum it would enter is already held.

@@ -1,7 +1,7 @@
 // The surface queries' lanes (LevelGrid.h) in vector registers, and the dispatch between
 // them and the plain loops: the Chebyshev sample and the shadow march of
-// SurfaceLanes-inl.h, compiled for AVX2 + FMA (four lanes a vector) and AVX-512 (eight,
-// a whole batch), both the same bits. (GCC does not vectorise the plain loops: their
+// SurfaceLanes-inl.h, compiled for AVX2 + FMA (four lanes a vector) and AVX-512 (eight),
+// both the same bits. (GCC does not vectorise the plain loops: their
 // float-to-int conversions and selects stay branches.)
 #pragma once
 

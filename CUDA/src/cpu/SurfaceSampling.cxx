@@ -23,48 +23,56 @@ namespace
 using detail::MarchBounds;
 using detail::PointLanes;
 
-/// The grid cell around a world position, clamped to the grid: lower and upper corner
-/// indices and the fractions towards the upper one, per axis.
-struct TrilinearCell
+/// Trilinear values of the raw volume at world positions, clamped to its bounds, with the
+/// divisions by the spacing and the strides done once for a query's many samples.
+template <class T>
+struct RawSampler
 {
-  std::int64_t i0[3], i1[3];
-  double f[3];
+  detail::TypedVolume<T> volume;
+  double origin[3], inverseSpacing[3], maxIndex[3];
+  std::int64_t stride[3];
 
-  TrilinearCell(const Index3& dims, const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
-    const std::array<double, 3>& position)
+  RawSampler(const detail::TypedVolume<T>& typed, const std::array<double, 3>& origin,
+    const std::array<double, 3>& spacing)
+    : volume(typed)
   {
     for (int a = 0; a < 3; ++a)
     {
-      const double maxIndex = static_cast<double>(dims[a] - 1);
-      const double u = std::min(std::max((position[a] - origin[a]) / spacing[a], 0.0), maxIndex);
-      const double fl = std::floor(u);
-      i0[a] = static_cast<std::int64_t>(fl);
-      i1[a] = std::min<std::int64_t>(i0[a] + 1, dims[a] - 1);
-      f[a] = u - fl;
+      this->origin[a] = origin[a];
+      this->inverseSpacing[a] = 1.0 / spacing[a];
+      this->maxIndex[a] = static_cast<double>(typed.dims[a] - 1);
     }
+    this->stride[0] = typed.stride;
+    this->stride[1] = typed.dims[0] * typed.stride;
+    this->stride[2] = typed.dims[0] * typed.dims[1] * typed.stride;
+  }
+
+  /// The cell's lower corner, the steps to the upper one (0 where clamped) and the
+  /// fractions towards it; then nested blends along x, y, z.
+  double operator()(const std::array<double, 3>& position) const
+  {
+    std::int64_t base = 0, step[3];
+    double f[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      // max(0, ...) first: a position on the origin of a spacing whose inverse overflows
+      // (a subnormal one) gives 0 * inf, NaN, which this takes to the first voxel.
+      const double u = std::min(std::max(0.0, (position[a] - this->origin[a]) * this->inverseSpacing[a]),
+        this->maxIndex[a]);
+      const std::int64_t lower = static_cast<std::int64_t>(u); // u >= 0: truncation is the floor
+      f[a] = u - static_cast<double>(lower);
+      base += lower * this->stride[a];
+      step[a] = u < this->maxIndex[a] ? this->stride[a] : 0;
+    }
+    const T* c = this->volume.data + base;
+    auto row = [&](std::int64_t i) {
+      return static_cast<double>(c[i]) * (1 - f[0]) + static_cast<double>(c[i + step[0]]) * f[0];
+    };
+    const double lowerPlane = row(0) * (1 - f[1]) + row(step[1]) * f[1];
+    const double upperPlane = row(step[2]) * (1 - f[1]) + row(step[2] + step[1]) * f[1];
+    return lowerPlane * (1 - f[2]) + upperPlane * f[2];
   }
 };
-
-/// Trilinear value of the raw volume at a world position (clamped to its bounds).
-template <class T>
-double trilinear(const detail::TypedVolume<T>& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const std::array<double, 3>& position)
-{
-  const TrilinearCell cell(volume.dims, origin, spacing, position);
-  const std::int64_t* i0 = cell.i0;
-  const std::int64_t* i1 = cell.i1;
-  const double* f = cell.f;
-  auto v = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-    return static_cast<double>(volume.value(x, y, z));
-  };
-  const double c00 = v(i0[0], i0[1], i0[2]) * (1 - f[0]) + v(i1[0], i0[1], i0[2]) * f[0];
-  const double c10 = v(i0[0], i1[1], i0[2]) * (1 - f[0]) + v(i1[0], i1[1], i0[2]) * f[0];
-  const double c01 = v(i0[0], i0[1], i1[2]) * (1 - f[0]) + v(i1[0], i0[1], i1[2]) * f[0];
-  const double c11 = v(i0[0], i1[1], i1[2]) * (1 - f[0]) + v(i1[0], i1[1], i1[2]) * f[0];
-  const double c0 = c00 * (1 - f[1]) + c10 * f[1];
-  const double c1 = c01 * (1 - f[1]) + c11 * f[1];
-  return c0 * (1 - f[2]) + c1 * f[2];
-}
 
 /// The levels a query uses, prepared for sampling.
 struct PreparedPyramid
@@ -116,7 +124,7 @@ double sampleVolume(const VolumeView& volume, const std::array<double, 3>& origi
 {
   return detail::dispatchScalarType(volume.type, [&](auto tag) {
     using T = decltype(tag);
-    return trilinear(detail::TypedVolume<T>(volume), origin, spacing, position);
+    return RawSampler<T>(detail::TypedVolume<T>(volume), origin, spacing)(position);
   });
 }
 
@@ -253,11 +261,12 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles
   };
   const PreparedPyramid prepared(pyramid, levels, tiles);
   const bool finished = detail::dispatchScalarType(half ? volume.type : ScalarType::Float32, [&](auto tag) {
-    const detail::TypedVolume<decltype(tag)> typed(half ? volume : VolumeView{});
+    const RawSampler<decltype(tag)> raw(detail::TypedVolume<decltype(tag)>(half ? volume : VolumeView{}),
+      half ? origin : std::array<double, 3>{ 0, 0, 0 }, half ? spacing : std::array<double, 3>{ 1, 1, 1 });
     return detail::sweepPoints(tiles, points, normals, count, execution, mark, [&](PointLanes& lanes) {
       for (int k = 0; k < detail::kLanes; ++k)
       {
-        lanes.query[k] = half ? trilinear(typed, origin, spacing, lanes.along(k, -0.5 * h)) : parameters.isoValue;
+        lanes.query[k] = half ? raw(lanes.along(k, -0.5 * h)) : parameters.isoValue;
       }
       double occlusion[detail::kLanes];
       batchOcclusion(prepared, levels, lanes, parameters, occlusion);
