@@ -40,6 +40,7 @@ VAO_LANES Idx onlyWhere(Mask m, Idx x)
   return _mm_and_si128(narrow, x);
 }
 VAO_LANES Idx gather(const std::int32_t* base, Idx at) { return _mm_i32gather_epi32(base, at, 4); }
+VAO_LANES void storeIndices(std::int32_t* to, Idx x) { _mm_storeu_si128(reinterpret_cast<__m128i*>(to), x); }
 /// The floats base[at[k]].
 VAO_LANES D gatherFloats(const float* base, Idx at) { return _mm256_cvtps_pd(_mm_i32gather_ps(base, at, 4)); }
 /// The float pairs at byte Scale * at[k] of base: first and second of each.
@@ -81,6 +82,7 @@ VAO_LANES Idx gather(const std::int32_t* base, Idx at)
   return _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), at, 4);
 }
 VAO_LANES D gatherFloats(const float* base, Idx at) { return _mm512_cvtps_pd(_mm256_i32gather_ps(base, at, 4)); }
+VAO_LANES void storeIndices(std::int32_t* to, Idx x) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(to), x); }
 template <int Scale>
 VAO_LANES void gatherPairs(const float* base, Idx at, D& first, D& second)
 {

@@ -110,6 +110,29 @@ VAO_LANES D chebyshevBound(const LevelGrid& g, const Cells& c, D q)
   return select(both(greaterThan(d, zero()), ordered(share)), share, set1(1.0));
 }
 
+/// Asks for the cache lines of the cells' rows (x pairs) at the lanes' positions, so that
+/// a batch's samples of a level far larger than the caches wait on their misses together.
+VAO_LANES_ENTRY void prefetchLanes(const LevelGrid& g, const double* x, const double* y, const double* z)
+{
+  for (int h = 0; h < kLanes; h += kWidth)
+  {
+    const D position[3] = { load(x + h), load(y + h), load(z + h) };
+    const Cells c = cellsOf(g, position);
+    const Idx rows[4] = { c.base, add(c.base, c.step[1]), add(c.base, c.step[2]),
+      add(add(c.base, c.step[2]), c.step[1]) };
+    alignas(64) std::int32_t at[4][kWidth];
+    for (int r = 0; r < 4; ++r)
+      storeIndices(at[r], rows[r]);
+    for (int r = 0; r < 4; ++r)
+      for (int k = 0; k < kWidth; ++k)
+      {
+        _mm_prefetch(reinterpret_cast<const char*>(g.mean + at[r][k]), _MM_HINT_T0);
+        if (!g.tiled)
+          _mm_prefetch(reinterpret_cast<const char*>(g.variance + at[r][k]), _MM_HINT_T0);
+      }
+  }
+}
+
 /// occlusionLanesPlain for Chebyshev.
 VAO_LANES_ENTRY void chebyshevLanes(const LevelGrid& g, const double* x, const double* y, const double* z,
   const double* query, double* occlusion)

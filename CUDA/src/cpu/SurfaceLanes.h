@@ -79,5 +79,17 @@ inline void occlusionLanes(const LevelGrid& g, Method estimator, const double* x
   occlusionLanesPlain(g, estimator, x, y, z, query, occlusion);
 }
 
+/// prefetchLanes (SurfaceLanes-inl.h) where the vector lanes apply.
+inline void prefetchLanes(const LevelGrid& g, const double* x, const double* y, const double* z)
+{
+#if VAO_HAVE_AVX2_TARGET
+  const SimdTier tier = cpuSimdTier();
+  if (tier == SimdTier::Avx512 && g.narrowIndices)
+    avx512::prefetchLanes(g, x, y, z);
+  else if (tier == SimdTier::Avx2 && g.narrowIndices)
+    avx2::prefetchLanes(g, x, y, z);
+#endif
+}
+
 } // namespace detail
 } // namespace vao

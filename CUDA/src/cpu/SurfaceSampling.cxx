@@ -142,19 +142,33 @@ void batchOcclusion(const PreparedPyramid& pyramid, int levels, const PointLanes
   const SurfaceOcclusionParameters& parameters, double* combined)
 {
   constexpr int W = detail::kLanes;
-  double x[W], y[W], z[W], occlusion[W];
+  double x[2][W], y[2][W], z[2][W], occlusion[W];
   std::fill(combined, combined + W, 0.0);
-  for (int l = 0; l < levels; ++l)
-  {
+  // Level l's sample positions, in slot l % 2.
+  const auto positions = [&](int l) {
     const double offset = parameters.offsetFactor * pyramid.kernelRadius[l];
     for (int k = 0; k < W; ++k)
     {
       const std::array<double, 3> at = lanes.along(k, offset);
-      x[k] = at[0];
-      y[k] = at[1];
-      z[k] = at[2];
+      x[l % 2][k] = at[0];
+      y[l % 2][k] = at[1];
+      z[l % 2][k] = at[2];
     }
-    detail::occlusionLanes(pyramid.grids[l], parameters.estimator, x, y, z, lanes.query, occlusion);
+  };
+  // Levels 0 and 1 (96% of a pyramid's bytes) are far larger than the caches: the batch
+  // first asks for their lines, so their misses overlap (CT head bone surface AO on the
+  // whole pyramid: 35 -> 32 ms).
+  for (int l = 0; l < std::min(levels, 2); ++l)
+  {
+    positions(l);
+    detail::prefetchLanes(pyramid.grids[l], x[l], y[l], z[l]);
+  }
+  for (int l = 0; l < levels; ++l)
+  {
+    if (l >= 2)
+      positions(l);
+    const int slot = l % 2;
+    detail::occlusionLanes(pyramid.grids[l], parameters.estimator, x[slot], y[slot], z[slot], lanes.query, occlusion);
     for (int k = 0; k < W; ++k)
     {
       combined[k] = parameters.combination == LevelCombination::Mean ? combined[k] + occlusion[k] / levels
