@@ -361,10 +361,10 @@ TEST(SurfaceLanes, MarchPassingOverBoundedCellsEqualsTheFullMarch)
       c /= length;
     const double* start[3] = { x, y, z };
     const int levels = 1 + batch % 4;
+    const std::vector<vao::detail::MarchStep> schedule = vao::detail::marchSchedule(radius.data(), levels, 1e9);
     using vao::detail::SimdTier;
-    vao::detail::chebyshevMarch(SimdTier::Avx2, bare.data(), radius.data(), levels, lo, hi, start, light.data(), q, full);
-    vao::detail::chebyshevMarch(
-      SimdTier::Avx2, bounded.data(), radius.data(), levels, lo, hi, start, light.data(), q, passed);
+    vao::detail::chebyshevMarch(SimdTier::Avx2, bare.data(), schedule, lo, hi, start, light.data(), q, full);
+    vao::detail::chebyshevMarch(SimdTier::Avx2, bounded.data(), schedule, lo, hi, start, light.data(), q, passed);
     for (int k = 0; k < W; ++k)
     {
       EXPECT_NEAR(passed[k], full[k], 1e-12) << "batch " << batch << ", lane " << k;
@@ -376,7 +376,7 @@ TEST(SurfaceLanes, MarchPassingOverBoundedCellsEqualsTheFullMarch)
     {
       double wide[W];
       vao::detail::chebyshevMarch(
-        SimdTier::Avx512, bounded.data(), radius.data(), levels, lo, hi, start, light.data(), q, wide);
+        SimdTier::Avx512, bounded.data(), schedule, lo, hi, start, light.data(), q, wide);
       for (int k = 0; k < W; ++k)
         EXPECT_EQ(wide[k], passed[k]) << "AVX-512, batch " << batch << ", lane " << k;
       ++wideBatches;

@@ -147,9 +147,11 @@ VAO_LANES_ENTRY void chebyshevLanes(const LevelGrid& g, const double* x, const d
 /// The Chebyshev shadow march of a batch (batchMarch in SurfaceSampling.cxx, whose rules
 /// it follows lane by lane) with the positions, bounds, occlusions and the lanes still
 /// marching in registers: from start (x, y, z per lane) along the unit light, inside
-/// [lo, hi], on levels whose indices fit in 32 bits.
-VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const double* kernelRadius, int levels, const double* lo,
-  const double* hi, const double* const* start, const double* light, const double* query, double* occlusion)
+/// [lo, hi], the steps of `schedule` (marchSchedule), on levels whose indices fit in 32
+/// bits.
+VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const MarchStep* schedule, std::size_t steps,
+  const double* lo, const double* hi, const double* const* start, const double* light, const double* query,
+  double* occlusion)
 {
   const D full = set1(kMarchFullOcclusion);
   D occ[kVectors], q[kVectors], from[kVectors][3];
@@ -162,10 +164,9 @@ VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const double* kernel
     for (int a = 0; a < 3; ++a)
       from[h][a] = load(start[a] + kWidth * h);
   }
-  const double r0 = kernelRadius[0];
-  double t = 0.0;
-  for (int s = 0; s < kMarchMaxSteps; ++s)
+  for (std::size_t s = 0; s < steps; ++s)
   {
+    const double t = schedule[s].t;
     D at[kVectors][3];
     bool any = false;
     for (int h = 0; h < kVectors; ++h)
@@ -181,8 +182,7 @@ VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const double* kernel
     }
     if (!any)
       break;
-    const int l = marchLevel(t, r0, levels);
-    const LevelGrid& grid = grids[l];
+    const LevelGrid& grid = grids[schedule[s].level];
     for (int h = 0; h < kVectors; ++h)
     {
       if (none(alive[h]))
@@ -196,7 +196,6 @@ VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const double* kernel
       occ[h] = select(alive[h], max(sample, occ[h]), occ[h]);
       alive[h] = both(alive[h], lessThan(occ[h], full));
     }
-    t += kMarchStepFraction * kernelRadius[l];
   }
   for (int h = 0; h < kVectors; ++h)
     store(occlusion + kWidth * h, occ[h]);

@@ -10,6 +10,7 @@
 #include "LevelGrid.h"
 
 #include <cmath>
+#include <vector>
 
 namespace vao
 {
@@ -25,6 +26,28 @@ constexpr double kMarchFullOcclusion = 0.999;
 inline int marchLevel(double t, double r0, int levels)
 {
   return std::min(levels - 1, std::max(0, static_cast<int>(std::floor(std::log2(1.0 + t / r0)))));
+}
+
+/// One step of the march: its distance from the start and its level.
+struct MarchStep
+{
+  double t;
+  int level;
+};
+
+/// Every march's steps: they depend on the distance alone, so every point takes the same.
+/// The list ends at kMarchMaxSteps, or past `reach` (twice the box's diagonal: a march
+/// that starts in the box has left it, so its lanes have stopped there).
+inline std::vector<MarchStep> marchSchedule(const double* kernelRadius, int levels, double reach)
+{
+  std::vector<MarchStep> steps;
+  for (double t = 0.0; steps.size() < static_cast<std::size_t>(kMarchMaxSteps) && !(t > reach);)
+  {
+    const int l = marchLevel(t, kernelRadius[0], levels);
+    steps.push_back({ t, l });
+    t += kMarchStepFraction * kernelRadius[l];
+  }
+  return steps;
 }
 
 #if VAO_HAVE_AVX2_TARGET
@@ -48,14 +71,14 @@ namespace avx512
 
 /// The Chebyshev shadow march of a batch (SurfaceLanes-inl.h) in the widest tier the
 /// processor has: `tier` is Avx2 or Avx512.
-inline void chebyshevMarch(SimdTier tier, const LevelGrid* grids, const double* kernelRadius, int levels,
+inline void chebyshevMarch(SimdTier tier, const LevelGrid* grids, const std::vector<MarchStep>& schedule,
   const double* lo, const double* hi, const double* const* start, const double* light, const double* query,
   double* occlusion)
 {
   if (tier == SimdTier::Avx512)
-    avx512::chebyshevMarch(grids, kernelRadius, levels, lo, hi, start, light, query, occlusion);
+    avx512::chebyshevMarch(grids, schedule.data(), schedule.size(), lo, hi, start, light, query, occlusion);
   else
-    avx2::chebyshevMarch(grids, kernelRadius, levels, lo, hi, start, light, query, occlusion);
+    avx2::chebyshevMarch(grids, schedule.data(), schedule.size(), lo, hi, start, light, query, occlusion);
 }
 #endif
 

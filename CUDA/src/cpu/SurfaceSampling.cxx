@@ -180,8 +180,8 @@ void batchOcclusion(const PreparedPyramid& pyramid, int levels, const PointLanes
 /// The largest occlusion each lane's march meets from p + r_0 n along the unit `light`.
 /// The lanes share the steps (t and the level depend on the distance alone); a lane stops
 /// on leaving the bounds or at full occlusion, the batch when every lane has.
-void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int levels, const PointLanes& lanes,
-  const std::array<double, 3>& light, Method estimator, double* occlusion)
+void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, const std::vector<detail::MarchStep>& schedule,
+  const PointLanes& lanes, const std::array<double, 3>& light, Method estimator, double* occlusion)
 {
   constexpr int W = detail::kLanes;
   const double r0 = pyramid.kernelRadius[0];
@@ -197,17 +197,17 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int l
   if (estimator == Method::Chebyshev && pyramid.vectorMarch)
   {
     const double* start[3] = { sx, sy, sz };
-    detail::chebyshevMarch(pyramid.tier, pyramid.grids.data(), pyramid.kernelRadius.data(), levels, bounds.lo, bounds.hi,
-      start, light.data(), lanes.query, occlusion);
+    detail::chebyshevMarch(
+      pyramid.tier, pyramid.grids.data(), schedule, bounds.lo, bounds.hi, start, light.data(), lanes.query, occlusion);
     return;
   }
 #endif
   bool alive[W];
   std::fill(occlusion, occlusion + W, 0.0);
   std::fill(alive, alive + W, true);
-  double t = 0.0;
-  for (int s = 0; s < detail::kMarchMaxSteps; ++s)
+  for (const detail::MarchStep& step : schedule)
   {
+    const double t = step.t;
     bool any = false;
     for (int k = 0; k < W; ++k)
     {
@@ -222,8 +222,7 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int l
     {
       break;
     }
-    const int l = detail::marchLevel(t, r0, levels);
-    detail::occlusionLanes(pyramid.grids[l], estimator, x, y, z, lanes.query, sample);
+    detail::occlusionLanes(pyramid.grids[step.level], estimator, x, y, z, lanes.query, sample);
     for (int k = 0; k < W; ++k)
     {
       if (alive[k])
@@ -232,7 +231,6 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, int l
         alive[k] = occlusion[k] < detail::kMarchFullOcclusion;
       }
     }
-    t += detail::kMarchStepFraction * pyramid.kernelRadius[l];
   }
 }
 
@@ -321,29 +319,26 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
   // The tiled levels' samples: the query half a voxel inside (level 0) and the march's
   // steps while it is on them (batchMarch's positions, whatever the occlusion met).
   const double r0 = base.kernelRadius;
-  // Every march takes the same distances and levels: those of the tiled levels, once.
-  std::vector<std::pair<double, detail::LevelTiles*>> steps;
-  for (double s = 0.0; tiles && steps.size() < detail::kMarchMaxSteps;)
-  {
-    const int l = detail::marchLevel(s, r0, levels);
-    if (!tiles->at(l))
-      break;
-    steps.emplace_back(s, tiles->at(l));
-    s += detail::kMarchStepFraction * pyramid[l].kernelRadius;
-  }
+  std::vector<double> kernelRadius;
+  for (int l = 0; l < levels; ++l)
+    kernelRadius.push_back(pyramid[l].kernelRadius);
+  double diagonal = 0.0;
+  for (int a = 0; a < 3; ++a)
+    diagonal += (bounds.hi[a] - bounds.lo[a]) * (bounds.hi[a] - bounds.lo[a]);
+  const std::vector<detail::MarchStep> schedule = detail::marchSchedule(kernelRadius.data(), levels, 2.0 * std::sqrt(diagonal));
   const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t) {
     for (int k = 0; k < lanes.used; ++k)
     {
       const std::array<double, 3> inside = lanes.along(k, -0.5 * h);
       const std::array<double, 3> start = lanes.along(k, r0);
       t.at(0)->markAround(inside[0], inside[1], inside[2]);
-      for (const auto& step : steps)
+      for (const detail::MarchStep& step : schedule)
       {
-        const double s = step.first;
+        const double s = step.t;
         const double at[3] = { start[0] + s * light[0], start[1] + s * light[1], start[2] + s * light[2] };
-        if (!bounds.contains(at))
+        if (!t.at(step.level) || !bounds.contains(at))
           break;
-        step.second->markAround(at[0], at[1], at[2]);
+        t.at(step.level)->markAround(at[0], at[1], at[2]);
       }
     }
   };
@@ -362,7 +357,7 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
       }
     }
     double occlusion[detail::kLanes];
-    batchMarch(prepared, bounds, levels, lanes, light, parameters.estimator, occlusion);
+    batchMarch(prepared, bounds, schedule, lanes, light, parameters.estimator, occlusion);
     for (int k = 0; k < lanes.used; ++k)
     {
       out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
