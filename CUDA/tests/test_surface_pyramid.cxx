@@ -235,7 +235,7 @@ TEST(SurfacePyramid, SweepsInSlabsHoldingLittleMoreThanItKeeps)
   std::vector<double> points, normals;
   scenePoints(f, points, normals);
   const Vec3 c = { f.origin[0] + 15 * f.spacing[0], f.origin[1] + 14 * f.spacing[1], f.origin[2] + 45 * f.spacing[2] };
-  std::vector<double> column, columnNormals; // a tall cylinder of points through the scene
+  // A tall cylinder of points through the scene.
   for (int i = 0; i < 4000; ++i)
   {
     const double angle = 0.37 * i, height = (i % 400) / 400.0 * 86 * f.spacing[2];

@@ -131,12 +131,13 @@ class PyramidTiles;
 
 /// A moment pyramid for the surface queries that holds levels 0 and 1 only where they
 /// sample them. Those levels (96% of a whole pyramid's bytes) are kept in tiles of 8^3
-/// cells (9^3 voxels, the ninth shared with the next tile): a query builds the tiles its samples reach (its points' AO offsets, the
-/// half-voxel query, the shadow march's steps on those levels), so a surface holds a
-/// small part of them. It sweeps its points in slabs along z, building a slab's tiles
-/// before sampling it, and gives back the tiles it has left behind while more than
-/// keptTileBytes() are built (by default a fifth of the volume's bytes, at least 16 MiB): a large surface
-/// holds the tiles near one slab plus those kept, which the next query finds built.
+/// cells (9^3 voxels, the ninth shared with the next tile): a query builds the tiles its
+/// samples reach (its points' AO offsets, the half-voxel query, the shadow march's steps
+/// on those levels), so a surface holds a small part of them. It sweeps its points in
+/// slabs along z, building a slab's tiles before sampling it, and gives back the tiles it
+/// has left behind while more than keptTileBytes() are built (by default a fifth of the
+/// volume's bytes, at least 16 MiB): a large surface holds the tiles near one slab plus
+/// those kept, which the next query finds built.
 /// Levels 2 and up are whole. Every result equals the one from
 /// buildMomentPyramid's whole pyramid bit for bit. Tiles are built from the volume: the
 /// volume the pyramid was built from must outlive it, unchanged. A query builds tiles, so

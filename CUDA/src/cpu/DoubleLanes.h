@@ -72,6 +72,13 @@ VAO_LANES bool none(Mask m) { return _mm256_movemask_pd(m) == 0; }
 VAO_LANES D select(Mask m, D yes, D no) { return _mm256_blendv_pd(no, yes, m); }
 /// x where m, else 0.
 VAO_LANES D onlyWhere(Mask m, D x) { return _mm256_and_pd(m, x); }
+/// a * b + c rounded once (an explicit one: these files are compiled without contraction).
+VAO_LANES D fusedMultiplyAdd(D a, D b, D c) { return _mm256_fmadd_pd(a, b, c); }
+VAO_LANES Mask everyLane() { return _mm256_castsi256_pd(_mm256_set1_epi64x(-1)); }
+/// a and not b.
+VAO_LANES Mask butNot(Mask a, Mask b) { return _mm256_andnot_pd(b, a); }
+/// Not NaN.
+VAO_LANES Mask ordered(D a) { return _mm256_cmp_pd(a, a, _CMP_ORD_Q); }
 /// a < b, 64-bit signed.
 VAO_LANES Mask lessThan(I a, I b) { return _mm256_castsi256_pd(_mm256_cmpgt_epi64(b, a)); }
 VAO_LANES I set1(std::int64_t x) { return _mm256_set1_epi64x(x); }
@@ -121,6 +128,10 @@ VAO_LANES bool all(Mask m) { return m == 0xFF; }
 VAO_LANES bool none(Mask m) { return m == 0; }
 VAO_LANES D select(Mask m, D yes, D no) { return _mm512_mask_blend_pd(m, no, yes); }
 VAO_LANES D onlyWhere(Mask m, D x) { return _mm512_maskz_mov_pd(m, x); }
+VAO_LANES D fusedMultiplyAdd(D a, D b, D c) { return _mm512_fmadd_pd(a, b, c); }
+VAO_LANES Mask everyLane() { return 0xFF; }
+VAO_LANES Mask butNot(Mask a, Mask b) { return static_cast<Mask>(a & ~b); }
+VAO_LANES Mask ordered(D a) { return _mm512_cmp_pd_mask(a, a, _CMP_ORD_Q); }
 VAO_LANES Mask lessThan(I a, I b) { return _mm512_cmplt_epi64_mask(a, b); }
 VAO_LANES I set1(std::int64_t x) { return _mm512_set1_epi64(x); }
 /// Exact below 2^53 (AVX-512 DQ converts 64-bit integers directly).

@@ -20,6 +20,17 @@ namespace vao
 {
 namespace detail
 {
+/// The 8 bytes at byte offsets Scale * i and Scale * j of base, in one vector (SSE2: the
+/// gathers of both widths inline it).
+template <int Scale>
+VAO_ALWAYS_INLINE __m128i loadPairs(const float* base, std::int32_t i, std::int32_t j)
+{
+  const char* bytes = reinterpret_cast<const char*>(base);
+  return _mm_unpacklo_epi64(
+    _mm_loadl_epi64(reinterpret_cast<const __m128i*>(bytes + static_cast<std::int64_t>(i) * Scale)),
+    _mm_loadl_epi64(reinterpret_cast<const __m128i*>(bytes + static_cast<std::int64_t>(j) * Scale)));
+}
+
 namespace avx2
 {
 using Idx = __m128i;
@@ -58,34 +69,20 @@ VAO_LANES D gatherFloats(const float* base, Idx at)
   storeIndices(i, at);
   return _mm256_cvtps_pd(_mm_setr_ps(base[i[0]], base[i[1]], base[i[2]], base[i[3]]));
 }
-/// The 8 bytes at byte offset Scale * i of base, as the low half of a vector.
-template <int Scale>
-VAO_LANES __m128i loadPair(const float* base, std::int32_t i)
-{
-  return _mm_loadl_epi64(
-    reinterpret_cast<const __m128i*>(reinterpret_cast<const char*>(base) + static_cast<std::int64_t>(i) * Scale));
-}
 /// The float pairs at byte Scale * at[k] of base: first and second of each.
 template <int Scale>
 VAO_LANES void gatherPairs(const float* base, Idx at, D& first, D& second)
 {
   alignas(16) std::int32_t i[4];
   storeIndices(i, at);
-  const __m128i low = _mm_unpacklo_epi64(loadPair<Scale>(base, i[0]), loadPair<Scale>(base, i[1]));
-  const __m128i high = _mm_unpacklo_epi64(loadPair<Scale>(base, i[2]), loadPair<Scale>(base, i[3]));
+  const __m128i low = loadPairs<Scale>(base, i[0], i[1]);
+  const __m128i high = loadPairs<Scale>(base, i[2], i[3]);
   const __m256i pairs = _mm256_inserti128_si256(_mm256_castsi128_si256(low), high, 1);
   const __m256 grouped =
     _mm256_permutevar8x32_ps(_mm256_castsi256_ps(pairs), _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7));
   first = _mm256_cvtps_pd(_mm256_castps256_ps128(grouped));
   second = _mm256_cvtps_pd(_mm256_extractf128_ps(grouped, 1));
 }
-/// a * b + c rounded once.
-VAO_LANES D fusedMultiplyAdd(D a, D b, D c) { return _mm256_fmadd_pd(a, b, c); }
-VAO_LANES Mask everyLane() { return _mm256_castsi256_pd(_mm256_set1_epi64x(-1)); }
-/// a and not b.
-VAO_LANES Mask butNot(Mask a, Mask b) { return _mm256_andnot_pd(b, a); }
-/// Not NaN.
-VAO_LANES Mask ordered(D a) { return _mm256_cmp_pd(a, a, _CMP_ORD_Q); }
 #undef VAO_LANES
 } // namespace avx2
 
@@ -119,19 +116,13 @@ VAO_LANES D gatherFloats(const float* base, Idx at)
     _mm256_setr_ps(base[i[0]], base[i[1]], base[i[2]], base[i[3]], base[i[4]], base[i[5]], base[i[6]], base[i[7]]));
 }
 template <int Scale>
-VAO_LANES __m128i loadPair(const float* base, std::int32_t i)
-{
-  return _mm_loadl_epi64(
-    reinterpret_cast<const __m128i*>(reinterpret_cast<const char*>(base) + static_cast<std::int64_t>(i) * Scale));
-}
-template <int Scale>
 VAO_LANES void gatherPairs(const float* base, Idx at, D& first, D& second)
 {
   alignas(32) std::int32_t i[8];
   storeIndices(i, at);
   __m128i quarter[4];
   for (int q = 0; q < 4; ++q)
-    quarter[q] = _mm_unpacklo_epi64(loadPair<Scale>(base, i[2 * q]), loadPair<Scale>(base, i[2 * q + 1]));
+    quarter[q] = loadPairs<Scale>(base, i[2 * q], i[2 * q + 1]);
   const __m256i low = _mm256_inserti128_si256(_mm256_castsi128_si256(quarter[0]), quarter[1], 1);
   const __m256i high = _mm256_inserti128_si256(_mm256_castsi128_si256(quarter[2]), quarter[3], 1);
   const __m512i pairs = _mm512_inserti64x4(_mm512_castsi256_si512(low), high, 1);
@@ -140,10 +131,6 @@ VAO_LANES void gatherPairs(const float* base, Idx at, D& first, D& second)
   first = _mm512_cvtps_pd(_mm512_castps512_ps256(grouped));
   second = _mm512_cvtps_pd(_mm512_extractf32x8_ps(grouped, 1));
 }
-VAO_LANES D fusedMultiplyAdd(D a, D b, D c) { return _mm512_fmadd_pd(a, b, c); }
-VAO_LANES Mask everyLane() { return 0xFF; }
-VAO_LANES Mask butNot(Mask a, Mask b) { return static_cast<Mask>(a & ~b); }
-VAO_LANES Mask ordered(D a) { return _mm512_cmp_pd_mask(a, a, _CMP_ORD_Q); }
 #undef VAO_LANES
 } // namespace avx512
 

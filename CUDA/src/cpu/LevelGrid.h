@@ -19,7 +19,7 @@ namespace detail
 {
 
 /// Points a surface query samples together. (16 rather than 8: the march's independent
-/// vectors overlap their gathers; the CT head's bone surface shadows ran 12% faster in
+/// vectors overlap their loads; the CT head's bone surface shadows ran 12% faster in
 /// AVX-512 and in AVX2.)
 constexpr int kLanes = 16;
 

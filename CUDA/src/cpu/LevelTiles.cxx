@@ -131,14 +131,7 @@ void LevelTiles::markAround(double x, double y, double z)
 {
   // The cell's lower corner as trilinearSample finds it, from the same grid numbers: the
   // cell's tile holds all its corners.
-  const LevelGrid& g = this->Grid;
-  const double p[3] = { x, y, z };
-  std::int64_t tile[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    const double u = std::min(std::max((p[a] - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
-    tile[a] = static_cast<std::int64_t>(u) >> kTileShift;
-  }
+  const std::int64_t tile[3] = { this->tileAlong(0, x), this->tileAlong(1, y), this->tileAlong(2, z) };
   std::int64_t lowest = this->LowestMarked.load(std::memory_order_relaxed);
   while (tile[2] < lowest && !this->LowestMarked.compare_exchange_weak(lowest, tile[2], std::memory_order_relaxed))
   {
@@ -155,10 +148,10 @@ void LevelTiles::markAround(double x, double y, double z)
     state.store(kInUse, std::memory_order_relaxed);
 }
 
-std::int64_t LevelTiles::layerOf(double z) const
+std::int64_t LevelTiles::tileAlong(int a, double p) const
 {
   const LevelGrid& g = this->Grid;
-  const double u = std::min(std::max((z - g.origin[2]) * g.inverseSpacing[2], 0.0), g.maxIndex[2]);
+  const double u = std::min(std::max((p - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
   return static_cast<std::int64_t>(u) >> kTileShift;
 }
 

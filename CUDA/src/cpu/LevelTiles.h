@@ -102,7 +102,7 @@ public:
   bool buildMarked(const Execution& execution);
 
   /// The layer of tiles (along z) holding world z, clamped to the level.
-  std::int64_t layerOf(double z) const;
+  std::int64_t layerOf(double z) const { return this->tileAlong(2, z); }
   std::int64_t layerCount() const { return this->Tiles[2]; }
   /// The lowest and highest layers markAround reached since forgetMarks (layerCount()
   /// and -1 when none). forgetMarks also ends the use of the tiles marked.
@@ -124,6 +124,10 @@ public:
   static std::int64_t tilesOf(const Index3& dims);
 
 private:
+  /// The tile coordinate along axis a of the cell holding world coordinate p (its lower
+  /// corner as trilinearSample finds it, clamped to the level).
+  std::int64_t tileAlong(int a, double p) const;
+
   struct TileRun
   {
     std::int64_t first, count; // tiles first, first + 1, ... along x

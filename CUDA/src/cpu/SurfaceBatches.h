@@ -106,6 +106,14 @@ struct MarchBounds
     }
   }
 
+  double diagonal() const
+  {
+    double squared = 0.0;
+    for (int a = 0; a < 3; ++a)
+      squared += (this->hi[a] - this->lo[a]) * (this->hi[a] - this->lo[a]);
+    return std::sqrt(squared);
+  }
+
   bool contains(const double* p) const
   {
     return p[0] >= this->lo[0] && p[0] <= this->hi[0] && p[1] >= this->lo[1] && p[1] <= this->hi[1] &&

@@ -1,9 +1,9 @@
 // The surface queries' Chebyshev lanes (LevelGrid.h's definition) on a width of doubles,
 // written once over DoubleLanes.h and GatherLanes.h and included by SurfaceLanes.h into
-// the avx2 and the avx512 namespace: a cell's corners by 32-bit gathers, the trilinear
-// blend and the estimator in vector arithmetic, and the whole shadow march of a batch in
-// registers, so one step is few enough instructions for the processor to overlap the
-// gathers' latency of several. Equal to the plain loops but for the rounding of the
+// the avx2 and the avx512 namespace: a cell's corners gathered through 32-bit indices,
+// the trilinear blend and the estimator in vector arithmetic, and the whole shadow march
+// of a batch in registers, so one step is few enough instructions for the processor to
+// overlap the loads' latency of several. Equal to the plain loops but for the rounding of the
 // blends' fused multiply-adds; the march passes over the samples that their cell's bound
 // (CellBounds) shows cannot raise a lane's occlusion, which changes no maximum.
 // No include guard: included once per namespace, with VAO_LANES its inline target.
@@ -54,12 +54,22 @@ VAO_LANES Cells cellsOf(const LevelGrid& g, const D* position)
   return c;
 }
 
+/// The lower x corners of the cells' four x rows: (y, z), (y + 1, z), (y, z + 1),
+/// (y + 1, z + 1).
+VAO_LANES void rowsOf(const Cells& c, Idx* row)
+{
+  row[0] = c.base;
+  row[1] = add(c.base, c.step[1]);
+  row[2] = add(c.base, c.step[2]);
+  row[3] = add(row[2], c.step[1]);
+}
+
 /// The trilinear mean and variance (not yet clamped) of the cells: the four x rows of
 /// each cell, lerped along x, then y, then z (trilinearSample's order).
 VAO_LANES void blend(const LevelGrid& g, const Cells& c, D& mean, D& variance)
 {
-  const Idx row[4] = { c.base, add(c.base, c.step[1]), add(c.base, c.step[2]),
-    add(add(c.base, c.step[2]), c.step[1]) };
+  Idx row[4];
+  rowsOf(c, row);
   D means[4], variances[4];
   for (int r = 0; r < 4; ++r)
   {
@@ -117,9 +127,8 @@ VAO_LANES_ENTRY void prefetchLanes(const LevelGrid& g, const double* x, const do
   for (int h = 0; h < kLanes; h += kWidth)
   {
     const D position[3] = { load(x + h), load(y + h), load(z + h) };
-    const Cells c = cellsOf(g, position);
-    const Idx rows[4] = { c.base, add(c.base, c.step[1]), add(c.base, c.step[2]),
-      add(add(c.base, c.step[2]), c.step[1]) };
+    Idx rows[4];
+    rowsOf(cellsOf(g, position), rows);
     alignas(64) std::int32_t at[4][kWidth];
     for (int r = 0; r < 4; ++r)
       storeIndices(at[r], rows[r]);

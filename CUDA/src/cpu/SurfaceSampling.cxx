@@ -157,7 +157,7 @@ void batchOcclusion(const PreparedPyramid& pyramid, int levels, const PointLanes
   };
   // Levels 0 and 1 (96% of a pyramid's bytes) are far larger than the caches: the batch
   // first asks for their lines, so their misses overlap (CT head bone surface AO on the
-  // whole pyramid: 35 -> 32 ms).
+  // whole pyramid: 40 -> 35 ms in alternated runs).
   for (int l = 0; l < std::min(levels, 2); ++l)
   {
     positions(l);
@@ -319,13 +319,9 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
   // The tiled levels' samples: the query half a voxel inside (level 0) and the march's
   // steps while it is on them (batchMarch's positions, whatever the occlusion met).
   const double r0 = base.kernelRadius;
-  std::vector<double> kernelRadius;
-  for (int l = 0; l < levels; ++l)
-    kernelRadius.push_back(pyramid[l].kernelRadius);
-  double diagonal = 0.0;
-  for (int a = 0; a < 3; ++a)
-    diagonal += (bounds.hi[a] - bounds.lo[a]) * (bounds.hi[a] - bounds.lo[a]);
-  const std::vector<detail::MarchStep> schedule = detail::marchSchedule(kernelRadius.data(), levels, 2.0 * std::sqrt(diagonal));
+  PreparedPyramid prepared(pyramid, levels, tiles);
+  const std::vector<detail::MarchStep> schedule =
+    detail::marchSchedule(prepared.kernelRadius.data(), levels, 2.0 * bounds.diagonal());
   const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t) {
     for (int k = 0; k < lanes.used; ++k)
     {
@@ -342,7 +338,6 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
       }
     }
   };
-  PreparedPyramid prepared(pyramid, levels, tiles);
   prepared.boundCells(count);
   const bool finished = detail::sweepPoints(tiles, points, normals, count, execution, mark, [&](PointLanes& lanes) {
     for (int k = 0; k < detail::kLanes; ++k)
