@@ -182,6 +182,11 @@ TEST(KeptRanges, OpennessRangeOfTheMomentMethodsEqualsAScan)
       EXPECT_FALSE(plainRange.known);
       output.opennessRange = &range;
       ASSERT_TRUE(vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, output).ok);
+      if (!vao::detail::cpuHasAvx2())
+      {
+        EXPECT_FALSE(range.known); // a processor without AVX2 leaves it to the caller's pass
+        continue;
+      }
       ASSERT_TRUE(range.known) << static_cast<int>(method);
       EXPECT_EQ(range.lowest, *std::min_element(out.begin(), out.end())) << static_cast<int>(method);
       EXPECT_EQ(range.highest, *std::max_element(out.begin(), out.end())) << static_cast<int>(method);
