@@ -15,7 +15,8 @@ job="${1:-demo}"
 shift || true
 
 # Verified from a bare Debian 12 (see ../shared/ARCHITECTURE.md), plus scipy for the
-# benchmark's peer and python3-dev for the Python package.
+# benchmark's peer, python3-dev for the Python package and qemu-user for the kernel tests
+# on an emulated processor without AVX2.
 qt_packages=(qtbase5-dev qttools5-dev libqt5svg5-dev libqt5opengl5-dev qtxmlpatterns5-dev-tools
   libqt5x11extras5-dev)
 # Debian 13's ParaView 5.13 is built with Qt 6 (Testing/compat/debian13.sh runs this there).
@@ -26,7 +27,7 @@ packages=(cmake g++ ninja-build paraview-dev paraview python3-paraview "${qt_pac
   libhdf5-openmpi-dev libutfcpp-dev libgl2ps-dev libglew-dev libgdal-dev libnetcdf-dev
   libavcodec-dev libavformat-dev libswscale-dev libtheora-dev libdouble-conversion-dev
   liblz4-dev libexpat1-dev libeigen3-dev libboost-dev libfreetype-dev mpi-default-dev
-  python3-mpi4py libgtest-dev xvfb xauth python3-numpy python3-scipy python3-dev)
+  python3-mpi4py libgtest-dev xvfb xauth python3-numpy python3-scipy python3-dev qemu-user)
 # libFuzzer comes with clang (GCC's sanitizers come with g++).
 [ "$job" = fuzz ] && packages+=(clang-16 libclang-rt-16-dev)
 
