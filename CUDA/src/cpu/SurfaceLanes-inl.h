@@ -3,9 +3,9 @@
 // the avx2 and the avx512 namespace: a cell's corners gathered through 32-bit indices,
 // the trilinear blend and the estimator in vector arithmetic, and the whole shadow march
 // of a batch in registers, so one step is few enough instructions for the processor to
-// overlap the loads' latency of several. Equal to the plain loops but for the rounding of the
-// blends' fused multiply-adds; the march passes over the samples that their cell's bound
-// (CellBounds) shows cannot raise a lane's occlusion, which changes no maximum.
+// overlap the loads' latency of several. Equal to the plain loops but for the rounding of
+// the blends' fused multiply-adds; the march passes over the samples that their cell's
+// bound (CellBounds) shows cannot raise a lane's occlusion, which changes no maximum.
 // No include guard: included once per namespace, with VAO_LANES its inline target.
 
 /// The vectors of a batch.

@@ -83,8 +83,8 @@ inline void chebyshevMarch(SimdTier tier, const LevelGrid* grids, const std::vec
 #endif
 
 /// The occlusions of kLanes samples of one level with the given estimator: Chebyshev on
-/// AVX2 or AVX-512 where the indices fit in 32 bits, else the plain loop (the exact erf has no vector
-/// form here).
+/// AVX2 or AVX-512 where the indices fit in 32 bits, else the plain loop (the exact erf
+/// has no vector form here).
 inline void occlusionLanes(const LevelGrid& g, Method estimator, const double* x, const double* y, const double* z,
   const double* query, double* occlusion)
 {
