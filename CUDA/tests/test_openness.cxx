@@ -4,7 +4,12 @@
 #include "ReferenceFormulas.h"
 #include "TestVolumes.h"
 
+#include "../src/cpu/ExactReference.h"
+
 #include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
 
 using namespace vaotest;
 
@@ -153,6 +158,80 @@ TEST(Openness, APieceGrownByTheRadiusGivesTheWholeVolumesNumbers)
     expectPieceEqualsWhole(v16, dims, method, { 3, 2, 4 }, 0.0f);
     expectPieceEqualsWhole(vd, dims, method, { 2, 3, 3 }, 1e-6f);
   }
+}
+
+/// The exact references on every type, against the brute force's test double(v) <= q:
+/// values at the type's ends, queries between two of its values, beyond its range and not
+/// finite (the internal entry point takes any query), a sub-region, and a strided view.
+template <class T>
+void expectExactCountsLikeDoubles(const std::vector<T>& values, const std::vector<double>& queries)
+{
+  SCOPED_TRACE(sizeof(T));
+  const vao::Index3 dims = { 11, 5, 4 };
+  const std::int64_t n = dims[0] * dims[1] * dims[2];
+  std::mt19937 rng(7);
+  std::vector<T> v(n), interleaved(2 * n);
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    v[i] = values[rng() % values.size()];
+    interleaved[2 * i + 1] = v[i];
+  }
+  const vao::Region region{ { 3, 1, 1 }, { 7, 3, 3 } };
+  std::vector<double> query(region.voxelCount());
+  for (double& q : query)
+    q = queries[rng() % queries.size()];
+  for (const vao::Radius r : { vao::Radius{ 2, 1, 1 }, vao::Radius{ 4, 2, 0 } })
+    for (const Method method : { Method::ExactBox, Method::ExactSphere })
+      for (const std::int64_t stride : { 1, 2 })
+      {
+        vao::AmbientOcclusionParameters p;
+        p.method = method;
+        p.radius = r;
+        std::vector<float> got(region.voxelCount(), -1.0f);
+        vao::VolumeView view = stride == 1 ? viewOf(v, dims) : viewOf(interleaved, dims, 2);
+        view.data = stride == 1 ? v.data() : interleaved.data() + 1;
+        ASSERT_TRUE(vao::detail::computeExactOpenness(view, region, p, query.data(), got.data(), {}).ok);
+        std::int64_t k = 0, failures = 0;
+        for (std::int64_t z = region.begin[2]; z < region.begin[2] + region.size[2]; ++z)
+          for (std::int64_t y = region.begin[1]; y < region.begin[1] + region.size[1]; ++y)
+            for (std::int64_t x = region.begin[0]; x < region.begin[0] + region.size[0]; ++x, ++k)
+            {
+              const auto expected = static_cast<float>(
+                bruteForceOpenness(v, dims, r, x, y, z, query[k], method == Method::ExactSphere));
+              if (got[k] != expected && failures++ < 5)
+                ADD_FAILURE() << "stride " << stride << " at (" << x << "," << y << "," << z << ") query "
+                              << query[k] << ": " << got[k] << " vs " << expected;
+            }
+      }
+}
+
+TEST(Openness, ExactReferencesCountAsDoublesOnEveryType)
+{
+  const double nan = std::nan(""), inf = INFINITY;
+  const std::vector<double> common = { nan, inf, -inf, 1e300, -1e300, 0.0, -0.0, 0.5, -0.5, 1.0, 7.25 };
+  auto with = [&](std::vector<double> extra) {
+    extra.insert(extra.end(), common.begin(), common.end());
+    return extra;
+  };
+  expectExactCountsLikeDoubles<std::int8_t>({ -128, 127, -1, 0, 1, 7 }, with({ -128, -128.5, 126.99, 127 }));
+  expectExactCountsLikeDoubles<std::uint8_t>({ 0, 255, 1, 7, 128 }, with({ 254.5, 255, 255.5, 127.9 }));
+  expectExactCountsLikeDoubles<std::int16_t>({ -32768, 32767, -1, 0, 7 }, with({ -32768.5, 32766.5, 32767 }));
+  expectExactCountsLikeDoubles<std::uint16_t>({ 0, 65535, 1, 7 }, with({ 65534.5, 65535, 65536 }));
+  expectExactCountsLikeDoubles<std::int32_t>({ INT32_MIN, INT32_MAX, -1, 0, 7 },
+    with({ -2147483648.5, -2147483648.0, 2147483646.5, 2147483647.0 }));
+  expectExactCountsLikeDoubles<std::uint32_t>({ 0, UINT32_MAX, 1, 7 }, with({ 4294967294.5, 4294967295.0 }));
+  // 64-bit integers round on the way to double: 2^53 + 1 compares as 2^53, 2^64 - 1 as 2^64.
+  const double two53 = 9007199254740992.0, two63 = 9223372036854775808.0;
+  const std::int64_t big = (std::int64_t(1) << 53) + 1;
+  expectExactCountsLikeDoubles<std::int64_t>({ INT64_MIN, INT64_MAX, big, big + 2, 0, 7 },
+    with({ two53, two53 + 2, -two63, two63 }));
+  expectExactCountsLikeDoubles<std::uint64_t>({ 0, 7, std::uint64_t(big), UINT64_MAX }, with({ two53, 2 * two63, two63 }));
+  // Floats: queries between two floats (0.1, 1e-46) and beyond the largest float.
+  const double fmax = std::numeric_limits<float>::max(), tiny = std::numeric_limits<float>::denorm_min();
+  expectExactCountsLikeDoubles<float>({ 0.1f, -0.1f, float(fmax), float(-fmax), float(tiny), 0, INFINITY, -INFINITY, NAN },
+    with({ 0.1, static_cast<double>(0.1f), -0.1, 1e-46, tiny, 2 * fmax, fmax, -fmax, -2 * fmax }));
+  expectExactCountsLikeDoubles<double>({ 0.1, -0.1, 1e308, -1e308, 5e-324, inf, -inf, nan },
+    with({ 0.1, std::nextafter(0.1, 1.0), 1e308, 5e-324, 1e-320 }));
 }
 
 TEST(Openness, RejectsNonFiniteIsoValue)

@@ -3,7 +3,10 @@
 #include "Parallel.h"
 #include "VolumeAccess.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <type_traits>
 #include <vector>
 
 namespace vao
@@ -51,49 +54,139 @@ std::int64_t rowHalfWidth(const Radius& r, std::int64_t dy, std::int64_t dz, boo
   return dx;
 }
 
+/// A voxel counts when double(v) <= q (METHODS.md). Every value of a type of up to 32 bits
+/// is a double, so that test holds exactly when v <= t, t the largest value of the type at
+/// most q, and it runs in the type itself: 8 to 32 lanes a vector. 64-bit integers round
+/// on the way to double, so they compare as doubles.
 template <class T>
-void exactSlice(const TypedVolume<T>& volume, const Region& region,
-  const AmbientOcclusionParameters& p, const std::vector<std::int64_t>& halfWidths,
-  std::int64_t z, const double* query, float* out)
+struct AtMost
 {
-  const Radius& r = p.radius;
-  const Index3& n = volume.dims;
-  const bool iso = p.queryMode == QueryMode::IsoValue;
-  for (std::int64_t y = region.begin[1]; y < region.begin[1] + region.size[1]; ++y)
+  using Type = typename std::conditional<std::is_integral<T>::value && sizeof(T) == 8, double, T>::type;
+
+  /// The largest Type at most q; false when none is (q NaN or below every value).
+  static bool threshold(double q, Type& t)
   {
-    for (std::int64_t x = region.begin[0]; x < region.begin[0] + region.size[0]; ++x)
+    using Limits = std::numeric_limits<Type>;
+    if (std::isnan(q))
     {
-      const std::int64_t k = ((z - region.begin[2]) * region.size[1] + (y - region.begin[1])) *
-          region.size[0] + (x - region.begin[0]);
-      const double q = query ? query[k] : (iso ? p.isoValue : static_cast<double>(volume.value(x, y, z)));
-      std::int64_t below = 0, total = 0;
-      for (std::int64_t dz = -r.z; dz <= r.z; ++dz)
+      return false;
+    }
+    if constexpr (std::is_same<Type, double>::value)
+    {
+      t = static_cast<Type>(q);
+    }
+    else if constexpr (std::is_floating_point<Type>::value)
+    {
+      // Beyond the largest finite float only the infinity on q's side can count.
+      if (q > static_cast<double>(Limits::max()) || q < static_cast<double>(Limits::lowest()))
       {
-        if (z + dz < 0 || z + dz >= n[2])
+        t = q == Limits::infinity() ? Limits::infinity() : (q > 0 ? Limits::max() : -Limits::infinity());
+      }
+      else
+      {
+        t = static_cast<Type>(q);
+        if (static_cast<double>(t) > q)
+        {
+          t = std::nextafter(t, -Limits::infinity());
+        }
+      }
+    }
+    else
+    {
+      if (q < static_cast<double>(Limits::lowest()))
+      {
+        return false;
+      }
+      t = q >= static_cast<double>(Limits::max()) ? Limits::max() : static_cast<Type>(std::floor(q));
+    }
+    return true;
+  }
+};
+
+/// part[i] += 1 where row[i + dx] <= t[i], for i in [from, to): the neighbours at offset dx
+/// of a run of voxels, each against its own threshold.
+template <class T, class C>
+void countAtOffset(const T* row, const C* t, std::int64_t from, std::int64_t to, std::int64_t dx, std::uint32_t* part)
+{
+  for (std::int64_t i = from; i < to; ++i)
+  {
+    part[i] += static_cast<C>(row[i + dx]) <= t[i] ? 1u : 0u;
+  }
+}
+
+/// One output row (y, z) of the region, counted offset by offset across the row: each
+/// pass compares a run of neighbours with the run of thresholds, which vectorises whatever
+/// the radius, where a voxel's own rows of 2 R + 1 values would not.
+template <class T>
+struct ExactRow
+{
+  using C = typename AtMost<T>::Type;
+  std::vector<C> thresholds;
+  std::vector<std::uint8_t> counted;
+  std::vector<std::uint32_t> part;
+  std::vector<std::int64_t> below, total;
+  std::vector<T> gathered;
+
+  void run(const TypedVolume<T>& volume, const Region& region, const AmbientOcclusionParameters& p,
+    const std::vector<std::int64_t>& halfWidths, std::int64_t y, std::int64_t z, const double* query, float* out)
+  {
+    const Radius& r = p.radius;
+    const Index3& n = volume.dims;
+    const std::int64_t x0 = region.begin[0], nx = region.size[0];
+    const std::int64_t first = ((z - region.begin[2]) * region.size[1] + (y - region.begin[1])) * nx;
+    thresholds.resize(nx);
+    counted.resize(nx);
+    part.resize(nx);
+    below.assign(nx, 0);
+    total.assign(nx, 0);
+    for (std::int64_t i = 0; i < nx; ++i)
+    {
+      const double q = query ? query[first + i]
+                             : (p.queryMode == QueryMode::IsoValue ? p.isoValue
+                                                                   : static_cast<double>(volume.value(x0 + i, y, z)));
+      counted[i] = AtMost<T>::threshold(q, thresholds[i]) ? 1 : 0;
+    }
+    for (std::int64_t dz = -r.z; dz <= r.z; ++dz)
+    {
+      for (std::int64_t dy = -r.y; dy <= r.y; ++dy)
+      {
+        const std::int64_t hw = halfWidths[(dz + r.z) * (2 * r.y + 1) + (dy + r.y)];
+        if (hw < 0 || z + dz < 0 || z + dz >= n[2] || y + dy < 0 || y + dy >= n[1])
         {
           continue;
         }
-        for (std::int64_t dy = -r.y; dy <= r.y; ++dy)
+        const T* row = volume.row(y + dy, z + dz);
+        if (volume.stride != 1)
         {
-          const std::int64_t hw = halfWidths[(dz + r.z) * (2 * r.y + 1) + (dy + r.y)];
-          if (hw < 0 || y + dy < 0 || y + dy >= n[1])
+          gathered.resize(n[0]);
+          for (std::int64_t x = 0; x < n[0]; ++x)
           {
-            continue;
+            gathered[x] = row[x * volume.stride];
           }
-          const std::int64_t lo = std::max<std::int64_t>(0, x - hw);
-          const std::int64_t hi = std::min<std::int64_t>(n[0] - 1, x + hw);
-          const T* row = volume.row(y + dy, z + dz);
-          for (std::int64_t i = lo; i <= hi; ++i)
-          {
-            below += static_cast<double>(row[i * volume.stride]) <= q ? 1 : 0;
-          }
-          total += hi - lo + 1;
+          row = gathered.data();
+        }
+        std::fill(part.begin(), part.end(), 0u);
+        // Offsets beyond the volume's x range have no neighbours to count.
+        for (std::int64_t dx = std::max(-hw, -x0 - nx + 1); dx <= std::min(hw, n[0] - 1 - x0); ++dx)
+        {
+          countAtOffset(row + x0, thresholds.data(), std::max<std::int64_t>(0, -x0 - dx),
+            std::min(nx, n[0] - x0 - dx), dx, part.data());
+        }
+        for (std::int64_t i = 0; i < nx; ++i)
+        {
+          const std::int64_t x = x0 + i;
+          below[i] += part[i];
+          total[i] += std::min(n[0] - 1, x + hw) - std::max<std::int64_t>(0, x - hw) + 1;
         }
       }
-      out[k] = static_cast<float>(static_cast<double>(below) / static_cast<double>(total));
+    }
+    for (std::int64_t i = 0; i < nx; ++i)
+    {
+      const double counts = counted[i] ? static_cast<double>(below[i]) : 0.0;
+      out[first + i] = static_cast<float>(counts / static_cast<double>(total[i]));
     }
   }
-}
+};
 
 } // namespace
 
@@ -120,9 +213,13 @@ Status computeExactOpenness(const VolumeView& view, const Region& region,
     // One slice per chunk: slices cost the same, and progress moves often.
     return parallelFor(region.size[2], static_cast<int>(region.size[2]), execution.threads, execution,
       [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+        ExactRow<T> rows;
         for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
         {
-          exactSlice(volume, region, p, halfWidths, region.begin[2] + k, query, openness);
+          for (std::int64_t y = region.begin[1]; y < region.begin[1] + region.size[1]; ++y)
+          {
+            rows.run(volume, region, p, halfWidths, y, region.begin[2] + k, query, openness);
+          }
           progress.advance();
         }
       });
