@@ -6,7 +6,7 @@ import sys
 METHODS = ["Histogram CDF", "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box", "Exact Sphere"]
 
 # SaveData's options for files the tests only read back: raw appended data, uncompressed
-# (a third of the time of base64 inline data; the MPI test writes 25 such files).
+# (a third of the time of base64 inline data; the MPI test writes three files a run).
 RAW_XML = dict(DataMode="Appended", EncodeAppendedData=0, CompressorType="None")
 
 
