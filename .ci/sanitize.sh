@@ -10,7 +10,10 @@
 # GCC's sanitizers come with g++ (libasan8, libubsan1, libtsan2). CI runs the kernel part.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-asan="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer -g"
+# UBSan's object-size, null and alignment checks are left out (a quarter of the instrumented
+# build): ASan reports the accesses out of bounds and through null itself, and the
+# misaligned access that matters on x86, an aligned vector load, faults in the tests anyway.
+asan="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize=object-size,null,alignment -fno-sanitize-recover=all -fno-omit-frame-pointer -g"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
 
