@@ -44,8 +44,10 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   const detail::MomentScale scale = detail::momentScale(volume, scan.minimum, scan.maximum);
   // Chebyshev and the Gaussian CDF take exact sums as they are (opennessRow).
   const bool fromSums = p.method == Method::Chebyshev || p.method == Method::GaussianCdf;
+  // CDF Reconstruction takes the mean alone from the moments.
+  const bool variance = output.variance || (output.openness && p.method != Method::CdfReconstruction);
   const detail::RowContents contents{ withExtrema, output.variance != nullptr || !output.openness || !fromSums,
-    output.openness && voxelQuery && !query };
+    output.openness && voxelQuery && !query, variance };
   // Kept where the rows' extremes take vector instructions; the plain loop would cost
   // several times the separate, threaded pass the caller then makes (vao/ValueRanges.h).
   const bool keepRange = output.openness && output.opennessRange && detail::cpuHasAvx2();

@@ -134,7 +134,7 @@ struct NeighbourhoodRow
   const double* value = nullptr;    // the voxels' own values
   const double* count = nullptr;    // voxels in each clipped box
   const double* mean = nullptr;
-  const double* variance = nullptr; // population variance, clamped at 0
+  const double* variance = nullptr; // population variance, clamped at 0; null if not asked for
   const double* minimum = nullptr;  // null unless the extrema were asked for
   const double* maximum = nullptr;
   double roundingVariance = 0.0;    // as NeighbourhoodStats::roundingVariance
@@ -147,7 +147,7 @@ struct NeighbourhoodRow
 
   NeighbourhoodStats stats(std::int64_t i) const
   {
-    return { this->mean[i], this->variance[i], this->minimum ? this->minimum[i] : 0.0,
+    return { this->mean[i], this->variance ? this->variance[i] : 0.0, this->minimum ? this->minimum[i] : 0.0,
       this->maximum ? this->maximum[i] : 0.0, this->roundingVariance };
   }
 };
@@ -155,22 +155,26 @@ struct NeighbourhoodRow
 /// What forEachNeighbourhoodRow hands over besides the sums: the box extrema (computed in
 /// passes of their own), the means and variances, which exact integer sums can skip for
 /// consumers that take the sums (NeighbourhoodRow::sum), and the voxels' own values.
+/// Without `variance` the sums of squares are not formed (half the moments' work) and the
+/// rows have the means alone.
 struct RowContents
 {
   bool extrema = false;
   bool moments = true;
   bool values = true;
+  bool variance = true;
 };
 
 /// forEachNeighbourhoodRow on one band (band.region, a slab of rows of `whole`): voxel
-/// indices are those of the whole region.
+/// indices are those of the whole region. `extrema` holds the band's extrema planes (kept
+/// from band to band, so that their pages are not cleared anew for each).
 template <class T, class Visit>
 bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Region& whole,
-  const MomentScale& scale, RowContents contents, const Execution& execution, Visit&& visit)
+  const MomentScale& scale, RowContents contents, const Execution& execution, BoxExtrema<T>& extrema,
+  Visit&& visit)
 {
   const bool withExtrema = contents.extrema;
   const Region& region = band.region;
-  BoxExtrema<T> extrema;
   const double split = withExtrema ? 0.5 : 0.0;
   if (withExtrema && !computeBoxExtrema(volume, band, stageExecution(execution, 0.0, split), extrema))
   {
@@ -181,7 +185,7 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
   const std::int64_t nx = region.size[0], ny = region.size[1];
   const std::int64_t wholePlane = whole.size[0] * whole.size[1];
   const std::int64_t firstRow = region.begin[1] - whole.begin[1];
-  return streamMoments(volume, band, scale, stageExecution(execution, split, 1.0),
+  return streamMoments(volume, band, scale, contents.variance, stageExecution(execution, split, 1.0),
     [&](const MomentSlice<T>& slice) {
       const std::int64_t bandBase = (slice.z - region.begin[2]) * nx * ny;
       const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
@@ -197,7 +201,7 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
       out.value = value.data();
       out.count = count.data();
       out.mean = mean.data();
-      out.variance = variance.data();
+      out.variance = contents.variance ? variance.data() : nullptr;
       out.minimum = withExtrema ? minimum.data() : nullptr;
       out.maximum = withExtrema ? maximum.data() : nullptr;
       out.roundingVariance = slice.roundingVariance;
@@ -211,12 +215,12 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
         if constexpr (MomentTraits<T>::exactInteger)
         {
           out.sum = slice.sum + j * nx;
-          out.sumSquares = slice.sumSquares + j * nx;
+          out.sumSquares = slice.sumSquares ? slice.sumSquares + j * nx : nullptr;
           out.countX = countX.data();
           out.countYZ = countYZ;
           if (contents.moments) // double sums below always give them
-            meanVarianceRowExact(slice.sum + j * nx, slice.sumSquares + j * nx, countX.data(), countYZ, nx,
-              count.data(), mean.data(), variance.data());
+            meanVarianceRowExact(out.sum, out.sumSquares, countX.data(), countYZ, nx, count.data(), mean.data(),
+              out.sumSquares ? variance.data() : nullptr);
         }
         else
         {
@@ -225,7 +229,9 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
             const std::int64_t p = j * nx + i;
             const std::int64_t c = countX[i] * countYZ;
             count[i] = static_cast<double>(c);
-            meanVarianceFromSums(slice.sum[p], slice.sumSquares[p], c, slice.shift, mean[i], variance[i]);
+            // Without the squares the mean comes out the same and the variance is dropped.
+            meanVarianceFromSums(slice.sum[p], slice.sumSquares ? slice.sumSquares[p] : 0.0, c, slice.shift,
+              mean[i], variance[i]);
           }
         }
         if (withExtrema)
@@ -265,13 +271,15 @@ bool forEachNeighbourhoodRow(const TypedVolume<T>& volume, const BoxGeometry& ge
   const std::int64_t ny = region.size[1];
   const std::int64_t bandRows = withExtrema ? std::min(ny, extremaBandRows(geometry)) : ny;
   const std::int64_t bands = (ny + bandRows - 1) / bandRows;
+  BoxExtrema<T> extrema;
   for (std::int64_t b = 0; b < bands; ++b)
   {
     Region band = region;
     band.begin[1] = region.begin[1] + b * bandRows;
     band.size[1] = std::min(bandRows, ny - b * bandRows);
     const Execution stage = stageExecution(execution, double(b) / bands, double(b + 1) / bands);
-    if (!visitBand(volume, BoxGeometry(geometry.dims, band, geometry.radius), region, scale, contents, stage, visit))
+    if (!visitBand(
+          volume, BoxGeometry(geometry.dims, band, geometry.radius), region, scale, contents, stage, extrema, visit))
     {
       return false;
     }

@@ -106,18 +106,23 @@ VAO_LANES_ENTRY void opennessRowLanes(const Row& row, const double* query, doubl
   plain(i);
 }
 
+/// The lanes whose integer sum lies within +-2^50, where its conversion and small multiples
+/// are exact.
+VAO_LANES Mask smallSums(I s)
+{
+  return both(lessThan(s, set1(std::int64_t(1) << 50)), lessThan(set1(-(std::int64_t(1) << 50)), s));
+}
+
 /// The kWidth boxes from box i in doubles: their counts c (countX times yz), sums S, S^2
 /// and numerators c sumSquares - S^2 (exactSumsNumerator before its clamp at 0), when all
 /// are exact (sums of magnitude below 2^50, both products below 2^52); false otherwise.
 VAO_LANES bool exactBoxes(const std::int64_t* sum, const std::int64_t* sumSquares, const std::int64_t* countX, D yz,
   std::int64_t i, D& c, D& total, D& totalSquared, D& numerator)
 {
-  const I limit = set1(std::int64_t(1) << 50);
-  const I negativeLimit = set1(-(std::int64_t(1) << 50));
   const D exact = set1(4503599627370496.0); // 2^52
   const I s = loadIntegers(sum + i);
   const I s2 = loadIntegers(sumSquares + i);
-  if (!all(both(both(lessThan(s, limit), lessThan(negativeLimit, s)), lessThan(s2, limit))))
+  if (!all(both(smallSums(s), lessThan(s2, set1(std::int64_t(1) << 50)))))
     return false;
   c = mul(smallIntegersToDouble(loadIntegers(countX + i)), yz);
   total = smallIntegersToDouble(s);
@@ -129,13 +134,31 @@ VAO_LANES bool exactBoxes(const std::int64_t* sum, const std::int64_t* sumSquare
 
 /// meanVarianceRowExact (MomentRows.h), kWidth boxes at a time: count * sumSquares - sum^2
 /// in doubles, exact while both products stay below 2^52; `plain(end, begin)` does the
-/// boxes of [begin, end) that could leave that range, and the row's tail.
+/// boxes of [begin, end) that could leave that range, and the row's tail. Without
+/// sumSquares, the counts and means alone.
 template <class Plain>
 VAO_LANES_ENTRY void meanVarianceRowLanes(const std::int64_t* sum, const std::int64_t* sumSquares,
   const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, double* count, double* mean, double* variance,
   Plain&& plain)
 {
   const D yz = set1(static_cast<double>(countYZ));
+  if (!sumSquares) // the means alone: sums below 2^50 in magnitude convert exactly
+  {
+    for (std::int64_t i = 0; i + kWidth <= n; i += kWidth)
+    {
+      const I s = loadIntegers(sum + i);
+      if (!all(smallSums(s)))
+      {
+        plain(i + kWidth, i);
+        continue;
+      }
+      const D c = mul(smallIntegersToDouble(loadIntegers(countX + i)), yz);
+      store(count + i, c);
+      store(mean + i, div(smallIntegersToDouble(s), c));
+    }
+    plain(n, n - n % kWidth);
+    return;
+  }
   for (std::int64_t i = 0; i + kWidth <= n; i += kWidth)
   {
     D c, total, totalSquared, numerator;

@@ -73,9 +73,9 @@ struct SlideColumns
   }
 };
 
-/// d1 = a - b and d2 = a^2 - b^2 with a, b the values of rows `in` and `out` less the
-/// shift (0 for a missing row). Compiled for AVX2 too.
-template <class T, class Acc>
+/// d1 = a - b and, with Squares, d2 = a^2 - b^2, with a, b the values of rows `in` and
+/// `out` less the shift (0 for a missing row). Compiled for AVX2 too.
+template <class T, class Acc, bool Squares = true>
 struct RowDifferences
 {
   static VAO_ALWAYS_INLINE void run(const T* __restrict in, const T* __restrict out, std::int64_t stride,
@@ -91,14 +91,15 @@ struct RowDifferences
       const Product a = in ? static_cast<Product>(in[i * stride]) - s : Product(0);
       const Product b = out ? static_cast<Product>(out[i * stride]) - s : Product(0);
       d1[i] = static_cast<Acc>(a - b);
-      d2[i] = static_cast<Acc>(a * a - b * b);
+      if constexpr (Squares)
+        d2[i] = static_cast<Acc>(a * a - b * b);
     }
   }
 };
 
 /// box[i] = p[i + offset + width] - p[i + offset] for i in [begin, end), for both prefix
-/// rows. Compiled for AVX2 too.
-template <class Acc>
+/// rows (the first alone without Squares). Compiled for AVX2 too.
+template <class Acc, bool Squares = true>
 struct WindowDifferences
 {
   static VAO_ALWAYS_INLINE void run(const Acc* __restrict p1, const Acc* __restrict p2, std::int64_t offset,
@@ -107,31 +108,34 @@ struct WindowDifferences
     for (std::int64_t i = begin; i < end; ++i)
     {
       box1[i] = p1[i + offset + width] - p1[i + offset];
-      box2[i] = p2[i + offset + width] - p2[i + offset];
+      if constexpr (Squares)
+        box2[i] = p2[i + offset + width] - p2[i + offset];
     }
   }
 };
 
-/// Box sums of (v - shift) and (v - shift)^2 for one slice of the region at a time.
+/// Box sums of (v - shift) and, unless told not to (a consumer that needs the mean alone),
+/// of (v - shift)^2 for one slice of the region at a time.
 template <class T>
 class MomentPlanes
 {
 public:
   using Acc = typename MomentTraits<T>::Accumulator;
 
-  MomentPlanes(const TypedVolume<T>& volume, const BoxGeometry& geometry, Acc shift)
+  MomentPlanes(const TypedVolume<T>& volume, const BoxGeometry& geometry, Acc shift, bool squares)
     : Volume(volume)
     , Geo(geometry)
     , Shift(shift)
+    , Squares(squares)
     , Sum(geometry.planeSize())
-    , SumSquares(geometry.planeSize())
+    , SumSquares(squares ? geometry.planeSize() : 0)
     , Row1(geometry.xs.size() + 1)
-    , Row2(geometry.xs.size() + 1)
+    , Row2(squares ? geometry.xs.size() + 1 : 0)
     , RingRows(std::min<std::int64_t>(2 * std::int64_t(geometry.radius.y) + 2, geometry.ys.size()))
     , XBox1(RingRows * geometry.region.size[0])
-    , XBox2(RingRows * geometry.region.size[0])
+    , XBox2(squares ? RingRows * geometry.region.size[0] : 0)
     , Run1(geometry.region.size[0])
-    , Run2(geometry.region.size[0])
+    , Run2(squares ? geometry.region.size[0] : 0)
     , Zeros(geometry.region.size[0], Acc(0))
   {
   }
@@ -159,7 +163,8 @@ public:
   }
 
   const Acc* sum() const { return this->Sum.data(); }
-  const Acc* sumSquares() const { return this->SumSquares.data(); }
+  /// Null when the squares were not asked for.
+  const Acc* sumSquares() const { return this->Squares ? this->SumSquares.data() : nullptr; }
 
 private:
   /// Adds the 2-D box sums of slice `entering` and subtracts those of `leaving` (-1: none):
@@ -184,8 +189,9 @@ private:
       Acc* plane2 = row < 0 ? nullptr : this->SumSquares.data() + row * nx;
       runRows<SlideColumns<Acc>>(this->Simd, plane1, this->Run1.data(), in < 0 ? zeros : this->xbox1(in),
         out < 0 ? zeros : this->xbox1(out), nx);
-      runRows<SlideColumns<Acc>>(this->Simd, plane2, this->Run2.data(), in < 0 ? zeros : this->xbox2(in),
-        out < 0 ? zeros : this->xbox2(out), nx);
+      if (this->Squares)
+        runRows<SlideColumns<Acc>>(this->Simd, plane2, this->Run2.data(), in < 0 ? zeros : this->xbox2(in),
+          out < 0 ? zeros : this->xbox2(out), nx);
     };
     for (std::int64_t y = std::max<std::int64_t>(0, y0 - r); y <= std::min(ny - 1, y0 + r); ++y)
     {
@@ -219,22 +225,28 @@ private:
     const T* out = leaving >= 0 ? this->Volume.row(y, leaving) + this->Geo.xs.lo * stride : nullptr;
     // The differences of the two rows (a vector loop), then their prefix sums:
     // p[i] = sum of the first i values.
-    runRows<RowDifferences<T, Acc>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
+    if (this->Squares)
+    {
+      runRows<RowDifferences<T, Acc>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
+      p2[0] = 0;
+    }
+    else
+      runRows<RowDifferences<T, Acc, false>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p1 + 1);
     p1[0] = 0;
-    p2[0] = 0;
     if constexpr (std::is_same<Acc, std::int64_t>::value)
-      runningTotals(p1, p2, span + 1, this->Simd); // exact: any order of the additions
+      runningTotals(p1, this->Squares ? p2 : nullptr, span + 1, this->Simd); // exact: any order of the additions
     else
       for (std::int64_t i = 0; i < span; ++i) // double sums: this order on every tier
       {
         p1[i + 1] += p1[i];
-        p2[i + 1] += p2[i];
+        if (this->Squares)
+          p2[i + 1] += p2[i];
       }
     const std::int64_t nx = this->Geo.region.size[0];
     const std::int64_t r = this->Geo.radius.x;
     const std::int64_t x0 = this->Geo.region.begin[0] - this->Geo.xs.lo; // first output in span
     Acc* box1 = this->xbox1(y);
-    Acc* box2 = this->xbox2(y);
+    Acc* box2 = this->Squares ? this->xbox2(y) : nullptr;
     // Outputs whose window lies inside the span (a vector loop) and the clamped ends.
     const std::int64_t first = std::min(nx, std::max<std::int64_t>(0, r - x0));
     const std::int64_t end = std::max(first, std::min(nx, span - r - x0));
@@ -242,11 +254,15 @@ private:
       const std::int64_t lo = std::max<std::int64_t>(0, x0 + i - r);
       const std::int64_t hi = std::min<std::int64_t>(span, x0 + i + r + 1);
       box1[i] = p1[hi] - p1[lo];
-      box2[i] = p2[hi] - p2[lo];
+      if (box2)
+        box2[i] = p2[hi] - p2[lo];
     };
     for (std::int64_t i = 0; i < first; ++i)
       clamped(i);
-    runRows<WindowDifferences<Acc>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+    if (box2)
+      runRows<WindowDifferences<Acc>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+    else
+      runRows<WindowDifferences<Acc, false>>(this->Simd, p1, p1, x0 - r, 2 * r + 1, box1, box1, first, end);
     for (std::int64_t i = end; i < nx; ++i)
       clamped(i);
   }
@@ -254,6 +270,7 @@ private:
   const TypedVolume<T>& Volume;
   const BoxGeometry& Geo;
   Acc Shift;
+  bool Squares; // the sums of squares are formed (else their rows are empty)
   std::vector<Acc> Sum, SumSquares;
   std::vector<Acc> Row1, Row2;
   std::int64_t RingRows; // x-box rows kept: a window's and the next entering one
@@ -271,24 +288,25 @@ struct MomentSlice
   using Acc = typename MomentTraits<T>::Accumulator;
   std::int64_t z;         // output slice, volume coordinates
   const Acc* sum;         // region plane, x fastest
-  const Acc* sumSquares;  //
+  const Acc* sumSquares;  // null when not asked for
   double shift;           // add to sum / count to get the mean
   std::int64_t countZ;    // clipped window size along z
   double roundingVariance; // what rounding can fake on a flat box (MomentScale)
 };
 
-/// Streams the moment planes of every region slice to consume(slice) on worker threads;
-/// each thread takes a contiguous chunk of slices. Returns false when cancelled.
+/// Streams the moment planes of every region slice (the sums of squares only if `squares`)
+/// to consume(slice) on worker threads; each thread takes a contiguous chunk of slices.
+/// Returns false when cancelled.
 template <class T, class Consume>
 bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry, const MomentScale& scale,
-  const Execution& execution, Consume&& consume)
+  bool squares, const Execution& execution, Consume&& consume)
 {
   const auto shift = static_cast<typename MomentTraits<T>::Accumulator>(scale.shift);
   const int threads = resolveThreadCount(execution.threads);
   const std::int64_t nz = geometry.region.size[2];
   return parallelFor(nz, threads, threads, execution,
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
-      MomentPlanes<T> planes(volume, geometry, shift);
+      MomentPlanes<T> planes(volume, geometry, shift, squares);
       for (std::int64_t k = begin; k < end; ++k)
       {
         const std::int64_t z = geometry.region.begin[2] + k;

@@ -19,7 +19,10 @@ void meanVarianceRowExactPlain(const std::int64_t* sum, const std::int64_t* sumS
   {
     const std::int64_t c = countX[i] * countYZ;
     count[i] = static_cast<double>(c);
-    meanVarianceFromExactSums(sum[i], sumSquares[i], c, mean[i], variance[i]);
+    double boxVariance = 0.0; // without the squares the mean is the same, the variance dropped
+    meanVarianceFromExactSums(sum[i], sumSquares ? sumSquares[i] : 0, c, mean[i], boxVariance);
+    if (variance)
+      variance[i] = boxVariance;
   }
 }
 

@@ -19,6 +19,13 @@ void runningTotalsPlain(std::int64_t* a, std::int64_t* b, std::int64_t begin, st
 {
   if (begin >= n)
     return;
+  if (!b)
+  {
+    std::int64_t total = begin > 0 ? a[begin - 1] : 0;
+    for (std::int64_t i = begin; i < n; ++i)
+      a[i] = total += a[i];
+    return;
+  }
   std::int64_t totalA = begin > 0 ? a[begin - 1] : 0;
   std::int64_t totalB = begin > 0 ? b[begin - 1] : 0;
   for (std::int64_t i = begin; i < n; ++i)
@@ -40,6 +47,8 @@ VAO_AVX512_TARGET inline __m512i scanLanes(__m512i x)
   return _mm512_add_epi64(x, _mm512_alignr_epi64(x, zero, 4));
 }
 
+/// Of a and, with Both, of b.
+template <bool Both>
 VAO_AVX512_TARGET void runningTotalsAvx512(std::int64_t* a, std::int64_t* b, std::int64_t n)
 {
   const __m512i last = _mm512_set1_epi64(7);
@@ -49,11 +58,14 @@ VAO_AVX512_TARGET void runningTotalsAvx512(std::int64_t* a, std::int64_t* b, std
   for (; i + 8 <= n; i += 8)
   {
     const __m512i x = _mm512_add_epi64(scanLanes(_mm512_loadu_si512(a + i)), carryA);
-    const __m512i y = _mm512_add_epi64(scanLanes(_mm512_loadu_si512(b + i)), carryB);
     _mm512_storeu_si512(a + i, x);
-    _mm512_storeu_si512(b + i, y);
     carryA = _mm512_permutexvar_epi64(last, x);
-    carryB = _mm512_permutexvar_epi64(last, y);
+    if constexpr (Both)
+    {
+      const __m512i y = _mm512_add_epi64(scanLanes(_mm512_loadu_si512(b + i)), carryB);
+      _mm512_storeu_si512(b + i, y);
+      carryB = _mm512_permutexvar_epi64(last, y);
+    }
   }
   runningTotalsPlain(a, b, i, n);
 }
@@ -66,7 +78,10 @@ void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier ti
 #if VAO_HAVE_AVX2_TARGET
   if (tier >= SimdTier::Avx512)
   {
-    runningTotalsAvx512(a, b, n);
+    if (b)
+      runningTotalsAvx512<true>(a, b, n);
+    else
+      runningTotalsAvx512<false>(a, nullptr, n);
     return;
   }
 #endif

@@ -13,7 +13,8 @@ namespace vao
 namespace detail
 {
 
-/// a[i] += a[i - 1] and b[i] += b[i - 1] for i in [1, n): the running totals of both rows.
+/// a[i] += a[i - 1] and b[i] += b[i - 1] for i in [1, n): the running totals of both rows
+/// (of a alone where b is null).
 void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier tier);
 
 } // namespace detail
