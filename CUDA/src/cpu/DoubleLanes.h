@@ -2,7 +2,7 @@
 // avx512) behind one set of names, so that the estimators' lane formulas
 // (EstimatorLanes-inl.h) are written once and compiled for both: every operation is the
 // same IEEE operation per lane in both, so both tiers give the same bits but for the
-// vector erf and pow, which glibc's libmvec implements per width (within a few ulps).
+// vector erf, exp and log, which glibc's libmvec implements per width (within a few ulps).
 //
 // Why a re-included formula file and not a template over these two sets: GCC inlines a
 // target-specific intrinsic only into a function of that target, and a template cannot
@@ -12,7 +12,7 @@
 #include "CpuDispatch.h"
 
 #if VAO_HAVE_AVX2_TARGET && defined(VAO_HAVE_LIBMVEC)
-#define VAO_VECTOR_MATH 1 // glibc's vector erf and pow (libmvec)
+#define VAO_VECTOR_MATH 1 // glibc's vector erf, exp and log (libmvec)
 #else
 #define VAO_VECTOR_MATH 0
 #endif
@@ -25,9 +25,11 @@
 #if VAO_VECTOR_MATH
 // Their x86-64 vector function ABI names.
 extern "C" __attribute__((target("avx2"))) __m256d _ZGVdN4v_erf(__m256d);
-extern "C" __attribute__((target("avx2"))) __m256d _ZGVdN4vv_pow(__m256d, __m256d);
+extern "C" __attribute__((target("avx2"))) __m256d _ZGVdN4v_exp(__m256d);
+extern "C" __attribute__((target("avx2"))) __m256d _ZGVdN4v_log(__m256d);
 extern "C" __attribute__((target("avx512f"))) __m512d _ZGVeN8v_erf(__m512d);
-extern "C" __attribute__((target("avx512f"))) __m512d _ZGVeN8vv_pow(__m512d, __m512d);
+extern "C" __attribute__((target("avx512f"))) __m512d _ZGVeN8v_exp(__m512d);
+extern "C" __attribute__((target("avx512f"))) __m512d _ZGVeN8v_log(__m512d);
 #endif
 
 #define VAO_AVX512_HELPER                                                                                    \
@@ -91,7 +93,8 @@ VAO_LANES D smallIntegersToDouble(I x)
 }
 #if VAO_VECTOR_MATH
 VAO_LANES D erf(D x) { return _ZGVdN4v_erf(x); }
-VAO_LANES D pow(D x, D y) { return _ZGVdN4vv_pow(x, y); }
+VAO_LANES D exp(D x) { return _ZGVdN4v_exp(x); }
+VAO_LANES D log(D x) { return _ZGVdN4v_log(x); }
 #endif
 #undef VAO_LANES
 } // namespace avx2
@@ -138,7 +141,8 @@ VAO_LANES I set1(std::int64_t x) { return _mm512_set1_epi64(x); }
 VAO_LANES D smallIntegersToDouble(I x) { return _mm512_cvtepi64_pd(x); }
 #if VAO_VECTOR_MATH
 VAO_LANES D erf(D x) { return _ZGVeN8v_erf(x); }
-VAO_LANES D pow(D x, D y) { return _ZGVeN8vv_pow(x, y); }
+VAO_LANES D exp(D x) { return _ZGVeN8v_exp(x); }
+VAO_LANES D log(D x) { return _ZGVeN8v_log(x); }
 #endif
 #undef VAO_LANES
 } // namespace avx512

@@ -1,8 +1,9 @@
 // opennessRow: the Gaussian CDF, Chebyshev and CDF Reconstruction four voxels at a time on
-// AVX2, eight on AVX-512 (EstimatorLanes-inl.h). The exact erf and pow are glibc's vector
-// forms (libmvec, within 4 ulps of the scalar functions: the float32 openness is the
-// scalar's but where the double lies within a few ulps of a float32 rounding boundary, or,
-// for the erf, in the far tail where 1 + erf cancels).
+// AVX2, eight on AVX-512 (EstimatorLanes-inl.h). The exact erf, and the exp and log that
+// form CDF Reconstruction's power, are glibc's vector forms (libmvec, within 4 ulps of the
+// scalar functions: the float32 openness is the scalar's but where the double lies within
+// a few ulps (for the power, |beta log t| more) of a float32 rounding boundary, or, for
+// the erf, in the far tail where 1 + erf cancels).
 // Everything else rounds as the scalar formulas (this file has no fused multiply-adds).
 #include "EstimatorRows.h"
 

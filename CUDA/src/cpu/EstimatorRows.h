@@ -1,5 +1,5 @@
 // The separable estimators over a row of neighbourhoods: on AVX2 four voxels at a time,
-// on AVX-512 eight (Chebyshev; with glibc's vector erf and pow, the Gaussian CDF and CDF
+// on AVX-512 eight (Chebyshev; with glibc's vector erf, exp and log, the Gaussian CDF and CDF
 // Reconstruction), elsewhere voxel by voxel.
 #pragma once
 
