@@ -16,13 +16,14 @@ namespace detail
 {
 
 /// Where each output window's two partial results sit, for one (n, r, outBegin, outCount):
-/// out[o] = op(parts[first[o]], parts[second[o]]) with parts = [prefix | suffix]. Computed
-/// once and reused for every lane vector and row of the same shape, so the per-element
-/// work has no integer division.
+/// out[o] = op(parts[first[o]], parts[second[o]]) with parts = [prefix | suffix], and
+/// lo[o], the window's first position, where the suffix it takes is known. Computed once
+/// and reused for every lane vector and row of the same shape, so the per-element work has
+/// no integer division.
 struct WindowPlan
 {
   std::int64_t n = -1, r = -1, outBegin = -1, outCount = -1;
-  std::vector<std::int64_t> first, second;
+  std::vector<std::int64_t> first, second, lo;
 
   void prepare(std::int64_t length, std::int64_t radius, std::int64_t begin, std::int64_t count)
   {
@@ -33,12 +34,14 @@ struct WindowPlan
     n = length, r = radius, outBegin = begin, outCount = count;
     first.resize(static_cast<std::size_t>(count));
     second.resize(static_cast<std::size_t>(count));
+    lo.resize(static_cast<std::size_t>(count));
     const std::int64_t w = 2 * r + 1;
     for (std::int64_t o = 0; o < count; ++o)
     {
       const std::int64_t i = begin + o;
       const std::int64_t lo = std::max<std::int64_t>(0, i - r);
       const std::int64_t hi = std::min<std::int64_t>(n - 1, i + r);
+      this->lo[o] = lo;
       if (lo / w != hi / w)
       {
         first[o] = n + lo; // suffix of the first block at lo
@@ -60,7 +63,7 @@ struct WindowPlan
 template <class T>
 struct ExtremumScratch
 {
-  std::vector<T> minParts; // prefix (n x m) then suffix (n x m) of the minimum
+  std::vector<T> minParts; // prefix (n x m) then the running suffix (m) of the minimum
   std::vector<T> maxParts; // the same for the maximum
   WindowPlan plan;
 };
@@ -82,9 +85,24 @@ struct ExtremumPasses
     }
   }
 
+  /// The suffix one position further: sufMin = min(lo, sufMin), sufMax = max(hi, sufMax).
+  static VAO_ALWAYS_INLINE void extendInPlace(const T* lo, const T* hi, T* sufMin, T* sufMax, std::int64_t m)
+  {
+    for (std::int64_t k = 0; k < m; ++k)
+    {
+      sufMin[k] = lo[k] < sufMin[k] ? lo[k] : sufMin[k];
+      sufMax[k] = sufMax[k] < hi[k] ? hi[k] : sufMax[k];
+    }
+  }
+
+  /// The prefixes of every block forward, then each block's suffix backward, kept as one
+  /// running lane vector: an output is written at its window's first position, where the
+  /// suffix it takes is the running one, so the suffixes are never stored. Outputs sit at
+  /// or after that position, so they may overwrite input already read.
   static VAO_ALWAYS_INLINE void run(const T* inMin, const T* inMax, std::int64_t inStride, std::int64_t n,
     std::int64_t m, std::int64_t w, T* preMin, T* sufMin, T* preMax, T* sufMax, const std::int64_t* first,
-    const std::int64_t* second, std::int64_t outCount, T* outMin, T* outMax, std::int64_t outStride)
+    const std::int64_t* second, const std::int64_t* lo, std::int64_t outCount, T* outMin, T* outMax,
+    std::int64_t outStride)
   {
     for (std::int64_t blockStart = 0; blockStart < n; blockStart += w)
     {
@@ -100,30 +118,36 @@ struct ExtremumPasses
         extend(inMin + i * inStride, inMax + i * inStride, preMin + (i - 1) * m, preMax + (i - 1) * m,
           preMin + i * m, preMax + i * m, m);
       }
-      const std::int64_t last = blockEnd - 1;
-      for (std::int64_t k = 0; k < m; ++k)
-      {
-        sufMin[last * m + k] = inMin[last * inStride + k];
-        sufMax[last * m + k] = inMax[last * inStride + k];
-      }
-      for (std::int64_t i = blockEnd - 2; i >= blockStart; --i)
-      {
-        extend(inMin + i * inStride, inMax + i * inStride, sufMin + (i + 1) * m, sufMax + (i + 1) * m,
-          sufMin + i * m, sufMax + i * m, m);
-      }
     }
-    for (std::int64_t o = 0; o < outCount; ++o)
+    std::int64_t o = outCount - 1;
+    for (std::int64_t blockStart = (n - 1) / w * w; blockStart >= 0; blockStart -= w)
     {
-      const T* minA = preMin + first[o] * m;
-      const T* minB = preMin + second[o] * m;
-      const T* maxA = preMax + first[o] * m;
-      const T* maxB = preMax + second[o] * m;
-      T* __restrict om = outMin + o * outStride;
-      T* __restrict ox = outMax + o * outStride;
-      for (std::int64_t k = 0; k < m; ++k)
+      const std::int64_t last = (blockStart + w < n ? blockStart + w : n) - 1;
+      for (std::int64_t i = last; i >= blockStart; --i)
       {
-        om[k] = minB[k] < minA[k] ? minB[k] : minA[k];
-        ox[k] = maxA[k] < maxB[k] ? maxB[k] : maxA[k];
+        if (i == last)
+          for (std::int64_t k = 0; k < m; ++k)
+          {
+            sufMin[k] = inMin[i * inStride + k];
+            sufMax[k] = inMax[i * inStride + k];
+          }
+        else
+          extendInPlace(inMin + i * inStride, inMax + i * inStride, sufMin, sufMax, m);
+        for (; o >= 0 && lo[o] == i; --o)
+        {
+          // first and second index [prefix | suffix]: a suffix reference is the running one.
+          const T* minA = first[o] < n ? preMin + first[o] * m : sufMin;
+          const T* minB = second[o] < n ? preMin + second[o] * m : sufMin;
+          const T* maxA = first[o] < n ? preMax + first[o] * m : sufMax;
+          const T* maxB = second[o] < n ? preMax + second[o] * m : sufMax;
+          T* __restrict om = outMin + o * outStride;
+          T* __restrict ox = outMax + o * outStride;
+          for (std::int64_t k = 0; k < m; ++k)
+          {
+            om[k] = minB[k] < minA[k] ? minB[k] : minA[k];
+            ox[k] = maxA[k] < maxB[k] ? maxB[k] : maxA[k];
+          }
+        }
       }
     }
   }
@@ -136,21 +160,21 @@ struct ExtremumPasses
 /// with the prefix of the next at hi. Both extrema go in one sweep (inMin == inMax on the
 /// first pass, the previous pass's minimum and maximum after it). Sequence position i of
 /// the input starts at i * inStride, of the output at o * outStride (default: m, packed);
-/// the output may overwrite the input (all of it is read before the first write).
+/// the output may overwrite the input (each output goes after its window has been read).
 template <class T>
 void slidingMinMax(const T* inMin, const T* inMax, std::int64_t n, std::int64_t m, std::int64_t r,
   std::int64_t outBegin, std::int64_t outCount, T* outMin, T* outMax, ExtremumScratch<T>& scratch,
   std::int64_t inStride = -1, std::int64_t outStride = -1)
 {
-  scratch.minParts.resize(static_cast<std::size_t>(2 * n * m));
-  scratch.maxParts.resize(static_cast<std::size_t>(2 * n * m));
+  scratch.minParts.resize(static_cast<std::size_t>((n + 1) * m));
+  scratch.maxParts.resize(static_cast<std::size_t>((n + 1) * m));
   scratch.plan.prepare(n, r, outBegin, outCount);
   T* preMin = scratch.minParts.data();
   T* preMax = scratch.maxParts.data();
   // AVX-512 measured no faster for these compare-and-store loops.
   runRows<ExtremumPasses<T>>(cpuSimdTierUpTo(SimdTier::Avx2), inMin, inMax, inStride < 0 ? m : inStride, n, m,
     2 * r + 1, preMin, preMin + n * m, preMax, preMax + n * m, scratch.plan.first.data(),
-    scratch.plan.second.data(), outCount, outMin, outMax, outStride < 0 ? m : outStride);
+    scratch.plan.second.data(), scratch.plan.lo.data(), outCount, outMin, outMax, outStride < 0 ? m : outStride);
 }
 
 } // namespace detail
