@@ -178,7 +178,8 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
   const Execution& execution)
 {
-  return catchOutOfMemory("the working buffers of Volumetric AO (box statistics, histograms, the smoothed query)",
+  return catchOutOfMemory(
+    "the working buffers of Volumetric AO (box statistics, histograms, the smoothed query, the exact references' rows)",
     [&] { return ambientOcclusion(volume, region, parameters, output, execution); });
 }
 
