@@ -160,6 +160,37 @@ TEST(Openness, APieceGrownByTheRadiusGivesTheWholeVolumesNumbers)
   }
 }
 
+/// The moment methods on one component of three (a strided view) against the same values
+/// stored alone, bit for bit: each voxel's own value is its query, so it must be read
+/// through the stride too.
+template <class T>
+void expectStridedComponentLikeContiguous(const std::vector<T>& v, const vao::Index3& dims)
+{
+  std::vector<T> interleaved(3 * v.size());
+  for (std::size_t i = 0; i < v.size(); ++i)
+  {
+    interleaved[3 * i] = v[v.size() - 1 - i]; // other components hold other values
+    interleaved[3 * i + 1] = v[i];
+    interleaved[3 * i + 2] = v[(i * 7) % v.size()];
+  }
+  vao::VolumeView strided = viewOf(interleaved, dims, 3);
+  strided.data = interleaved.data() + 1;
+  const auto contiguous = viewOf(v, dims);
+  for (const vao::Region region : { vao::Region::whole(contiguous), vao::Region{ { 2, 1, 1 }, { 19, 4, 3 } } })
+    for (const vao::Radius r : { vao::Radius{ 1, 1, 1 }, vao::Radius{ 3, 2, 1 } })
+      for (const Method method : { Method::CdfReconstruction, Method::GaussianCdf, Method::Chebyshev })
+        EXPECT_EQ(openness(strided, region, method, r), openness(contiguous, region, method, r))
+          << "method " << int(method) << ", radius " << r.x << "," << r.y << "," << r.z;
+}
+
+TEST(Openness, MomentMethodsReadEachVoxelsOwnValueThroughTheStride)
+{
+  const vao::Index3 dims = { 23, 6, 5 };
+  expectStridedComponentLikeContiguous(randomVolume<std::int16_t>(dims, -1024, 1600, 31), dims);
+  expectStridedComponentLikeContiguous(randomVolume<std::uint8_t>(dims, 0, 255, 32), dims);
+  expectStridedComponentLikeContiguous(randomVolume<float>(dims, -1, 1, 33), dims);
+}
+
 /// The exact references on every type, against the brute force's test double(v) <= q:
 /// values at the type's ends, queries between two of its values, beyond its range and not
 /// finite (the internal entry point takes any query), a sub-region, and a strided view.

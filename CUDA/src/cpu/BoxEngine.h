@@ -125,6 +125,23 @@ namespace vao
 namespace detail
 {
 
+/// out[i] = double(in[i * stride]) for i < n: a row loop (CpuDispatch.h), so that rows of
+/// contiguous 8- and 16-bit values widen on AVX2 vectors.
+template <class T>
+struct WidenRow
+{
+  static VAO_ALWAYS_INLINE void run(const T* __restrict in, std::int64_t stride, std::int64_t n,
+    double* __restrict out)
+  {
+    if (stride == 1)
+      for (std::int64_t i = 0; i < n; ++i)
+        out[i] = static_cast<double>(in[i]);
+    else
+      for (std::int64_t i = 0; i < n; ++i)
+        out[i] = static_cast<double>(in[i * stride]);
+  }
+};
+
 /// One row of the region with the statistics of its voxels' neighbourhoods, as arrays
 /// (x fastest), handed to a consumer: a row at a time lets the estimators run on vectors.
 struct NeighbourhoodRow
@@ -196,6 +213,7 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
         minimum.resize(n);
         maximum.resize(n);
       }
+      const SimdTier simd = cpuSimdTier();
       NeighbourhoodRow out;
       out.size = nx;
       out.value = value.data();
@@ -210,8 +228,7 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
         const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
         const std::int64_t countYZ = countY[j] * slice.countZ;
         if (contents.values)
-          for (std::int64_t i = 0; i < nx; ++i)
-            value[i] = static_cast<double>(row[i * volume.stride]);
+          runRows<WidenRow<T>>(simd, row, volume.stride, nx, value.data());
         if constexpr (MomentTraits<T>::exactInteger)
         {
           out.sum = slice.sum + j * nx;
@@ -236,11 +253,9 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
         }
         if (withExtrema)
         {
-          for (std::int64_t i = 0; i < nx; ++i)
-          {
-            minimum[i] = static_cast<double>(extrema.minimum(bandBase + j * nx + i));
-            maximum[i] = static_cast<double>(extrema.maximum(bandBase + j * nx + i));
-          }
+          const std::int64_t at = extrema.offset + bandBase + j * nx;
+          runRows<WidenRow<T>>(simd, extrema.minimumPlanes.data() + at, std::int64_t(1), nx, minimum.data());
+          runRows<WidenRow<T>>(simd, extrema.maximumPlanes.data() + at, std::int64_t(1), nx, maximum.data());
         }
         out.index = base + j * nx;
         visit(static_cast<const NeighbourhoodRow&>(out));
