@@ -249,3 +249,43 @@ TEST(BoxStatistics, BandsOfRowsOnALargeVolumeMatchBruteForce)
         ASSERT_TRUE(closeRelative(got.variance[k], ref.variance, 1e-9)) << x << "," << y << "," << z;
       }
 }
+
+namespace
+{
+
+/// A flat volume of `value` in boxes of `radius` (in x and y; the volume is one slice):
+/// every mean must be `value` exactly and every variance 0, as exact integer sums give them.
+template <class T>
+void expectFlatExact(T value, std::int64_t side, int radius)
+{
+  const vao::Index3 dims = { side, side, 1 };
+  const std::vector<T> v(side * side, value);
+  StatsArrays got(side * side);
+  const vao::Region whole = vao::Region::whole(viewOf(v, dims));
+  ASSERT_TRUE(vao::computeBoxStatistics(viewOf(v, dims), whole, { radius, radius, 0 }, got.output()).ok);
+  std::int64_t failures = 0;
+  for (std::int64_t k = 0; k < side * side; ++k)
+    if ((got.mean[k] != double(value) || got.variance[k] != 0.0) && failures++ < 5)
+      ADD_FAILURE() << "radius " << radius << ", voxel " << k << ": mean " << got.mean[k] << ", variance "
+                    << got.variance[k] << ", count " << got.count[k];
+}
+
+} // namespace
+
+// Sums of v run in 32 bits where every box sum fits int32 whatever the values (R = 90 on
+// uint16's largest value, 181^2 voxels, and R = 127 on int16's smallest, 255^2) and in 64
+// bits just beyond (R = 91 and 128, whose sums would overflow int32).
+TEST(BoxStatistics, SumsExactOnBothSidesOfTheirThirtyTwoBitLimit)
+{
+  expectFlatExact<std::uint16_t>(65535, 200, 90);
+  expectFlatExact<std::uint16_t>(65535, 200, 91);
+  expectFlatExact<std::int16_t>(-32768, 300, 127);
+  expectFlatExact<std::int16_t>(-32768, 300, 128);
+  // A row whose running sums pass 2^32 (more than 65537 voxels of 65535) and wrap.
+  const vao::Index3 dims = { 100000, 1, 1 };
+  std::vector<std::uint16_t> row(dims[0]);
+  std::mt19937 rng(5);
+  for (auto& value : row)
+    value = rng() % 8 ? 65535 : 0;
+  expectStatsMatchBruteForce(row, dims, { 3, 0, 0 }, vao::Region::whole(viewOf(row, dims)), 2);
+}

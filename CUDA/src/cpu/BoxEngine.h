@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 namespace vao
@@ -142,6 +143,17 @@ struct WidenRow
   }
 };
 
+/// The 64-bit box sums of a row of 32-bit ones (MomentPlanes' std::uint32_t sums hold the
+/// bits of exact int32 sums): out[i] = int32(in[i]). Compiled for AVX2 too.
+struct WidenSums
+{
+  static VAO_ALWAYS_INLINE void run(const std::uint32_t* __restrict in, std::int64_t n, std::int64_t* __restrict out)
+  {
+    for (std::int64_t i = 0; i < n; ++i)
+      out[i] = static_cast<std::int32_t>(in[i]);
+  }
+};
+
 /// One row of the region with the statistics of its voxels' neighbourhoods, as arrays
 /// (x fastest), handed to a consumer: a row at a time lets the estimators run on vectors.
 struct NeighbourhoodRow
@@ -202,12 +214,13 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
   const std::int64_t nx = region.size[0], ny = region.size[1];
   const std::int64_t wholePlane = whole.size[0] * whole.size[1];
   const std::int64_t firstRow = region.begin[1] - whole.begin[1];
-  return streamMoments(volume, band, scale, contents.variance, stageExecution(execution, split, 1.0),
-    [&](const MomentSlice<T>& slice) {
+  const auto consume = [&](const auto& slice) {
       const std::int64_t bandBase = (slice.z - region.begin[2]) * nx * ny;
       const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
       const auto n = static_cast<std::size_t>(nx);
       std::vector<double> value(n), count(n), mean(n), variance(n), minimum, maximum;
+      constexpr bool narrow = std::is_same<std::decay_t<decltype(*slice.sum)>, std::uint32_t>::value;
+      std::vector<std::int64_t> sums(narrow ? n : 0); // the row's sums widened
       if (withExtrema)
       {
         minimum.resize(n);
@@ -231,7 +244,13 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
           runRows<WidenRow<T>>(simd, row, volume.stride, nx, value.data());
         if constexpr (MomentTraits<T>::exactInteger)
         {
-          out.sum = slice.sum + j * nx;
+          if constexpr (narrow)
+          {
+            runRows<WidenSums>(simd, slice.sum + j * nx, nx, sums.data());
+            out.sum = sums.data();
+          }
+          else
+            out.sum = slice.sum + j * nx;
           out.sumSquares = slice.sumSquares ? slice.sumSquares + j * nx : nullptr;
           out.countX = countX.data();
           out.countYZ = countYZ;
@@ -260,7 +279,13 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
         out.index = base + j * nx;
         visit(static_cast<const NeighbourhoodRow&>(out));
       }
-    });
+  };
+  const Execution stage = stageExecution(execution, split, 1.0);
+  if constexpr (MomentTraits<T>::exactInteger)
+    if (linearSumsFit32<T>(band))
+      return streamMoments<T, std::uint32_t>(volume, band, scale, contents.variance, stage, consume);
+  return streamMoments<T, typename MomentTraits<T>::Accumulator>(
+    volume, band, scale, contents.variance, stage, consume);
 }
 
 /// Rows of region per band when the extrema are needed: a band's extrema planes hold

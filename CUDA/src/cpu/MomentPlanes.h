@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 #include <vector>
 
@@ -73,13 +74,14 @@ struct SlideColumns
   }
 };
 
-/// d1 = a - b and, with Squares, d2 = a^2 - b^2, with a, b the values of rows `in` and
-/// `out` less the shift (0 for a missing row). Compiled for AVX2 too.
-template <class T, class Acc, bool Squares = true>
+/// d1 = a - b (in Lin, modulo 2^32 for std::uint32_t) and, with Squares, d2 = a^2 - b^2,
+/// with a, b the values of rows `in` and `out` less the shift (0 for a missing row).
+/// Compiled for AVX2 too.
+template <class T, class Acc, bool Squares = true, class Lin = Acc>
 struct RowDifferences
 {
   static VAO_ALWAYS_INLINE void run(const T* __restrict in, const T* __restrict out, std::int64_t stride,
-    std::int64_t n, Acc shift, Acc* __restrict d1, Acc* __restrict d2)
+    std::int64_t n, Acc shift, Lin* __restrict d1, Acc* __restrict d2)
   {
     // Squares of 8-bit and int16 values and their differences fit in 32 bits, whose
     // products vectorise (64-bit ones do not on AVX2).
@@ -90,7 +92,7 @@ struct RowDifferences
     {
       const Product a = in ? static_cast<Product>(in[i * stride]) - s : Product(0);
       const Product b = out ? static_cast<Product>(out[i * stride]) - s : Product(0);
-      d1[i] = static_cast<Acc>(a - b);
+      d1[i] = static_cast<Lin>(a - b);
       if constexpr (Squares)
         d2[i] = static_cast<Acc>(a * a - b * b);
     }
@@ -98,12 +100,12 @@ struct RowDifferences
 };
 
 /// box[i] = p[i + offset + width] - p[i + offset] for i in [begin, end), for both prefix
-/// rows (the first alone without Squares). Compiled for AVX2 too.
-template <class Acc, bool Squares = true>
+/// rows (the first, in Lin, alone without Squares). Compiled for AVX2 too.
+template <class Acc, bool Squares = true, class Lin = Acc>
 struct WindowDifferences
 {
-  static VAO_ALWAYS_INLINE void run(const Acc* __restrict p1, const Acc* __restrict p2, std::int64_t offset,
-    std::int64_t width, Acc* __restrict box1, Acc* __restrict box2, std::int64_t begin, std::int64_t end)
+  static VAO_ALWAYS_INLINE void run(const Lin* __restrict p1, const Acc* __restrict p2, std::int64_t offset,
+    std::int64_t width, Lin* __restrict box1, Acc* __restrict box2, std::int64_t begin, std::int64_t end)
   {
     for (std::int64_t i = begin; i < end; ++i)
     {
@@ -114,9 +116,27 @@ struct WindowDifferences
   }
 };
 
-/// Box sums of (v - shift) and, unless told not to (a consumer that needs the mean alone),
-/// of (v - shift)^2 for one slice of the region at a time.
+/// Whether the box sums of v (exact integer types) can run in 32 bits: every box sum of the
+/// region, whatever the values, lies within int32's range. The running sums then wrap
+/// modulo 2^32 (unsigned, so wrapping is defined) and each box sum comes out exact; half
+/// the bytes and twice the lanes of 64 bits. True for 16-bit data in boxes of up to 32767
+/// (uint16) or 65535 (int16) voxels, R = 15 and 19 in cubes.
 template <class T>
+bool linearSumsFit32(const BoxGeometry& geometry)
+{
+  static_assert(MomentTraits<T>::exactInteger, "exact integer sums only");
+  const double largest = std::max(-double(std::numeric_limits<T>::min()), double(std::numeric_limits<T>::max()));
+  double voxels = 1.0;
+  const int radii[3] = { geometry.radius.x, geometry.radius.y, geometry.radius.z };
+  for (int a = 0; a < 3; ++a)
+    voxels *= double(std::min<std::int64_t>(2 * std::int64_t(radii[a]) + 1, geometry.dims[a]));
+  return voxels * largest < 2147483648.0;
+}
+
+/// Box sums of (v - shift) and, unless told not to (a consumer that needs the mean alone),
+/// of (v - shift)^2 for one slice of the region at a time; the sums of v in Lin
+/// (std::uint32_t where linearSumsFit32, else the accumulator).
+template <class T, class Lin = typename MomentTraits<T>::Accumulator>
 class MomentPlanes
 {
 public:
@@ -137,13 +157,14 @@ public:
     , Run1(geometry.region.size[0])
     , Run2(squares ? geometry.region.size[0] : 0)
     , Zeros(geometry.region.size[0], Acc(0))
+    , ZerosLin(geometry.region.size[0], Lin(0))
   {
   }
 
   /// Sets the planes to the box sums of output slice z (window clipped to the volume).
   void startAt(std::int64_t z)
   {
-    std::fill(this->Sum.begin(), this->Sum.end(), Acc(0));
+    std::fill(this->Sum.begin(), this->Sum.end(), Lin(0));
     std::fill(this->SumSquares.begin(), this->SumSquares.end(), Acc(0));
     const std::int64_t lo = std::max<std::int64_t>(0, z - this->Geo.radius.z);
     const std::int64_t hi = std::min<std::int64_t>(this->Geo.dims[2] - 1, z + this->Geo.radius.z);
@@ -162,7 +183,7 @@ public:
       entering < this->Geo.dims[2] ? entering : -1, leaving >= 0 ? leaving : -1);
   }
 
-  const Acc* sum() const { return this->Sum.data(); }
+  const Lin* sum() const { return this->Sum.data(); }
   /// Null when the squares were not asked for.
   const Acc* sumSquares() const { return this->Squares ? this->SumSquares.data() : nullptr; }
 
@@ -182,13 +203,14 @@ private:
     const std::int64_t ny = this->Geo.dims[1];
     const std::int64_t y0 = this->Geo.region.begin[1];
     const Acc* zeros = this->Zeros.data();
-    std::fill(this->Run1.begin(), this->Run1.end(), Acc(0));
+    std::fill(this->Run1.begin(), this->Run1.end(), Lin(0));
+    const Lin* zerosLin = this->ZerosLin.data();
     std::fill(this->Run2.begin(), this->Run2.end(), Acc(0));
     const auto slide = [&](std::int64_t row, std::int64_t in, std::int64_t out) {
-      Acc* plane1 = row < 0 ? nullptr : this->Sum.data() + row * nx;
+      Lin* plane1 = row < 0 ? nullptr : this->Sum.data() + row * nx;
       Acc* plane2 = row < 0 ? nullptr : this->SumSquares.data() + row * nx;
-      runRows<SlideColumns<Acc>>(this->Simd, plane1, this->Run1.data(), in < 0 ? zeros : this->xbox1(in),
-        out < 0 ? zeros : this->xbox1(out), nx);
+      runRows<SlideColumns<Lin>>(this->Simd, plane1, this->Run1.data(), in < 0 ? zerosLin : this->xbox1(in),
+        out < 0 ? zerosLin : this->xbox1(out), nx);
       if (this->Squares)
         runRows<SlideColumns<Acc>>(this->Simd, plane2, this->Run2.data(), in < 0 ? zeros : this->xbox2(in),
           out < 0 ? zeros : this->xbox2(out), nx);
@@ -211,7 +233,7 @@ private:
     }
   }
 
-  Acc* xbox1(std::int64_t y) { return this->XBox1.data() + (y - this->Geo.ys.lo) % this->RingRows * this->Geo.region.size[0]; }
+  Lin* xbox1(std::int64_t y) { return this->XBox1.data() + (y - this->Geo.ys.lo) % this->RingRows * this->Geo.region.size[0]; }
   Acc* xbox2(std::int64_t y) { return this->XBox2.data() + (y - this->Geo.ys.lo) % this->RingRows * this->Geo.region.size[0]; }
 
   /// x box sums of one row of (entering - leaving), stored in the ring at xbox1(y), xbox2(y).
@@ -219,7 +241,7 @@ private:
   {
     const std::int64_t span = this->Geo.xs.size();
     const std::int64_t stride = this->Volume.stride;
-    Acc* p1 = this->Row1.data();
+    Lin* p1 = this->Row1.data();
     Acc* p2 = this->Row2.data();
     const T* in = entering >= 0 ? this->Volume.row(y, entering) + this->Geo.xs.lo * stride : nullptr;
     const T* out = leaving >= 0 ? this->Volume.row(y, leaving) + this->Geo.xs.lo * stride : nullptr;
@@ -227,13 +249,21 @@ private:
     // p[i] = sum of the first i values.
     if (this->Squares)
     {
-      runRows<RowDifferences<T, Acc>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
+      runRows<RowDifferences<T, Acc, true, Lin>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
       p2[0] = 0;
     }
     else
-      runRows<RowDifferences<T, Acc, false>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p1 + 1);
+      runRows<RowDifferences<T, Acc, false, Lin>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2);
     p1[0] = 0;
-    if constexpr (std::is_same<Acc, std::int64_t>::value)
+    if constexpr (std::is_same<Lin, std::uint32_t>::value)
+    {
+      Lin total = 0; // exact modulo 2^32, as every box sum below
+      for (std::int64_t i = 0; i <= span; ++i)
+        p1[i] = total += p1[i];
+      if (this->Squares)
+        runningTotals(p2, nullptr, span + 1, this->Simd);
+    }
+    else if constexpr (std::is_same<Acc, std::int64_t>::value)
       runningTotals(p1, this->Squares ? p2 : nullptr, span + 1, this->Simd); // exact: any order of the additions
     else
       for (std::int64_t i = 0; i < span; ++i) // double sums: this order on every tier
@@ -245,7 +275,7 @@ private:
     const std::int64_t nx = this->Geo.region.size[0];
     const std::int64_t r = this->Geo.radius.x;
     const std::int64_t x0 = this->Geo.region.begin[0] - this->Geo.xs.lo; // first output in span
-    Acc* box1 = this->xbox1(y);
+    Lin* box1 = this->xbox1(y);
     Acc* box2 = this->Squares ? this->xbox2(y) : nullptr;
     // Outputs whose window lies inside the span (a vector loop) and the clamped ends.
     const std::int64_t first = std::min(nx, std::max<std::int64_t>(0, r - x0));
@@ -260,9 +290,9 @@ private:
     for (std::int64_t i = 0; i < first; ++i)
       clamped(i);
     if (box2)
-      runRows<WindowDifferences<Acc>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+      runRows<WindowDifferences<Acc, true, Lin>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
     else
-      runRows<WindowDifferences<Acc, false>>(this->Simd, p1, p1, x0 - r, 2 * r + 1, box1, box1, first, end);
+      runRows<WindowDifferences<Acc, false, Lin>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
     for (std::int64_t i = end; i < nx; ++i)
       clamped(i);
   }
@@ -271,33 +301,39 @@ private:
   const BoxGeometry& Geo;
   Acc Shift;
   bool Squares; // the sums of squares are formed (else their rows are empty)
-  std::vector<Acc> Sum, SumSquares;
-  std::vector<Acc> Row1, Row2;
+  std::vector<Lin> Sum;
+  std::vector<Acc> SumSquares;
+  std::vector<Lin> Row1;
+  std::vector<Acc> Row2;
   std::int64_t RingRows; // x-box rows kept: a window's and the next entering one
-  std::vector<Acc> XBox1, XBox2;
-  std::vector<Acc> Run1, Run2;
+  std::vector<Lin> XBox1;
+  std::vector<Acc> XBox2;
+  std::vector<Lin> Run1;
+  std::vector<Acc> Run2;
   std::vector<Acc> Zeros; // a row outside the volume
+  std::vector<Lin> ZerosLin; // the same for the sums of v
   SimdTier Simd = cpuSimdTier();
 };
 
 /// Per-slice view handed to the consumer of the moments: everything needed to turn the
 /// sums of slice z into statistics.
-template <class T>
+template <class T, class Lin = typename MomentTraits<T>::Accumulator>
 struct MomentSlice
 {
   using Acc = typename MomentTraits<T>::Accumulator;
   std::int64_t z;         // output slice, volume coordinates
-  const Acc* sum;         // region plane, x fastest
+  const Lin* sum;         // region plane, x fastest (uint32: the int32 sums' bits)
   const Acc* sumSquares;  // null when not asked for
   double shift;           // add to sum / count to get the mean
   std::int64_t countZ;    // clipped window size along z
   double roundingVariance; // what rounding can fake on a flat box (MomentScale)
 };
 
-/// Streams the moment planes of every region slice (the sums of squares only if `squares`)
+/// Streams the moment planes of every region slice (the sums of v in Lin, std::uint32_t only
+/// where linearSumsFit32; the sums of squares only if `squares`)
 /// to consume(slice) on worker threads; each thread takes a contiguous chunk of slices.
 /// Returns false when cancelled.
-template <class T, class Consume>
+template <class T, class Lin, class Consume>
 bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry, const MomentScale& scale,
   bool squares, const Execution& execution, Consume&& consume)
 {
@@ -306,7 +342,7 @@ bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry, co
   const std::int64_t nz = geometry.region.size[2];
   return parallelFor(nz, threads, threads, execution,
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
-      MomentPlanes<T> planes(volume, geometry, shift, squares);
+      MomentPlanes<T, Lin> planes(volume, geometry, shift, squares);
       for (std::int64_t k = begin; k < end; ++k)
       {
         const std::int64_t z = geometry.region.begin[2] + k;
@@ -318,7 +354,7 @@ bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry, co
         {
           planes.advanceFrom(z - 1);
         }
-        MomentSlice<T> slice{ z, planes.sum(), planes.sumSquares(), static_cast<double>(shift),
+        MomentSlice<T, Lin> slice{ z, planes.sum(), planes.sumSquares(), static_cast<double>(shift),
           clippedWindowCount(z, geometry.radius.z, geometry.dims[2]), scale.roundingVariance };
         consume(slice);
         if (!progress.advance())
