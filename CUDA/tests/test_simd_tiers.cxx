@@ -207,7 +207,8 @@ TEST(SimdTiers, HistogramCdfOfEveryQueryCaseEqualsTheBaselineBitForBit)
 }
 
 // The box sums' running totals (RunningTotals.h) on every tier against the totals summed
-// one by one here: lengths around the 8-wide vector, values up to 2^40 of either sign.
+// one by one here: lengths around the 8-wide vector, values up to 2^40 of either sign; one
+// row alone as well, and the 32-bit totals, which wrap modulo 2^32.
 TEST(SimdTiers, RunningTotalsEqualTheSumsOneByOne)
 {
   std::mt19937_64 rng(31);
@@ -226,9 +227,21 @@ TEST(SimdTiers, RunningTotalsEqualTheSumsOneByOne)
       }
       // Capped like every loop here: a tier the processor lacks runs the best it has.
       const TierCap cap(tier);
+      std::vector<std::int64_t> single = a; // one row alone (no second row)
+      std::vector<std::uint32_t> narrow(n), expectedNarrow(n);
+      std::uint32_t totalNarrow = 0;
+      for (std::int64_t i = 0; i < n; ++i)
+      {
+        narrow[i] = static_cast<std::uint32_t>(rng()); // the totals wrap modulo 2^32
+        expectedNarrow[i] = totalNarrow += narrow[i];
+      }
       vao::detail::runningTotals(a.data(), b.data(), n, vao::detail::cpuSimdTier());
+      vao::detail::runningTotals(single.data(), nullptr, n, vao::detail::cpuSimdTier());
+      vao::detail::runningTotals(narrow.data(), n);
       ASSERT_EQ(a, expectedA) << "tier " << static_cast<int>(tier) << ", n " << n;
       ASSERT_EQ(b, expectedB) << "tier " << static_cast<int>(tier) << ", n " << n;
+      ASSERT_EQ(single, expectedA) << "one row, tier " << static_cast<int>(tier) << ", n " << n;
+      ASSERT_EQ(narrow, expectedNarrow) << "32 bits, n " << n;
     }
   }
 }

@@ -29,8 +29,9 @@ struct BoxExtrema
   StorageArray<T> maximumPlanes;
   std::int64_t offset = 0;
 
-  T minimum(std::int64_t regionIndex) const { return this->minimumPlanes[this->offset + regionIndex]; }
-  T maximum(std::int64_t regionIndex) const { return this->maximumPlanes[this->offset + regionIndex]; }
+  /// The box minima and maxima from region voxel `regionIndex` on.
+  const T* minima(std::int64_t regionIndex) const { return this->minimumPlanes.data() + this->offset + regionIndex; }
+  const T* maxima(std::int64_t regionIndex) const { return this->maximumPlanes.data() + this->offset + regionIndex; }
 };
 
 /// Rows of a slice whose x passes run together (one AVX2 vector of 16-bit values).
@@ -215,70 +216,69 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
   const std::int64_t wholePlane = whole.size[0] * whole.size[1];
   const std::int64_t firstRow = region.begin[1] - whole.begin[1];
   const auto consume = [&](const auto& slice) {
-      const std::int64_t bandBase = (slice.z - region.begin[2]) * nx * ny;
-      const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
-      const auto n = static_cast<std::size_t>(nx);
-      std::vector<double> value(n), count(n), mean(n), variance(n), minimum, maximum;
-      constexpr bool narrow = std::is_same<std::decay_t<decltype(*slice.sum)>, std::uint32_t>::value;
-      std::vector<std::int64_t> sums(narrow ? n : 0); // the row's sums widened
-      if (withExtrema)
+    const std::int64_t bandBase = (slice.z - region.begin[2]) * nx * ny;
+    const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
+    const auto n = static_cast<std::size_t>(nx);
+    std::vector<double> value(n), count(n), mean(n), variance(n), minimum, maximum;
+    constexpr bool narrow = std::is_same<std::decay_t<decltype(*slice.sum)>, std::uint32_t>::value;
+    std::vector<std::int64_t> sums(narrow ? n : 0); // the row's sums widened
+    if (withExtrema)
+    {
+      minimum.resize(n);
+      maximum.resize(n);
+    }
+    const SimdTier simd = cpuSimdTier();
+    NeighbourhoodRow out;
+    out.size = nx;
+    out.value = value.data();
+    out.count = count.data();
+    out.mean = mean.data();
+    out.variance = contents.variance ? variance.data() : nullptr;
+    out.minimum = withExtrema ? minimum.data() : nullptr;
+    out.maximum = withExtrema ? maximum.data() : nullptr;
+    out.roundingVariance = slice.roundingVariance;
+    for (std::int64_t j = 0; j < ny; ++j)
+    {
+      const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
+      const std::int64_t countYZ = countY[j] * slice.countZ;
+      if (contents.values)
+        runRows<WidenRow<T>>(simd, row, volume.stride, nx, value.data());
+      if constexpr (MomentTraits<T>::exactInteger)
       {
-        minimum.resize(n);
-        maximum.resize(n);
-      }
-      const SimdTier simd = cpuSimdTier();
-      NeighbourhoodRow out;
-      out.size = nx;
-      out.value = value.data();
-      out.count = count.data();
-      out.mean = mean.data();
-      out.variance = contents.variance ? variance.data() : nullptr;
-      out.minimum = withExtrema ? minimum.data() : nullptr;
-      out.maximum = withExtrema ? maximum.data() : nullptr;
-      out.roundingVariance = slice.roundingVariance;
-      for (std::int64_t j = 0; j < ny; ++j)
-      {
-        const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
-        const std::int64_t countYZ = countY[j] * slice.countZ;
-        if (contents.values)
-          runRows<WidenRow<T>>(simd, row, volume.stride, nx, value.data());
-        if constexpr (MomentTraits<T>::exactInteger)
+        if constexpr (narrow)
         {
-          if constexpr (narrow)
-          {
-            runRows<WidenSums>(simd, slice.sum + j * nx, nx, sums.data());
-            out.sum = sums.data();
-          }
-          else
-            out.sum = slice.sum + j * nx;
-          out.sumSquares = slice.sumSquares ? slice.sumSquares + j * nx : nullptr;
-          out.countX = countX.data();
-          out.countYZ = countYZ;
-          if (contents.moments) // double sums below always give them
-            meanVarianceRowExact(out.sum, out.sumSquares, countX.data(), countYZ, nx, count.data(), mean.data(),
-              out.sumSquares ? variance.data() : nullptr);
+          runRows<WidenSums>(simd, slice.sum + j * nx, nx, sums.data());
+          out.sum = sums.data();
         }
         else
-        {
-          for (std::int64_t i = 0; i < nx; ++i)
-          {
-            const std::int64_t p = j * nx + i;
-            const std::int64_t c = countX[i] * countYZ;
-            count[i] = static_cast<double>(c);
-            // Without the squares the mean comes out the same and the variance is dropped.
-            meanVarianceFromSums(slice.sum[p], slice.sumSquares ? slice.sumSquares[p] : 0.0, c, slice.shift,
-              mean[i], variance[i]);
-          }
-        }
-        if (withExtrema)
-        {
-          const std::int64_t at = extrema.offset + bandBase + j * nx;
-          runRows<WidenRow<T>>(simd, extrema.minimumPlanes.data() + at, std::int64_t(1), nx, minimum.data());
-          runRows<WidenRow<T>>(simd, extrema.maximumPlanes.data() + at, std::int64_t(1), nx, maximum.data());
-        }
-        out.index = base + j * nx;
-        visit(static_cast<const NeighbourhoodRow&>(out));
+          out.sum = slice.sum + j * nx;
+        out.sumSquares = slice.sumSquares ? slice.sumSquares + j * nx : nullptr;
+        out.countX = countX.data();
+        out.countYZ = countYZ;
+        if (contents.moments) // double sums below always give them
+          meanVarianceRowExact(out.sum, out.sumSquares, countX.data(), countYZ, nx, count.data(), mean.data(),
+            out.sumSquares ? variance.data() : nullptr);
       }
+      else
+      {
+        for (std::int64_t i = 0; i < nx; ++i)
+        {
+          const std::int64_t p = j * nx + i;
+          const std::int64_t c = countX[i] * countYZ;
+          count[i] = static_cast<double>(c);
+          // Without the squares the mean comes out the same and the variance is dropped.
+          meanVarianceFromSums(slice.sum[p], slice.sumSquares ? slice.sumSquares[p] : 0.0, c, slice.shift,
+            mean[i], variance[i]);
+        }
+      }
+      if (withExtrema)
+      {
+        runRows<WidenRow<T>>(simd, extrema.minima(bandBase + j * nx), std::int64_t(1), nx, minimum.data());
+        runRows<WidenRow<T>>(simd, extrema.maxima(bandBase + j * nx), std::int64_t(1), nx, maximum.data());
+      }
+      out.index = base + j * nx;
+      visit(static_cast<const NeighbourhoodRow&>(out));
+    }
   };
   const Execution stage = stageExecution(execution, split, 1.0);
   if constexpr (MomentTraits<T>::exactInteger)

@@ -257,9 +257,7 @@ private:
     p1[0] = 0;
     if constexpr (std::is_same<Lin, std::uint32_t>::value)
     {
-      Lin total = 0; // exact modulo 2^32, as every box sum below
-      for (std::int64_t i = 0; i <= span; ++i)
-        p1[i] = total += p1[i];
+      runningTotals(p1, span + 1); // modulo 2^32, as every box sum below
       if (this->Squares)
         runningTotals(p2, nullptr, span + 1, this->Simd);
     }
@@ -329,10 +327,10 @@ struct MomentSlice
   double roundingVariance; // what rounding can fake on a flat box (MomentScale)
 };
 
-/// Streams the moment planes of every region slice (the sums of v in Lin, std::uint32_t only
-/// where linearSumsFit32; the sums of squares only if `squares`)
-/// to consume(slice) on worker threads; each thread takes a contiguous chunk of slices.
-/// Returns false when cancelled.
+/// Streams the moment planes of every region slice to consume(slice) on worker threads;
+/// each thread takes a contiguous chunk of slices. The sums of v are in Lin (std::uint32_t
+/// only where linearSumsFit32), the sums of squares formed only if `squares`. Returns false
+/// when cancelled.
 template <class T, class Lin, class Consume>
 bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry, const MomentScale& scale,
   bool squares, const Execution& execution, Consume&& consume)

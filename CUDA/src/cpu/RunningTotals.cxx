@@ -12,6 +12,15 @@ namespace detail
 namespace
 {
 
+/// One row from `begin` on, one value at a time (unsigned values wrap modulo their width).
+template <class V>
+void runningTotalsOfRow(V* a, std::int64_t begin, std::int64_t n)
+{
+  V total = begin > 0 ? a[begin - 1] : V(0);
+  for (std::int64_t i = begin; i < n; ++i)
+    a[i] = total += a[i];
+}
+
 /// From `begin` on, one value at a time; the running totals stay in registers (a and b may
 /// alias as far as the compiler knows, so a[i] += a[i - 1] would reload each value just
 /// stored).
@@ -21,9 +30,7 @@ void runningTotalsPlain(std::int64_t* a, std::int64_t* b, std::int64_t begin, st
     return;
   if (!b)
   {
-    std::int64_t total = begin > 0 ? a[begin - 1] : 0;
-    for (std::int64_t i = begin; i < n; ++i)
-      a[i] = total += a[i];
+    runningTotalsOfRow(a, begin, n);
     return;
   }
   std::int64_t totalA = begin > 0 ? a[begin - 1] : 0;
@@ -87,6 +94,11 @@ void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier ti
 #endif
   (void)tier;
   runningTotalsPlain(a, b, 0, n);
+}
+
+void runningTotals(std::uint32_t* a, std::int64_t n)
+{
+  runningTotalsOfRow(a, 0, n);
 }
 
 } // namespace detail

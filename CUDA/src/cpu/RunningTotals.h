@@ -17,5 +17,9 @@ namespace detail
 /// (of a alone where b is null).
 void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier tier);
 
+/// a[i] += a[i - 1] for i in [1, n) modulo 2^32: 32-bit sums whose every difference of two
+/// totals, a box sum, is exact as an int32 (MomentPlanes.h's linearSumsFit32).
+void runningTotals(std::uint32_t* a, std::int64_t n);
+
 } // namespace detail
 } // namespace vao
