@@ -49,20 +49,21 @@ struct RawSource
 
   Index3 dims() const { return volume.dims; }
   /// a[i] = sum_k w[k] d(x0 + i, y, z_k), b[i] = sum_k w[k] s(x0 + i, y, z_k) for i in
-  /// [0, count) over the 5 rows (y, z[k]); a clipped tap has weight 0 and a valid
-  /// (clamped) row.
-  void blurRows(std::int64_t y, const std::int64_t* z, const double* w, std::int64_t x0, std::int64_t count,
-    double* a, double* b, SimdTier simd) const
+  /// [0, count) over the 5 rows (y, z[k]), for the `rows` rows y = y0, y0 + 1, ... (their
+  /// outputs outRowStride apart); a clipped tap has weight 0 and a valid (clamped) row.
+  void blurRows(std::int64_t y0, std::int64_t rows, const std::int64_t* z, const double* w, std::int64_t x0,
+    std::int64_t count, double* a, double* b, std::int64_t outRowStride, SimdTier simd) const
   {
-    const T* rows[kTaps];
+    const T* first[kTaps];
     for (int k = 0; k < kTaps; ++k)
     {
-      rows[k] = volume.row(y, z[k]) + x0 * volume.stride;
+      first[k] = volume.row(y0, z[k]) + x0 * volume.stride;
     }
+    const std::int64_t inRowStride = volume.dims[0] * volume.stride;
     if (volume.stride == 1)
-      runRows<RawRows<T, true>>(simd, &rows[0], w, shift, std::int64_t(1), count, a, b);
+      runRows<RawPlane<T, true>>(simd, &first[0], w, shift, std::int64_t(1), count, rows, inRowStride, outRowStride, a, b);
     else
-      runRows<RawRows<T, false>>(simd, &rows[0], w, shift, volume.stride, count, a, b);
+      runRows<RawPlane<T, false>>(simd, &first[0], w, shift, volume.stride, count, rows, inRowStride, outRowStride, a, b);
   }
 };
 
@@ -77,18 +78,21 @@ struct StoredSource
   double shift;
 
   Index3 dims() const { return size; }
-  void blurRows(std::int64_t y, const std::int64_t* z, const double* w, std::int64_t x0, std::int64_t count,
-    double* a, double* b, SimdTier simd) const
+  /// RawSource::blurRows from the stored moments.
+  void blurRows(std::int64_t y0, std::int64_t rows, const std::int64_t* z, const double* w, std::int64_t x0,
+    std::int64_t count, double* a, double* b, std::int64_t outRowStride, SimdTier simd) const
   {
     const float* means[kTaps];
     const float* variances[kTaps];
     for (int k = 0; k < kTaps; ++k)
     {
-      const auto voxel = at(x0, y, z[k]);
+      const auto voxel = at(x0, y0, z[k]);
       means[k] = voxel.first;
       variances[k] = voxel.second;
     }
-    runRows<LevelRows>(simd, &means[0], &variances[0], w, shift, count, a, b);
+    // The voxels' rows are evenly spaced: the next row's first one gives the stride.
+    const std::int64_t inRowStride = rows > 1 ? at(x0, y0 + 1, z[0]).first - means[0] : 0;
+    runRows<LevelPlane>(simd, &means[0], &variances[0], w, shift, count, rows, inRowStride, outRowStride, a, b);
   }
 };
 
@@ -165,13 +169,28 @@ public:
   }
 
   /// Narrows the slices to a window of output voxels: only the input columns its taps
-  /// reach are blurred.
+  /// reach are blurred. A window of few rows (a tile's block) is blurred a plane at a
+  /// time (slicePlane).
   void setWindow(const SliceWindow& window)
   {
     const BlurPlan& p = this->Plan;
     this->Window = window;
     this->Xa = std::max<std::int64_t>(0, window.x0 * p.step - kHalf);
     this->Xb = std::min<std::int64_t>(p.in[0], (window.x1 - 1) * p.step + kHalf + 1);
+    this->Ya = std::max<std::int64_t>(0, window.y0 * p.step - kHalf);
+    this->Yb = std::min<std::int64_t>(p.in[1], (window.y1 - 1) * p.step + kHalf + 1);
+    const std::int64_t width = this->Xb - this->Xa;
+    this->PlaneMode = this->Yb - this->Ya <= kPlaneRows && width <= kPlaneWidth && window.y1 > window.y0;
+    if (this->PlaneMode)
+    {
+      // Each y-blurred row padded as RowA is, zeros where the x taps leave the volume.
+      this->PaddedWidth = width + 2 * kHalf + 2 * p.step;
+      const auto rows = static_cast<std::size_t>(window.y1 - window.y0);
+      this->PlaneA.resize(static_cast<std::size_t>((this->Yb - this->Ya) * width));
+      this->PlaneB.resize(this->PlaneA.size());
+      this->YRowsA.assign(rows * static_cast<std::size_t>(this->PaddedWidth), 0.0);
+      this->YRowsB.assign(this->YRowsA.size(), 0.0);
+    }
   }
 
   /// Output slice zo within the window: rows(yo) gives the float pointers where the mean
@@ -187,6 +206,11 @@ public:
       this->ZRows[k] = std::min(std::max<std::int64_t>(zo * p.step + k - kHalf, 0), p.in[2] - 1);
       this->Tags[k] = -1;
     }
+    if (this->PlaneMode)
+    {
+      this->slicePlane(zo, rows);
+      return;
+    }
     for (std::int64_t yo = this->Window.y0; yo < this->Window.y1; ++yo)
     {
       const double* ia[kTaps];
@@ -200,11 +224,38 @@ public:
       runRows<ColumnRows>(p.simd, &ia[0], &ib[0], &p.wy[yo * kTaps], width, this->RowA.data() + kHalf + xa,
         this->RowB.data() + kHalf + xa);
       const auto out = rows(yo);
-      this->xPass(out.first, out.second);
+      this->xPass(this->RowA.data(), this->RowB.data(), 0, out.first, out.second);
     }
   }
 
 private:
+  // A window whose taps reach at most this many input rows, of at most this many voxels,
+  // is blurred a plane at a time.
+  static constexpr std::int64_t kPlaneRows = 32;
+  static constexpr std::int64_t kPlaneWidth = 4096;
+
+  /// slice() of a window of few rows: every input row its taps reach blurred along z in
+  /// one call, then every output row along y in one, then each along x: the same numbers
+  /// as row by row, without a call per row of a dozen voxels.
+  template <class Rows>
+  void slicePlane(std::int64_t zo, Rows&& rows)
+  {
+    const BlurPlan& p = this->Plan;
+    const std::int64_t width = this->Xb - this->Xa;
+    this->Src.blurRows(this->Ya, this->Yb - this->Ya, this->ZRows, &p.wz[zo * kTaps], this->Xa, width,
+      this->PlaneA.data(), this->PlaneB.data(), width, p.simd);
+    runRows<ColumnPlane>(p.simd, static_cast<const double*>(this->PlaneA.data()),
+      static_cast<const double*>(this->PlaneB.data()), width, this->Ya, p.in[1], static_cast<std::int64_t>(p.step),
+      p.wy.data(), this->Window.y0, this->Window.y1, width, this->YRowsA.data() + kHalf, this->YRowsB.data() + kHalf,
+      this->PaddedWidth);
+    for (std::int64_t yo = this->Window.y0; yo < this->Window.y1; ++yo)
+    {
+      const std::int64_t row = (yo - this->Window.y0) * this->PaddedWidth;
+      const auto out = rows(yo);
+      this->xPass(this->YRowsA.data() + row, this->YRowsB.data() + row, this->Xa, out.first, out.second);
+    }
+  }
+
   /// The ring slot holding input row y blurred along z (computed when missing).
   int zBlurredRow(std::int64_t y, std::int64_t zo)
   {
@@ -212,21 +263,20 @@ private:
     if (this->Tags[slot] != y)
     {
       const std::int64_t nx = this->Plan.in[0];
-      this->Src.blurRows(y, this->ZRows, &this->Plan.wz[zo * kTaps], this->Xa, this->Xb - this->Xa,
-        &this->RingA[slot * nx + this->Xa], &this->RingB[slot * nx + this->Xa], this->Plan.simd);
+      this->Src.blurRows(y, 1, this->ZRows, &this->Plan.wz[zo * kTaps], this->Xa, this->Xb - this->Xa,
+        &this->RingA[slot * nx + this->Xa], &this->RingB[slot * nx + this->Xa], 0, this->Plan.simd);
       this->Tags[slot] = y;
     }
     return slot;
   }
 
-  /// x pass at the window's kept voxels of the y-blurred row; the padding is zero and so
-  /// are the clipped weights. Interior voxels take the constant weights in a vectorised
-  /// loop. mean[0] is output voxel window.x0.
-  void xPass(float* mean, float* variance) const
+  /// x pass at the window's kept voxels of the y-blurred row pa, pb: pa[i + kHalf] is its
+  /// value at input x = lo + i; the padding is zero and so are the clipped weights.
+  /// Interior voxels take the constant weights in a vectorised loop. mean[0] is output
+  /// voxel window.x0.
+  void xPass(const double* pa, const double* pb, std::int64_t lo, float* mean, float* variance) const
   {
     const BlurPlan& p = this->Plan;
-    const double* pa = this->RowA.data(); // pa[i + kHalf] = row value at input x = i
-    const double* pb = this->RowB.data();
     const std::int64_t x0 = this->Window.x0, x1 = this->Window.x1, step = p.step;
     // The unclipped outputs of the whole row, then of the window.
     const std::int64_t rowBegin = std::min<std::int64_t>(p.out[0], (kHalf + step - 1) / step);
@@ -239,19 +289,21 @@ private:
       double sa = 0.0, sb = 0.0;
       for (int k = 0; k < kTaps; ++k)
       {
-        sa += w[k] * pa[xo * step + k];
-        sb += w[k] * pb[xo * step + k];
+        sa += w[k] * pa[xo * step + k - lo];
+        sb += w[k] * pb[xo * step + k - lo];
       }
       blur::levelMoments(sa, sb, p.shift, mean[xo - x0], variance[xo - x0]);
     };
     for (std::int64_t xo = x0; xo < begin; ++xo)
       clipped(xo);
+    // InteriorRow's output xo - begin reads from pa + step * xo - lo.
+    const std::int64_t from = step * begin - lo;
     if (step == 1)
-      runRows<InteriorRow<1>>(p.simd, pa, pb, &p.kernel[0], p.shift, begin, end, mean + (begin - x0),
-        variance + (begin - x0));
+      runRows<InteriorRow<1>>(p.simd, pa + from, pb + from, &p.kernel[0], p.shift, std::int64_t(0), end - begin,
+        mean + (begin - x0), variance + (begin - x0));
     else
-      runRows<InteriorRow<2>>(p.simd, pa, pb, &p.kernel[0], p.shift, begin, end, mean + (begin - x0),
-        variance + (begin - x0));
+      runRows<InteriorRow<2>>(p.simd, pa + from, pb + from, &p.kernel[0], p.shift, std::int64_t(0), end - begin,
+        mean + (begin - x0), variance + (begin - x0));
     for (std::int64_t xo = end; xo < x1; ++xo)
       clipped(xo);
   }
@@ -264,6 +316,11 @@ private:
   std::vector<double> RowA, RowB;
   SliceWindow Window{};
   std::int64_t Xa = 0, Xb = 0; // input columns the window's taps reach
+  std::int64_t Ya = 0, Yb = 0; // input rows the window's taps reach
+  bool PlaneMode = false;
+  std::int64_t PaddedWidth = 0;
+  std::vector<double> PlaneA, PlaneB; // the plane's z-blurred input rows [Ya, Yb)
+  std::vector<double> YRowsA, YRowsB; // its y-blurred output rows, padded
 };
 
 /// The mean and variance rows of output slice zo of a whole level (dims `out`).

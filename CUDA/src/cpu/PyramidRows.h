@@ -84,6 +84,71 @@ struct ColumnRows
   }
 };
 
+/// Consecutive rows in one call: the z pass of `rows` rows (row j of every tap
+/// inRowStride values after row 0, its outputs outRowStride after) or the y pass of
+/// output rows [y0, y1). A tile's block has rows of a dozen voxels, whose calls one by
+/// one cost more than their arithmetic; each row still takes its own row loop above, so
+/// the numbers are those of the whole level's rows.
+template <class T, bool Unit>
+struct RawPlane
+{
+  static VAO_ALWAYS_INLINE void run(const T* const* r, const double* w, double shift, std::int64_t stride,
+    std::int64_t nx, std::int64_t rows, std::int64_t inRowStride, std::int64_t outRowStride, double* a, double* b)
+  {
+    for (std::int64_t j = 0; j < rows; ++j)
+    {
+      const T* row[kTaps];
+      for (int k = 0; k < kTaps; ++k)
+        row[k] = r[k] + j * inRowStride;
+      RawRows<T, Unit>::run(row, w, shift, stride, nx, a + j * outRowStride, b + j * outRowStride);
+    }
+  }
+};
+
+struct LevelPlane
+{
+  static VAO_ALWAYS_INLINE void run(const float* const* m, const float* const* v, const double* w, double shift,
+    std::int64_t nx, std::int64_t rows, std::int64_t inRowStride, std::int64_t outRowStride, double* a, double* b)
+  {
+    for (std::int64_t j = 0; j < rows; ++j)
+    {
+      const float* means[kTaps];
+      const float* variances[kTaps];
+      for (int k = 0; k < kTaps; ++k)
+      {
+        means[k] = m[k] + j * inRowStride;
+        variances[k] = v[k] + j * inRowStride;
+      }
+      LevelRows::run(means, variances, w, shift, nx, a + j * outRowStride, b + j * outRowStride);
+    }
+  }
+};
+
+/// The y pass of output rows [y0, y1) from z-blurred input rows [ya, ...) kept rowStride
+/// apart: output row yo takes input rows yo * step + k - kHalf clamped to [0, ny) with
+/// the weights w + yo * kTaps (no library min/max: this is compiled for AVX2).
+struct ColumnPlane
+{
+  static VAO_ALWAYS_INLINE void run(const double* za, const double* zb, std::int64_t rowStride, std::int64_t ya,
+    std::int64_t ny, std::int64_t step, const double* w, std::int64_t y0, std::int64_t y1, std::int64_t nx,
+    double* oa, double* ob, std::int64_t outRowStride)
+  {
+    for (std::int64_t yo = y0; yo < y1; ++yo)
+    {
+      const double* ia[kTaps];
+      const double* ib[kTaps];
+      for (int k = 0; k < kTaps; ++k)
+      {
+        std::int64_t y = yo * step + k - kHalf;
+        y = y < 0 ? 0 : y > ny - 1 ? ny - 1 : y;
+        ia[k] = za + (y - ya) * rowStride;
+        ib[k] = zb + (y - ya) * rowStride;
+      }
+      ColumnRows::run(ia, ib, w + yo * kTaps, nx, oa + (yo - y0) * outRowStride, ob + (yo - y0) * outRowStride);
+    }
+  }
+};
+
 /// x pass over unclipped outputs [begin, end): pa[xo * Step + k] is tap k of output xo;
 /// stores mean = A + shift and variance = max(0, B - A^2) as float at mean[xo - begin].
 template <int Step>
