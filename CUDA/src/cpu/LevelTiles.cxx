@@ -127,34 +127,6 @@ void LevelTiles::prepareGrid()
   g.pairedRows = false;
 }
 
-void LevelTiles::markAround(double x, double y, double z)
-{
-  // The cell's lower corner as trilinearSample finds it, from the same grid numbers: the
-  // cell's tile holds all its corners.
-  const std::int64_t tile[3] = { this->tileAlong(0, x), this->tileAlong(1, y), this->tileAlong(2, z) };
-  std::int64_t lowest = this->LowestMarked.load(std::memory_order_relaxed);
-  while (tile[2] < lowest && !this->LowestMarked.compare_exchange_weak(lowest, tile[2], std::memory_order_relaxed))
-  {
-  }
-  std::int64_t highest = this->HighestMarked.load(std::memory_order_relaxed);
-  while (tile[2] > highest && !this->HighestMarked.compare_exchange_weak(highest, tile[2], std::memory_order_relaxed))
-  {
-  }
-  std::atomic<std::uint8_t>& state = this->State[(tile[2] * this->Tiles[1] + tile[1]) * this->Tiles[0] + tile[0]];
-  const std::uint8_t now = state.load(std::memory_order_relaxed);
-  if (now == kAbsent)
-    state.store(kMarked, std::memory_order_relaxed);
-  else if (now == kBuilt)
-    state.store(kInUse, std::memory_order_relaxed);
-}
-
-std::int64_t LevelTiles::tileAlong(int a, double p) const
-{
-  const LevelGrid& g = this->Grid;
-  const double u = std::min(std::max((p - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
-  return static_cast<std::int64_t>(u) >> kTileShift;
-}
-
 void LevelTiles::forgetMarks()
 {
   // Tiles in use lie in the layers marked (built ones were marked first).

@@ -22,6 +22,7 @@
 
 #include "LevelGrid.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -94,8 +95,33 @@ public:
   /// Marks the tiles holding the corners of the trilinear cell at world (x, y, z), clamped
   /// to the level with the samplers' own arithmetic (the tests compare every query with
   /// the whole pyramid bit for bit, so a sample outside its marked tiles would show).
-  /// Any thread.
-  void markAround(double x, double y, double z);
+  /// Any thread. Inline: a shadow query marks five samples a point.
+  void markAround(double x, double y, double z)
+  {
+    // The cell's lower corner as trilinearSample finds it, from the same grid numbers: the
+    // cell's tile holds all its corners.
+    const std::int64_t tile[3] = { this->tileAlong(0, x), this->tileAlong(1, y), this->tileAlong(2, z) };
+    std::atomic<std::uint8_t>& state = this->State[(tile[2] * this->Tiles[1] + tile[1]) * this->Tiles[0] + tile[0]];
+    const std::uint8_t now = state.load(std::memory_order_relaxed);
+    // Marked or in use: marked since forgetMarks, its layer already among those marked
+    // (the points of a batch are neighbours: most of their samples share a tile).
+    if (now == kMarked || now == kInUse)
+      return;
+    std::int64_t lowest = this->LowestMarked.load(std::memory_order_relaxed);
+    while (tile[2] < lowest &&
+      !this->LowestMarked.compare_exchange_weak(lowest, tile[2], std::memory_order_relaxed))
+    {
+    }
+    std::int64_t highest = this->HighestMarked.load(std::memory_order_relaxed);
+    while (tile[2] > highest &&
+      !this->HighestMarked.compare_exchange_weak(highest, tile[2], std::memory_order_relaxed))
+    {
+    }
+    if (now == kAbsent)
+      state.store(kMarked, std::memory_order_relaxed);
+    else if (now == kBuilt)
+      state.store(kInUse, std::memory_order_relaxed);
+  }
 
   /// Builds the tiles marked and not built yet, on the execution's threads. Returns false
   /// when cancelled (the tiles finished stay built).
@@ -126,7 +152,12 @@ public:
 private:
   /// The tile coordinate along axis a of the cell holding world coordinate p (its lower
   /// corner as trilinearSample finds it, clamped to the level).
-  std::int64_t tileAlong(int a, double p) const;
+  std::int64_t tileAlong(int a, double p) const
+  {
+    const LevelGrid& g = this->Grid;
+    const double u = std::min(std::max((p - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
+    return static_cast<std::int64_t>(u) >> kTileShift;
+  }
 
   struct TileRun
   {
