@@ -62,6 +62,19 @@ try:
     peer = min(seconds(lambda: statistics(volume, 10)) for repeat in range(3))
     print("scipy.ndimage box statistics, R = 10: %.1f ms; pvpython Volumetric AO faster by: %s"
           % (peer * 1e3, ", ".join("%s %.1fx" % (m, peer / t) for m, t in volumetric.items())))
+    # The same ratios from rounds in which scipy and each method run one after the other:
+    # this machine's speed drifts by a third within minutes, which the best of runs made
+    # minutes apart takes into the ratio, and a round mostly does not.
+    rounds = {m: [] for m in volumetric}
+    for repeat in range(5):
+        once = seconds(lambda: statistics(volume, 10))
+        for m in volumetric:
+            proxy = VolumetricAmbientOcclusion(Input=body, Method=m, Radius=10)
+            rounds[m].append(once / seconds(proxy.UpdatePipeline))
+            Delete(proxy)
+    print("  round by round (5 rounds, scipy then each method): %s"
+          % ", ".join("%s median %.1fx (%.1f-%.1f)" % (m, sorted(r)[len(r) // 2], min(r), max(r))
+                      for m, r in rounds.items()))
 except ImportError as error:
     print("scipy.ndimage peer skipped: %s" % error)
 
