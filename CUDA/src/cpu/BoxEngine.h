@@ -1,7 +1,7 @@
 // The separable box statistics of every voxel: the streamed box sums (MomentPlanes.h) and,
 // for CDF Reconstruction and the statistics, the box minimum and maximum, which are not
-// invertible and take three van Herk passes (x and y per slice, then z per row); handed
-// to consumers row by row.
+// invertible and take three van Herk passes (y per slice, z per row, then x per slice as
+// its rows are consumed); handed to consumers row by row.
 #pragma once
 
 #include "MomentPlanes.h"
@@ -20,80 +20,83 @@ namespace vao
 namespace detail
 {
 
-/// Box minimum and maximum of every region voxel: planes of the slices the region reads,
-/// the region's own slices starting at `offset` (x fastest, region-sized planes).
+/// Box minimum and maximum of every region voxel, in two steps. computeBoxExtrema runs
+/// the y pass on every slice the region reads, straight from the volume, and then the z
+/// pass along each row, into planes of the region's rows by the x span its boxes read;
+/// SliceExtrema runs the x pass of one region slice as its rows are consumed. The x pass
+/// comes last so that it takes the region's rows alone: a band of rows (forEachNeighbourhoodRow)
+/// reads R rows above and below it, which an x pass first would also take. Minima and
+/// maxima are exact in any order of the passes.
 template <class T>
 struct BoxExtrema
 {
   StorageArray<T> minimumPlanes; // uninitialised: the y pass writes every plane whole
   StorageArray<T> maximumPlanes;
-  std::int64_t offset = 0;
+  std::int64_t offset = 0; // where the region's first slice starts
+  std::int64_t width = 0;  // values a plane row holds: the x span the boxes read
+  std::int64_t rows = 0;   // rows a plane holds: the region's
 
-  /// The box minima and maxima from region voxel `regionIndex` on.
-  const T* minima(std::int64_t regionIndex) const { return this->minimumPlanes.data() + this->offset + regionIndex; }
-  const T* maxima(std::int64_t regionIndex) const { return this->maximumPlanes.data() + this->offset + regionIndex; }
+  /// Row j of region slice k, after the y and z passes.
+  const T* minimumRow(std::int64_t k, std::int64_t j) const
+  {
+    return this->minimumPlanes.data() + this->offset + (k * this->rows + j) * this->width;
+  }
+  const T* maximumRow(std::int64_t k, std::int64_t j) const
+  {
+    return this->maximumPlanes.data() + this->offset + (k * this->rows + j) * this->width;
+  }
 };
 
 /// Rows of a slice whose x passes run together (one AVX2 vector of 16-bit values).
 constexpr std::int64_t kExtremumRows = 16;
 
-/// Three van Herk passes: x then y within each slice the region reads (into planes of
-/// region width), then z along each region row, written back in place. Progress: slices,
-/// then rows.
+/// The y pass of every slice the region reads, then the z pass along each region row,
+/// written back in place (BoxExtrema). Progress: slices, then rows.
 template <class T>
 bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry,
   const Execution& execution, BoxExtrema<T>& result)
 {
   const Region& region = geometry.region;
-  const std::int64_t nx = region.size[0];
-  const std::int64_t plane = geometry.planeSize();
+  const std::int64_t span = geometry.xs.size();
+  const std::int64_t rows = region.size[1];
+  const std::int64_t plane = span * rows;
   const std::int64_t slices = geometry.zs.size();
   StorageArray<T>& planeMin = result.minimumPlanes;
   StorageArray<T>& planeMax = result.maximumPlanes;
   planeMin.resize(static_cast<std::size_t>(slices * plane));
   planeMax.resize(static_cast<std::size_t>(slices * plane));
   result.offset = (region.begin[2] - geometry.zs.lo) * plane;
+  result.width = span;
+  result.rows = rows;
   const int threads = resolveThreadCount(execution.threads);
-  // Progress: the slices of the x/y passes, then the rows of the z pass.
-  const std::int64_t work = slices + region.size[1];
+  // Progress: the slices of the y pass, then the rows of the z pass.
+  const std::int64_t work = slices + rows;
   const bool planesDone = parallelFor(slices, threads, threads, stageExecution(execution, 0.0, double(slices) / work),
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
-      const std::int64_t span = geometry.xs.size();
-      const std::int64_t rows = geometry.ys.size();
-      // The x pass takes kExtremumRows rows at once, transposed so that the rows are the
-      // lanes: the recurrence runs along x on vectors instead of one value at a time.
-      std::vector<T> lanes(static_cast<std::size_t>(span * kExtremumRows));
-      std::vector<T> lanesMin(static_cast<std::size_t>(nx * kExtremumRows));
-      std::vector<T> lanesMax(lanesMin.size());
-      std::vector<T> xMin(static_cast<std::size_t>(rows * nx));
-      std::vector<T> xMax(static_cast<std::size_t>(rows * nx));
+      const std::int64_t read = geometry.ys.size();
+      // Interleaved voxels (one component of several) are gathered first: the pass takes
+      // each row's span as contiguous lanes.
+      std::vector<T> gathered(volume.stride == 1 ? 0 : static_cast<std::size_t>(read * span));
       ExtremumScratch<T> scratch;
-      const std::int64_t x0 = region.begin[0] - geometry.xs.lo;
       for (std::int64_t s = begin; s < end && !progress.stopped(); ++s)
       {
         const std::int64_t z = geometry.zs.lo + s;
-        for (std::int64_t j0 = 0; j0 < rows; j0 += kExtremumRows)
+        const T* first = volume.row(geometry.ys.lo, z) + geometry.xs.lo * volume.stride;
+        std::int64_t rowStride = volume.dims[0]; // values from one row's first to the next's
+        if (volume.stride != 1)
         {
-          const std::int64_t m = std::min(kExtremumRows, rows - j0);
-          const T* src[kExtremumRows];
-          T* minRows[kExtremumRows];
-          T* maxRows[kExtremumRows];
-          for (std::int64_t k = 0; k < m; ++k)
+          for (std::int64_t j = 0; j < read; ++j)
           {
-            src[k] = volume.row(geometry.ys.lo + j0 + k, z) + geometry.xs.lo * volume.stride;
-            minRows[k] = &xMin[(j0 + k) * nx];
-            maxRows[k] = &xMax[(j0 + k) * nx];
+            const T* row = volume.row(geometry.ys.lo + j, z) + geometry.xs.lo * volume.stride;
+            for (std::int64_t i = 0; i < span; ++i)
+              gathered[static_cast<std::size_t>(j * span + i)] = row[i * volume.stride];
           }
-          rowsToLanes(src, m, volume.stride, span, lanes.data());
-          slidingMinMax(lanes.data(), lanes.data(), span, m, geometry.radius.x, x0, nx, lanesMin.data(),
-            lanesMax.data(), scratch);
-          lanesToRows(lanesMin.data(), m, nx, minRows);
-          lanesToRows(lanesMax.data(), m, nx, maxRows);
+          first = gathered.data();
+          rowStride = span;
         }
-        // y pass: whole rows are the lanes.
-        const std::int64_t y0 = region.begin[1] - geometry.ys.lo;
-        slidingMinMax(xMin.data(), xMax.data(), rows, nx, geometry.radius.y, y0, region.size[1],
-          &planeMin[s * plane], &planeMax[s * plane], scratch);
+        // y pass: the rows are the sequence, their x spans the lanes.
+        slidingMinMax(first, first, read, span, geometry.radius.y, region.begin[1] - geometry.ys.lo, rows,
+          &planeMin[s * plane], &planeMax[s * plane], scratch, rowStride);
         progress.advance();
       }
     });
@@ -102,7 +105,7 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
     return false;
   }
 
-  return parallelFor(region.size[1], threads, threads, stageExecution(execution, double(slices) / work, 1.0),
+  return parallelFor(rows, threads, threads, stageExecution(execution, double(slices) / work, 1.0),
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
       ExtremumScratch<T> scratch;
       const std::int64_t z0 = region.begin[2] - geometry.zs.lo;
@@ -110,14 +113,67 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
       {
         // z pass: row y of every slice is a sequence of lane vectors, a plane apart; the
         // results go back in place (the pass reads all of its input first).
-        T* rowMin = &planeMin[y * nx];
-        T* rowMax = &planeMax[y * nx];
-        slidingMinMax(rowMin, rowMax, slices, nx, geometry.radius.z, z0, region.size[2], rowMin + result.offset,
+        T* rowMin = &planeMin[y * span];
+        T* rowMax = &planeMax[y * span];
+        slidingMinMax(rowMin, rowMax, slices, span, geometry.radius.z, z0, region.size[2], rowMin + result.offset,
           rowMax + result.offset, scratch, plane, plane);
         progress.advance();
       }
     });
 }
+
+/// The x pass of one region slice (BoxExtrema's y and z passes done): the box minima and
+/// maxima of its voxels, a row of the region's width per region row. One per thread.
+template <class T>
+class SliceExtrema
+{
+public:
+  const T* minima(std::int64_t j) const { return this->Minima.data() + j * this->Width; }
+  const T* maxima(std::int64_t j) const { return this->Maxima.data() + j * this->Width; }
+
+  /// Region slice k: kExtremumRows rows at once, transposed so that the rows are the
+  /// lanes and the recurrence runs along x on vectors.
+  void compute(const BoxExtrema<T>& extrema, const BoxGeometry& geometry, std::int64_t k)
+  {
+    const Region& region = geometry.region;
+    const std::int64_t nx = region.size[0], span = extrema.width;
+    this->Width = nx;
+    this->Minima.resize(static_cast<std::size_t>(extrema.rows * nx));
+    this->Maxima.resize(this->Minima.size());
+    this->LanesMin.resize(static_cast<std::size_t>(span * kExtremumRows));
+    this->LanesMax.resize(this->LanesMin.size());
+    this->OutMin.resize(static_cast<std::size_t>(nx * kExtremumRows));
+    this->OutMax.resize(this->OutMin.size());
+    const std::int64_t x0 = region.begin[0] - geometry.xs.lo;
+    for (std::int64_t j0 = 0; j0 < extrema.rows; j0 += kExtremumRows)
+    {
+      const std::int64_t m = std::min(kExtremumRows, extrema.rows - j0);
+      const T* inMin[kExtremumRows];
+      const T* inMax[kExtremumRows];
+      T* minRows[kExtremumRows];
+      T* maxRows[kExtremumRows];
+      for (std::int64_t r = 0; r < m; ++r)
+      {
+        inMin[r] = extrema.minimumRow(k, j0 + r);
+        inMax[r] = extrema.maximumRow(k, j0 + r);
+        minRows[r] = &this->Minima[static_cast<std::size_t>((j0 + r) * nx)];
+        maxRows[r] = &this->Maxima[static_cast<std::size_t>((j0 + r) * nx)];
+      }
+      rowsToLanes(inMin, m, 1, span, this->LanesMin.data());
+      rowsToLanes(inMax, m, 1, span, this->LanesMax.data());
+      slidingMinMax(this->LanesMin.data(), this->LanesMax.data(), span, m, geometry.radius.x, x0, nx,
+        this->OutMin.data(), this->OutMax.data(), this->Scratch);
+      lanesToRows(this->OutMin.data(), m, nx, minRows);
+      lanesToRows(this->OutMax.data(), m, nx, maxRows);
+    }
+  }
+
+private:
+  std::int64_t Width = 0;
+  std::vector<T> Minima, Maxima;                     // rows of the region's width
+  std::vector<T> LanesMin, LanesMax, OutMin, OutMax; // the transposed rows, in and out
+  ExtremumScratch<T> Scratch;
+};
 
 } // namespace detail
 } // namespace vao
@@ -216,16 +272,17 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
   const std::int64_t wholePlane = whole.size[0] * whole.size[1];
   const std::int64_t firstRow = region.begin[1] - whole.begin[1];
   const auto consume = [&](const auto& slice) {
-    const std::int64_t bandBase = (slice.z - region.begin[2]) * nx * ny;
     const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
     const auto n = static_cast<std::size_t>(nx);
     std::vector<double> value(n), count(n), mean(n), variance(n), minimum, maximum;
     constexpr bool narrow = std::is_same<std::decay_t<decltype(*slice.sum)>, std::uint32_t>::value;
     std::vector<std::int64_t> sums(narrow ? n : 0); // the row's sums widened
+    SliceExtrema<T> sliceExtrema;
     if (withExtrema)
     {
       minimum.resize(n);
       maximum.resize(n);
+      sliceExtrema.compute(extrema, band, slice.z - region.begin[2]);
     }
     const SimdTier simd = cpuSimdTier();
     NeighbourhoodRow out;
@@ -273,8 +330,8 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
       }
       if (withExtrema)
       {
-        runRows<WidenRow<T>>(simd, extrema.minima(bandBase + j * nx), std::int64_t(1), nx, minimum.data());
-        runRows<WidenRow<T>>(simd, extrema.maxima(bandBase + j * nx), std::int64_t(1), nx, maximum.data());
+        runRows<WidenRow<T>>(simd, sliceExtrema.minima(j), std::int64_t(1), nx, minimum.data());
+        runRows<WidenRow<T>>(simd, sliceExtrema.maxima(j), std::int64_t(1), nx, maximum.data());
       }
       out.index = base + j * nx;
       visit(static_cast<const NeighbourhoodRow&>(out));
@@ -289,12 +346,12 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
 }
 
 /// Rows of region per band when the extrema are needed: a band's extrema planes hold
-/// 2 x (slices read) x rows x width values, so bands of 1/10 of the volume's rows keep
-/// them at 1/5 of the input's size (CDF Reconstruction's working memory stays under 25%
-/// of the input: 21.7% on the 512x512x209 CT head). Each band re-reads R rows above and
-/// below it in the x and y passes, so the fewer bands the fewer rows read: at R = 10 the
-/// CT head's 512 rows read 732 rows in 11 bands where they read 832 in 16 at 1/16 of the
-/// rows. Bands of at least 2R + 1 rows keep that price under 2x.
+/// 2 x (slices read) x rows x (width + 2R) values, so bands of 1/10 of the volume's rows
+/// keep them at about 1/5 of the input's size (CDF Reconstruction's working memory stays
+/// under 25% of the input). Each band re-reads R rows above and below it in its y pass,
+/// so the fewer bands the fewer rows read: at R = 10 the CT head's 512 rows read 732 rows
+/// in 11 bands where they read 832 in 16 at 1/16 of the rows. Bands of at least 2R + 1
+/// rows keep that price under 2x.
 inline std::int64_t extremaBandRows(const BoxGeometry& geometry)
 {
   return std::max<std::int64_t>({ 8, geometry.dims[1] / 10, 2 * std::int64_t(geometry.radius.y) + 1 });
