@@ -123,7 +123,8 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
 }
 
 /// The x pass of one region slice (BoxExtrema's y and z passes done): the box minima and
-/// maxima of its voxels, a row of the region's width per region row. One per thread.
+/// maxima of its voxels, a row of the region's width per region row. visitBand makes one
+/// for each slice it consumes, beside that slice's other rows.
 template <class T>
 class SliceExtrema
 {
@@ -346,12 +347,12 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
 }
 
 /// Rows of region per band when the extrema are needed: a band's extrema planes hold
-/// 2 x (slices read) x rows x (width + 2R) values, so bands of 1/10 of the volume's rows
-/// keep them at about 1/5 of the input's size (CDF Reconstruction's working memory stays
-/// under 25% of the input). Each band re-reads R rows above and below it in its y pass,
-/// so the fewer bands the fewer rows read: at R = 10 the CT head's 512 rows read 732 rows
-/// in 11 bands where they read 832 in 16 at 1/16 of the rows. Bands of at least 2R + 1
-/// rows keep that price under 2x.
+/// 2 x (slices read) x rows x (the x span the boxes read, at most width + 2R) values, so
+/// bands of 1/10 of the volume's rows keep them at about 1/5 of the input's size (CDF
+/// Reconstruction's working memory stays under 25% of the input). Each band re-reads R
+/// rows above and below it in its y pass, so the fewer bands the fewer rows read: at
+/// R = 10 the CT head's 512 rows read 732 rows in 11 bands where they read 832 in 16 at
+/// 1/16 of the rows. Bands of at least 2R + 1 rows keep that price under 2x.
 inline std::int64_t extremaBandRows(const BoxGeometry& geometry)
 {
   return std::max<std::int64_t>({ 8, geometry.dims[1] / 10, 2 * std::int64_t(geometry.radius.y) + 1 });
@@ -371,8 +372,9 @@ bool forEachNeighbourhoodRow(const TypedVolume<T>& volume, const BoxGeometry& ge
   // As many bands as rows of extremaBandRows take, of equal rows: a short last band
   // would read its 2R halo rows for few rows of its own.
   const std::int64_t most = withExtrema ? std::min(ny, extremaBandRows(geometry)) : ny;
-  const std::int64_t bandRows = (ny + (ny + most - 1) / most - 1) / ((ny + most - 1) / most);
-  const std::int64_t bands = (ny + bandRows - 1) / bandRows;
+  const std::int64_t shares = (ny + most - 1) / most;
+  const std::int64_t bandRows = (ny + shares - 1) / shares;
+  const std::int64_t bands = (ny + bandRows - 1) / bandRows; // shares, or fewer: none empty
   BoxExtrema<T> extrema;
   for (std::int64_t b = 0; b < bands; ++b)
   {
