@@ -237,11 +237,11 @@ TEST(SimdTiers, RunningTotalsEqualTheSumsOneByOne)
       }
       vao::detail::runningTotals(a.data(), b.data(), n, vao::detail::cpuSimdTier());
       vao::detail::runningTotals(single.data(), nullptr, n, vao::detail::cpuSimdTier());
-      vao::detail::runningTotals(narrow.data(), n);
+      vao::detail::runningTotals(narrow.data(), n, vao::detail::cpuSimdTier());
       ASSERT_EQ(a, expectedA) << "tier " << static_cast<int>(tier) << ", n " << n;
       ASSERT_EQ(b, expectedB) << "tier " << static_cast<int>(tier) << ", n " << n;
       ASSERT_EQ(single, expectedA) << "one row, tier " << static_cast<int>(tier) << ", n " << n;
-      ASSERT_EQ(narrow, expectedNarrow) << "32 bits, n " << n;
+      ASSERT_EQ(narrow, expectedNarrow) << "32 bits, tier " << static_cast<int>(tier) << ", n " << n;
     }
   }
 }

@@ -257,7 +257,7 @@ private:
     p1[0] = 0;
     if constexpr (std::is_same<Lin, std::uint32_t>::value)
     {
-      runningTotals(p1, span + 1); // modulo 2^32, as every box sum below
+      runningTotals(p1, span + 1, this->Simd); // modulo 2^32, as every box sum below
       if (this->Squares)
         runningTotals(p2, nullptr, span + 1, this->Simd);
     }

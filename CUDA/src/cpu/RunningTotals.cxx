@@ -54,6 +54,59 @@ VAO_AVX512_TARGET inline __m512i scanLanes(__m512i x)
   return _mm512_add_epi64(x, _mm512_alignr_epi64(x, zero, 4));
 }
 
+/// 64-bit running totals four at a time: within each 128-bit half by a shifted add, then
+/// the low half's total added to the high half.
+VAO_AVX2_HELPER __m256i scanLanes(__m256i x)
+{
+  x = _mm256_add_epi64(x, _mm256_slli_si256(x, 8));
+  return _mm256_add_epi64(
+    x, _mm256_blend_epi32(_mm256_setzero_si256(), _mm256_permute4x64_epi64(x, _MM_SHUFFLE(1, 1, 0, 0)), 0xF0));
+}
+
+/// Of a and, with Both, of b, four at a time; the carried totals as in the 32-bit rows.
+template <bool Both>
+VAO_AVX2_INLINE void runningTotalsAvx2(std::int64_t* a, std::int64_t* b, std::int64_t n)
+{
+  __m256i carryA = _mm256_setzero_si256();
+  __m256i carryB = _mm256_setzero_si256();
+  std::int64_t i = 0;
+  for (; i + 4 <= n; i += 4)
+  {
+    const __m256i x = scanLanes(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(a + i)));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(a + i), _mm256_add_epi64(x, carryA));
+    carryA = _mm256_add_epi64(carryA, _mm256_permute4x64_epi64(x, _MM_SHUFFLE(3, 3, 3, 3)));
+    if constexpr (Both)
+    {
+      const __m256i y = scanLanes(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(b + i)));
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(b + i), _mm256_add_epi64(y, carryB));
+      carryB = _mm256_add_epi64(carryB, _mm256_permute4x64_epi64(y, _MM_SHUFFLE(3, 3, 3, 3)));
+    }
+  }
+  runningTotalsPlain(a, b, i, n);
+}
+
+/// 32-bit running totals eight at a time: within each 128-bit half by two shifted adds,
+/// then the low half's total added to the high half. The carried total of the values
+/// before is added last; its next value sums the scan's own last lane, so the chain from
+/// one eight to the next is a single addition.
+VAO_AVX2_INLINE void runningTotalsAvx2(std::uint32_t* a, std::int64_t n)
+{
+  const __m256i last = _mm256_set1_epi32(7);
+  __m256i carry = _mm256_setzero_si256();
+  std::int64_t i = 0;
+  for (; i + 8 <= n; i += 8)
+  {
+    __m256i x = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(a + i));
+    x = _mm256_add_epi32(x, _mm256_slli_si256(x, 4));
+    x = _mm256_add_epi32(x, _mm256_slli_si256(x, 8));
+    // Lane 3 of each half in every lane of it; the low half's moved up, zeros below.
+    x = _mm256_add_epi32(x, _mm256_permute2x128_si256(_mm256_shuffle_epi32(x, 0xFF), x, 0x08));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(a + i), _mm256_add_epi32(x, carry));
+    carry = _mm256_add_epi32(carry, _mm256_permutevar8x32_epi32(x, last));
+  }
+  runningTotalsOfRow(a, i, n);
+}
+
 /// Of a and, with Both, of b.
 template <bool Both>
 VAO_AVX512_TARGET void runningTotalsAvx512(std::int64_t* a, std::int64_t* b, std::int64_t n)
@@ -91,13 +144,29 @@ void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier ti
       runningTotalsAvx512<false>(a, nullptr, n);
     return;
   }
+  if (tier == SimdTier::Avx2)
+  {
+    if (b)
+      runningTotalsAvx2<true>(a, b, n);
+    else
+      runningTotalsAvx2<false>(a, nullptr, n);
+    return;
+  }
 #endif
   (void)tier;
   runningTotalsPlain(a, b, 0, n);
 }
 
-void runningTotals(std::uint32_t* a, std::int64_t n)
+void runningTotals(std::uint32_t* a, std::int64_t n, SimdTier tier)
 {
+#if VAO_HAVE_AVX2_TARGET
+  if (tier >= SimdTier::Avx2)
+  {
+    runningTotalsAvx2(a, n);
+    return;
+  }
+#endif
+  (void)tier;
   runningTotalsOfRow(a, 0, n);
 }
 

@@ -1,7 +1,9 @@
-// Running totals of rows of 64-bit integers in place, for the box sums' x pass
-// (MomentPlanes.h): integer sums are exact, so any order of the additions gives the same
-// values, and AVX-512 forms eight at a time by a scan within the register (three shifted
-// adds) plus the total carried from the previous eight.
+// Running totals of rows of 64- and 32-bit integers in place, for the box sums' x pass
+// (MomentPlanes.h): integer sums are exact (32-bit ones modulo 2^32), so any order of the
+// additions gives the same values, and a vector forms several totals at once by a scan
+// within the register (shifted adds) plus the total carried from the vector before: eight
+// 64-bit totals on AVX-512, four on AVX2, eight 32-bit ones on AVX2 and AVX-512. The
+// serial sum waits one addition per value; the scan, one per vector.
 #pragma once
 
 #include "CpuDispatch.h"
@@ -19,7 +21,7 @@ void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier ti
 
 /// a[i] += a[i - 1] for i in [1, n) modulo 2^32: 32-bit sums whose every difference of two
 /// totals, a box sum, is exact as an int32 (MomentPlanes.h's linearSumsFit32).
-void runningTotals(std::uint32_t* a, std::int64_t n);
+void runningTotals(std::uint32_t* a, std::int64_t n, SimdTier tier);
 
 } // namespace detail
 } // namespace vao
