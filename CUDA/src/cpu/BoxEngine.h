@@ -123,8 +123,8 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
 }
 
 /// The x pass of one region slice (BoxExtrema's y and z passes done): the box minima and
-/// maxima of its voxels, a row of the region's width per region row. visitBand makes one
-/// for each slice it consumes, beside that slice's other rows.
+/// maxima of its voxels, a row of the region's width per region row. Each worker of
+/// visitBand keeps one for the slices it consumes, so its buffers are made once.
 template <class T>
 class SliceExtrema
 {
@@ -272,19 +272,22 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
   const std::int64_t nx = region.size[0], ny = region.size[1];
   const std::int64_t wholePlane = whole.size[0] * whole.size[1];
   const std::int64_t firstRow = region.begin[1] - whole.begin[1];
-  const auto consume = [&](const auto& slice) {
-    const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
-    const auto n = static_cast<std::size_t>(nx);
-    std::vector<double> value(n), count(n), mean(n), variance(n), minimum, maximum;
-    constexpr bool narrow = std::is_same<std::decay_t<decltype(*slice.sum)>, std::uint32_t>::value;
-    std::vector<std::int64_t> sums(narrow ? n : 0); // the row's sums widened
+  // A worker's row buffers and x pass, made once for its chunk of slices.
+  struct Buffers
+  {
+    std::vector<double> value, count, mean, variance, minimum, maximum;
+    std::vector<std::int64_t> sums; // a row's 32-bit sums widened
     SliceExtrema<T> sliceExtrema;
+  };
+  const auto consumeSlice = [&](const auto& slice, Buffers& buffers) {
+    const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
+    std::vector<double>&value = buffers.value, &count = buffers.count, &mean = buffers.mean,
+                       &variance = buffers.variance, &minimum = buffers.minimum, &maximum = buffers.maximum;
+    std::vector<std::int64_t>& sums = buffers.sums;
+    constexpr bool narrow = std::is_same<std::decay_t<decltype(*slice.sum)>, std::uint32_t>::value;
+    SliceExtrema<T>& sliceExtrema = buffers.sliceExtrema;
     if (withExtrema)
-    {
-      minimum.resize(n);
-      maximum.resize(n);
       sliceExtrema.compute(extrema, band, slice.z - region.begin[2]);
-    }
     const SimdTier simd = cpuSimdTier();
     NeighbourhoodRow out;
     out.size = nx;
@@ -338,12 +341,20 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
       visit(static_cast<const NeighbourhoodRow&>(out));
     }
   };
+  const auto makeConsumer = [&] {
+    const auto n = static_cast<std::size_t>(nx);
+    const std::size_t extremaRow = withExtrema ? n : 0;
+    Buffers made{ std::vector<double>(n), std::vector<double>(n), std::vector<double>(n), std::vector<double>(n),
+      std::vector<double>(extremaRow), std::vector<double>(extremaRow), std::vector<std::int64_t>(n), {} };
+    return [&consumeSlice, buffers = std::move(made)](
+             const auto& slice) mutable { consumeSlice(slice, buffers); };
+  };
   const Execution stage = stageExecution(execution, split, 1.0);
   if constexpr (MomentTraits<T>::exactInteger)
     if (linearSumsFit32<T>(band))
-      return streamMoments<T, std::uint32_t>(volume, band, scale, contents.variance, stage, consume);
+      return streamMoments<T, std::uint32_t>(volume, band, scale, contents.variance, stage, makeConsumer);
   return streamMoments<T, typename MomentTraits<T>::Accumulator>(
-    volume, band, scale, contents.variance, stage, consume);
+    volume, band, scale, contents.variance, stage, makeConsumer);
 }
 
 /// Rows of region per band when the extrema are needed: a band's extrema planes hold

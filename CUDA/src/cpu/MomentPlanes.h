@@ -328,12 +328,13 @@ struct MomentSlice
 };
 
 /// Streams the moment planes of every region slice to consume(slice) on worker threads;
-/// each thread takes a contiguous chunk of slices. The sums of v are in Lin (std::uint32_t
-/// only where linearSumsFit32), the sums of squares formed only if `squares`. Returns false
-/// when cancelled.
-template <class T, class Lin, class Consume>
+/// each thread takes a contiguous chunk of slices and a consumer of its own, made by
+/// makeConsumer(), whose buffers then serve the chunk's slices, not one slice each. The
+/// sums of v are in Lin (std::uint32_t only where linearSumsFit32), the sums of squares
+/// formed only if `squares`. Returns false when cancelled.
+template <class T, class Lin, class MakeConsumer>
 bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry, const MomentScale& scale,
-  bool squares, const Execution& execution, Consume&& consume)
+  bool squares, const Execution& execution, MakeConsumer&& makeConsumer)
 {
   const auto shift = static_cast<typename MomentTraits<T>::Accumulator>(scale.shift);
   const int threads = resolveThreadCount(execution.threads);
@@ -341,6 +342,7 @@ bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry, co
   return parallelFor(nz, threads, threads, execution,
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
       MomentPlanes<T, Lin> planes(volume, geometry, shift, squares);
+      auto consume = makeConsumer();
       for (std::int64_t k = begin; k < end; ++k)
       {
         const std::int64_t z = geometry.region.begin[2] + k;
