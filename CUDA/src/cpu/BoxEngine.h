@@ -145,27 +145,34 @@ public:
     this->LanesMax.resize(this->LanesMin.size());
     this->OutMin.resize(static_cast<std::size_t>(nx * kExtremumRows));
     this->OutMax.resize(this->OutMin.size());
+    // A last group of fewer rows runs as a whole one where the transposes take blocks of
+    // 16 rows (else they and the pass would go value by value): its spare lanes repeat
+    // the last row and their results go to a row that is not kept.
+    const bool padded = transposesInBlocks<T>();
+    this->Spare.resize(static_cast<std::size_t>(padded ? 2 * nx : 0));
     const std::int64_t x0 = region.begin[0] - geometry.xs.lo;
     for (std::int64_t j0 = 0; j0 < extrema.rows; j0 += kExtremumRows)
     {
       const std::int64_t m = std::min(kExtremumRows, extrema.rows - j0);
+      const std::int64_t lanes = padded ? kExtremumRows : m;
       const T* inMin[kExtremumRows];
       const T* inMax[kExtremumRows];
       T* minRows[kExtremumRows];
       T* maxRows[kExtremumRows];
-      for (std::int64_t r = 0; r < m; ++r)
+      for (std::int64_t r = 0; r < lanes; ++r)
       {
-        inMin[r] = extrema.minimumRow(k, j0 + r);
-        inMax[r] = extrema.maximumRow(k, j0 + r);
-        minRows[r] = &this->Minima[static_cast<std::size_t>((j0 + r) * nx)];
-        maxRows[r] = &this->Maxima[static_cast<std::size_t>((j0 + r) * nx)];
+        const std::int64_t j = j0 + std::min(r, m - 1);
+        inMin[r] = extrema.minimumRow(k, j);
+        inMax[r] = extrema.maximumRow(k, j);
+        minRows[r] = r < m ? &this->Minima[static_cast<std::size_t>(j * nx)] : this->Spare.data();
+        maxRows[r] = r < m ? &this->Maxima[static_cast<std::size_t>(j * nx)] : this->Spare.data() + nx;
       }
-      rowsToLanes(inMin, m, 1, span, this->LanesMin.data());
-      rowsToLanes(inMax, m, 1, span, this->LanesMax.data());
-      slidingMinMax(this->LanesMin.data(), this->LanesMax.data(), span, m, geometry.radius.x, x0, nx,
+      rowsToLanes(inMin, lanes, 1, span, this->LanesMin.data());
+      rowsToLanes(inMax, lanes, 1, span, this->LanesMax.data());
+      slidingMinMax(this->LanesMin.data(), this->LanesMax.data(), span, lanes, geometry.radius.x, x0, nx,
         this->OutMin.data(), this->OutMax.data(), this->Scratch);
-      lanesToRows(this->OutMin.data(), m, nx, minRows);
-      lanesToRows(this->OutMax.data(), m, nx, maxRows);
+      lanesToRows(this->OutMin.data(), lanes, nx, minRows);
+      lanesToRows(this->OutMax.data(), lanes, nx, maxRows);
     }
   }
 
@@ -173,6 +180,7 @@ private:
   std::int64_t Width = 0;
   std::vector<T> Minima, Maxima;                     // rows of the region's width
   std::vector<T> LanesMin, LanesMax, OutMin, OutMax; // the transposed rows, in and out
+  std::vector<T> Spare;                              // results of padding lanes, not kept
   ExtremumScratch<T> Scratch;
 };
 

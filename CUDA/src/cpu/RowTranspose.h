@@ -77,13 +77,25 @@ VAO_AVX2_INLINE void lanesToRows16x16(const void* lanes, std::int64_t blocks, vo
 }
 #endif
 
+/// Whether 16 contiguous rows of T go through the 16 x 16 block transposes: a caller with
+/// fewer rows gains by padding them to 16.
+template <class T>
+bool transposesInBlocks()
+{
+#if VAO_HAVE_AVX2_TARGET
+  return sizeof(T) == 2 && cpuSimdTier() >= SimdTier::Avx2;
+#else
+  return false;
+#endif
+}
+
 /// lanes[i * m + k] = rows[k][i * stride] for k < m, i < span.
 template <class T>
 void rowsToLanes(const T* const* rows, std::int64_t m, std::int64_t stride, std::int64_t span, T* lanes)
 {
   std::int64_t done = 0;
 #if VAO_HAVE_AVX2_TARGET
-  if (sizeof(T) == 2 && m == 16 && stride == 1 && cpuSimdTier() >= SimdTier::Avx2)
+  if (m == 16 && stride == 1 && transposesInBlocks<T>())
   {
     done = span / 16 * 16;
     rowsToLanes16x16(reinterpret_cast<const void* const*>(rows), span / 16, lanes);
@@ -100,7 +112,7 @@ void lanesToRows(const T* lanes, std::int64_t m, std::int64_t n, T* const* rows)
 {
   std::int64_t done = 0;
 #if VAO_HAVE_AVX2_TARGET
-  if (sizeof(T) == 2 && m == 16 && cpuSimdTier() >= SimdTier::Avx2)
+  if (m == 16 && transposesInBlocks<T>())
   {
     done = n / 16 * 16;
     lanesToRows16x16(lanes, n / 16, reinterpret_cast<void* const*>(rows));
