@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 namespace vao
@@ -68,12 +69,23 @@ struct ExtremumScratch
   WindowPlan plan;
 };
 
-/// The recurrence and the combination of slidingMinMax on prepared buffers: a row loop
-/// (CpuDispatch.h), so the lanes run on AVX2 vectors where the processor has them. Plain
-/// loops and conditionals only: no inline library function is compiled for AVX2 here.
+/// The steps of the recurrence on m lanes: plain loops and conditionals, which the row
+/// loop's target vectorises (CpuDispatch.h); no inline library function is compiled for
+/// AVX2 here.
 template <class T>
-struct ExtremumPasses
+struct LaneLoops
 {
+  /// A block's first element starts both running results.
+  static VAO_ALWAYS_INLINE void start(const T* lo, const T* hi, T* __restrict runMin, T* __restrict runMax,
+    std::int64_t m)
+  {
+    for (std::int64_t k = 0; k < m; ++k)
+    {
+      runMin[k] = lo[k];
+      runMax[k] = hi[k];
+    }
+  }
+
   /// One step of the running results: runMin = min(lo, prevMin), runMax = max(hi, prevMax).
   static VAO_ALWAYS_INLINE void extend(const T* lo, const T* hi, const T* prevMin, const T* prevMax,
     T* __restrict runMin, T* __restrict runMax, std::int64_t m)
@@ -95,6 +107,89 @@ struct ExtremumPasses
     }
   }
 
+  /// An output: om = min(minA, minB), ox = max(maxA, maxB).
+  static VAO_ALWAYS_INLINE void combine(const T* minA, const T* minB, const T* maxA, const T* maxB,
+    T* __restrict om, T* __restrict ox, std::int64_t m)
+  {
+    for (std::int64_t k = 0; k < m; ++k)
+    {
+      om[k] = minB[k] < minA[k] ? minB[k] : minA[k];
+      ox[k] = maxA[k] < maxB[k] ? maxB[k] : maxA[k];
+    }
+  }
+};
+
+#if defined(__GNUC__) || defined(__clang__)
+/// 16 values of a 16-bit type as one 32-byte vector (the compilers' vector extension).
+template <class T>
+struct SixteenValues;
+template <>
+struct SixteenValues<std::int16_t>
+{
+  typedef std::int16_t type __attribute__((vector_size(32)));
+};
+template <>
+struct SixteenValues<std::uint16_t>
+{
+  typedef std::uint16_t type __attribute__((vector_size(32)));
+};
+
+/// LaneLoops' steps on exactly 16 lanes of 16-bit values (the x pass's rows, BoxEngine.h):
+/// one vector each, as the loops over a run-time m compile to a vector step wrapped in
+/// the checks and tails of a loop, which on 16 lanes cost more than the step.
+template <class T>
+struct SixteenLanes
+{
+  using V = typename SixteenValues<T>::type;
+  // Pointers in and out, so that no function passes a vector by value (whose ABI differs
+  // between the targets the row loop is built for).
+  /// out = min(a, b), or max(a, b) with Greater.
+  template <bool Greater>
+  static VAO_ALWAYS_INLINE void pick(const T* a, const T* b, T* out)
+  {
+    V x, y;
+    __builtin_memcpy(&x, a, sizeof x);
+    __builtin_memcpy(&y, b, sizeof y);
+    V result;
+    if constexpr (Greater)
+      result = x < y ? y : x;
+    else
+      result = x < y ? x : y;
+    __builtin_memcpy(out, &result, sizeof result);
+  }
+  static VAO_ALWAYS_INLINE void lesser(const T* a, const T* b, T* out) { pick<false>(a, b, out); }
+  static VAO_ALWAYS_INLINE void greater(const T* a, const T* b, T* out) { pick<true>(a, b, out); }
+
+  static VAO_ALWAYS_INLINE void start(const T* lo, const T* hi, T* runMin, T* runMax, std::int64_t)
+  {
+    __builtin_memcpy(runMin, lo, sizeof(V));
+    __builtin_memcpy(runMax, hi, sizeof(V));
+  }
+  static VAO_ALWAYS_INLINE void extend(const T* lo, const T* hi, const T* prevMin, const T* prevMax, T* runMin,
+    T* runMax, std::int64_t)
+  {
+    lesser(lo, prevMin, runMin);
+    greater(hi, prevMax, runMax);
+  }
+  static VAO_ALWAYS_INLINE void extendInPlace(const T* lo, const T* hi, T* sufMin, T* sufMax, std::int64_t)
+  {
+    lesser(lo, sufMin, sufMin);
+    greater(hi, sufMax, sufMax);
+  }
+  static VAO_ALWAYS_INLINE void combine(const T* minA, const T* minB, const T* maxA, const T* maxB, T* om, T* ox,
+    std::int64_t)
+  {
+    lesser(minA, minB, om);
+    greater(maxA, maxB, ox);
+  }
+};
+#endif
+
+/// The recurrence and the combination of slidingMinMax on prepared buffers, a row loop
+/// (CpuDispatch.h) whose element-wise steps are Steps' (LaneLoops, or SixteenLanes).
+template <class T, class Steps = LaneLoops<T>>
+struct ExtremumPasses
+{
   /// The prefixes of every block forward, then each block's suffix backward, kept as one
   /// running lane vector: an output is written at its window's first position, where the
   /// suffix it takes is the running one, so the suffixes are never stored. Outputs sit at
@@ -108,14 +203,11 @@ struct ExtremumPasses
     {
       const std::int64_t blockEnd = blockStart + w < n ? blockStart + w : n;
       // The first element of a block starts both running results; the rest extend them.
-      for (std::int64_t k = 0; k < m; ++k)
-      {
-        preMin[blockStart * m + k] = inMin[blockStart * inStride + k];
-        preMax[blockStart * m + k] = inMax[blockStart * inStride + k];
-      }
+      Steps::start(inMin + blockStart * inStride, inMax + blockStart * inStride, preMin + blockStart * m,
+        preMax + blockStart * m, m);
       for (std::int64_t i = blockStart + 1; i < blockEnd; ++i)
       {
-        extend(inMin + i * inStride, inMax + i * inStride, preMin + (i - 1) * m, preMax + (i - 1) * m,
+        Steps::extend(inMin + i * inStride, inMax + i * inStride, preMin + (i - 1) * m, preMax + (i - 1) * m,
           preMin + i * m, preMax + i * m, m);
       }
     }
@@ -126,13 +218,9 @@ struct ExtremumPasses
       for (std::int64_t i = last; i >= blockStart; --i)
       {
         if (i == last)
-          for (std::int64_t k = 0; k < m; ++k)
-          {
-            sufMin[k] = inMin[i * inStride + k];
-            sufMax[k] = inMax[i * inStride + k];
-          }
+          Steps::start(inMin + i * inStride, inMax + i * inStride, sufMin, sufMax, m);
         else
-          extendInPlace(inMin + i * inStride, inMax + i * inStride, sufMin, sufMax, m);
+          Steps::extendInPlace(inMin + i * inStride, inMax + i * inStride, sufMin, sufMax, m);
         for (; o >= 0 && lo[o] == i; --o)
         {
           // first and second index [prefix | suffix]: a suffix reference is the running one.
@@ -140,13 +228,7 @@ struct ExtremumPasses
           const T* minB = second[o] < n ? preMin + second[o] * m : sufMin;
           const T* maxA = first[o] < n ? preMax + first[o] * m : sufMax;
           const T* maxB = second[o] < n ? preMax + second[o] * m : sufMax;
-          T* __restrict om = outMin + o * outStride;
-          T* __restrict ox = outMax + o * outStride;
-          for (std::int64_t k = 0; k < m; ++k)
-          {
-            om[k] = minB[k] < minA[k] ? minB[k] : minA[k];
-            ox[k] = maxA[k] < maxB[k] ? maxB[k] : maxA[k];
-          }
+          Steps::combine(minA, minB, maxA, maxB, outMin + o * outStride, outMax + o * outStride, m);
         }
       }
     }
@@ -172,9 +254,21 @@ void slidingMinMax(const T* inMin, const T* inMax, std::int64_t n, std::int64_t 
   T* preMin = scratch.minParts.data();
   T* preMax = scratch.maxParts.data();
   // AVX-512 measured no faster for these compare-and-store loops.
-  runRows<ExtremumPasses<T>>(cpuSimdTierUpTo(SimdTier::Avx2), inMin, inMax, inStride < 0 ? m : inStride, n, m,
-    2 * r + 1, preMin, preMin + n * m, preMax, preMax + n * m, scratch.plan.first.data(),
-    scratch.plan.second.data(), scratch.plan.lo.data(), outCount, outMin, outMax, outStride < 0 ? m : outStride);
+  const auto passes = [&](auto steps) {
+    runRows<ExtremumPasses<T, decltype(steps)>>(cpuSimdTierUpTo(SimdTier::Avx2), inMin, inMax,
+      inStride < 0 ? m : inStride, n, m, 2 * r + 1, preMin, preMin + n * m, preMax, preMax + n * m,
+      scratch.plan.first.data(), scratch.plan.second.data(), scratch.plan.lo.data(), outCount, outMin, outMax,
+      outStride < 0 ? m : outStride);
+  };
+#if defined(__GNUC__) || defined(__clang__)
+  if constexpr (std::is_same<T, std::int16_t>::value || std::is_same<T, std::uint16_t>::value)
+    if (m == 16)
+    {
+      passes(SixteenLanes<T>());
+      return;
+    }
+#endif
+  passes(LaneLoops<T>());
 }
 
 } // namespace detail
