@@ -59,7 +59,8 @@ struct BoxGeometry
 
 /// One row of the y pass: plane += run (when plane is not null), then the running column
 /// sums move on: run = (run + entering) - leaving, in that order (the rounding of double
-/// sums is that of the scalar code it replaced). Compiled for AVX2 too (CpuDispatch.h).
+/// sums is that of the scalar code it replaced), in one loop that loads run once.
+/// Compiled for AVX2 too (CpuDispatch.h).
 template <class Acc>
 struct SlideColumns
 {
@@ -68,9 +69,14 @@ struct SlideColumns
   {
     if (plane)
       for (std::int64_t i = 0; i < n; ++i)
-        plane[i] += run[i];
-    for (std::int64_t i = 0; i < n; ++i)
-      run[i] = (run[i] + entering[i]) - leaving[i];
+      {
+        const Acc r = run[i];
+        plane[i] += r;
+        run[i] = (r + entering[i]) - leaving[i];
+      }
+    else
+      for (std::int64_t i = 0; i < n; ++i)
+        run[i] = (run[i] + entering[i]) - leaving[i];
   }
 };
 
