@@ -283,6 +283,16 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
   // A worker's row buffers and x pass, made once for its chunk of slices.
   struct Buffers
   {
+    Buffers(std::size_t n, bool extrema)
+      : value(n)
+      , count(n)
+      , mean(n)
+      , variance(n)
+      , minimum(extrema ? n : 0)
+      , maximum(extrema ? n : 0)
+      , sums(n)
+    {
+    }
     std::vector<double> value, count, mean, variance, minimum, maximum;
     std::vector<std::int64_t> sums; // a row's 32-bit sums widened
     SliceExtrema<T> sliceExtrema;
@@ -350,11 +360,7 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
     }
   };
   const auto makeConsumer = [&] {
-    const auto n = static_cast<std::size_t>(nx);
-    const std::size_t extremaRow = withExtrema ? n : 0;
-    Buffers made{ std::vector<double>(n), std::vector<double>(n), std::vector<double>(n), std::vector<double>(n),
-      std::vector<double>(extremaRow), std::vector<double>(extremaRow), std::vector<std::int64_t>(n), {} };
-    return [&consumeSlice, buffers = std::move(made)](
+    return [&consumeSlice, buffers = Buffers(static_cast<std::size_t>(nx), withExtrema)](
              const auto& slice) mutable { consumeSlice(slice, buffers); };
   };
   const Execution stage = stageExecution(execution, split, 1.0);
