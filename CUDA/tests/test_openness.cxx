@@ -89,14 +89,18 @@ TEST(Openness, EveryMethodMatchesBruteForceOnRandomVolumes)
   const auto v8 = randomVolume<std::uint8_t>(dims, 0, 6, 21); // few values: ties and flat boxes
   const auto v16 = randomVolume<std::int16_t>(dims, -1024, 1600, 22);
   const auto vf = randomVolume<float>(dims, -1, 1, 23);
+  // Above int16's range: CDF Reconstruction reads 16-bit rows as they are (raw rows).
+  const auto vu16 = randomVolume<std::uint16_t>(dims, 40000, 65535, 24);
   for (int r = 0; r <= 4; ++r)
   {
     SCOPED_TRACE(r);
     expectMatchesBruteForce(v8, dims, { r, r, r }, vao::QueryMode::VoxelValue, 0);
     expectMatchesBruteForce(v16, dims, { r, r, r }, vao::QueryMode::VoxelValue, 0);
+    expectMatchesBruteForce(vu16, dims, { r, r, r }, vao::QueryMode::VoxelValue, 0);
     expectMatchesBruteForce(vf, dims, { r, r, r }, vao::QueryMode::IsoValue, 0.25);
   }
   expectMatchesBruteForce(v16, dims, { 3, 1, 2 }, vao::QueryMode::IsoValue, 100.0);
+  expectMatchesBruteForce(vu16, dims, { 2, 3, 1 }, vao::QueryMode::IsoValue, 52000.5);
   expectMatchesBruteForce(v8, dims, { 0, 4, 1 }, vao::QueryMode::VoxelValue, 0);
   expectMatchesBruteForce(v16, dims, { 30, 30, 30 }, vao::QueryMode::VoxelValue, 0);
 }
@@ -161,8 +165,9 @@ TEST(Openness, APieceGrownByTheRadiusGivesTheWholeVolumesNumbers)
 }
 
 /// The moment methods on one component of three (a strided view) against the same values
-/// stored alone, bit for bit: each voxel's own value is its query, so it must be read
-/// through the stride too.
+/// stored alone, bit for bit, with each query: a voxel's own value must be read through
+/// the stride too, and 16-bit voxels stored alone take CDF Reconstruction's raw rows, the
+/// strided ones its rows of doubles.
 template <class T>
 void expectStridedComponentLikeContiguous(const std::vector<T>& v, const vao::Index3& dims)
 {
@@ -179,14 +184,18 @@ void expectStridedComponentLikeContiguous(const std::vector<T>& v, const vao::In
   for (const vao::Region region : { vao::Region::whole(contiguous), vao::Region{ { 2, 1, 1 }, { 19, 4, 3 } } })
     for (const vao::Radius r : { vao::Radius{ 1, 1, 1 }, vao::Radius{ 3, 2, 1 } })
       for (const Method method : { Method::CdfReconstruction, Method::GaussianCdf, Method::Chebyshev })
-        EXPECT_EQ(openness(strided, region, method, r), openness(contiguous, region, method, r))
-          << "method " << int(method) << ", radius " << r.x << "," << r.y << "," << r.z;
+        for (const vao::QueryMode query :
+          { vao::QueryMode::VoxelValue, vao::QueryMode::IsoValue, vao::QueryMode::SmoothedValue })
+          EXPECT_EQ(openness(strided, region, method, r, query, 3.5), openness(contiguous, region, method, r, query, 3.5))
+            << "method " << int(method) << ", query " << int(query) << ", radius " << r.x << "," << r.y << ","
+            << r.z;
 }
 
 TEST(Openness, MomentMethodsReadEachVoxelsOwnValueThroughTheStride)
 {
   const vao::Index3 dims = { 23, 6, 5 };
   expectStridedComponentLikeContiguous(randomVolume<std::int16_t>(dims, -1024, 1600, 31), dims);
+  expectStridedComponentLikeContiguous(randomVolume<std::uint16_t>(dims, 0, 65535, 34), dims);
   expectStridedComponentLikeContiguous(randomVolume<std::uint8_t>(dims, 0, 255, 32), dims);
   expectStridedComponentLikeContiguous(randomVolume<float>(dims, -1, 1, 33), dims);
 }

@@ -46,8 +46,9 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   const bool fromSums = p.method == Method::Chebyshev || p.method == Method::GaussianCdf;
   // CDF Reconstruction takes the mean alone from the moments.
   const bool variance = output.variance || (output.openness && p.method != Method::CdfReconstruction);
+  // Raw rows (16-bit voxels) where CDF Reconstruction asks for the means and extrema alone.
   const detail::RowContents contents{ withExtrema, output.variance != nullptr || !output.openness || !fromSums,
-    output.openness && voxelQuery && !query, variance };
+    output.openness && voxelQuery && !query, variance, withExtrema && !variance };
   // Kept where the rows' extremes take vector instructions; the plain loop would cost
   // several times the separate, threaded pass the caller then makes (vao/ValueRanges.h).
   const bool keepRange = output.openness && output.opennessRange && detail::cpuHasAvx2();
@@ -61,6 +62,7 @@ Status separableOpenness(const VolumeView& view, const Region& region,
       }
       if (output.openness)
       {
+        // A raw row reads its own values where query and row.value are null (opennessRow).
         const double* q = query ? query + row.index : (voxelQuery ? row.value : nullptr);
         detail::opennessRow(p.method, p.erfMode, row, q, p.isoValue, output.openness + row.index);
         if (keepRange)

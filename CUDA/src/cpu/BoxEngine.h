@@ -220,6 +220,19 @@ struct WidenSums
   }
 };
 
+/// A row of 16-bit voxels (Int16 or UInt16) with its box extrema and exact 32-bit box sums
+/// as the passes leave them (RowContents::raw): CDF Reconstruction's lanes widen these
+/// themselves (opennessRow), where widening them into rows of doubles first, and the means
+/// in a pass of their own, cost a sixth of its time.
+struct RawRow
+{
+  ScalarType type = ScalarType::Int16;
+  const void* value = nullptr; // the voxels' own, contiguous; null unless RowContents::values
+  const void* minimum = nullptr;
+  const void* maximum = nullptr;
+  const std::int32_t* sum = nullptr; // null: the row is not raw
+};
+
 /// One row of the region with the statistics of its voxels' neighbourhoods, as arrays
 /// (x fastest), handed to a consumer: a row at a time lets the estimators run on vectors.
 struct NeighbourhoodRow
@@ -239,6 +252,9 @@ struct NeighbourhoodRow
   const std::int64_t* sumSquares = nullptr;
   const std::int64_t* countX = nullptr;
   std::int64_t countYZ = 0;
+  // Where raw.sum is set, the row holds raw, countX and countYZ alone: value, count, mean,
+  // minimum and maximum are null.
+  RawRow raw;
 
   NeighbourhoodStats stats(std::int64_t i) const
   {
@@ -258,6 +274,9 @@ struct RowContents
   bool moments = true;
   bool values = true;
   bool variance = true;
+  // Rows of 16-bit voxels with 32-bit sums may come raw (NeighbourhoodRow::raw): for CDF
+  // Reconstruction, which takes the means and the extrema alone.
+  bool raw = false;
 };
 
 /// forEachNeighbourhoodRow on one band (band.region, a slab of rows of `whole`): voxel
@@ -316,10 +335,31 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
     out.minimum = withExtrema ? minimum.data() : nullptr;
     out.maximum = withExtrema ? maximum.data() : nullptr;
     out.roundingVariance = slice.roundingVariance;
+    constexpr bool sixteenBit = std::is_same<T, std::int16_t>::value || std::is_same<T, std::uint16_t>::value;
+    const bool raw = narrow && sixteenBit && contents.raw && withExtrema && volume.stride == 1;
+    if (raw)
+      out.value = out.count = out.mean = out.minimum = out.maximum = nullptr;
     for (std::int64_t j = 0; j < ny; ++j)
     {
       const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
       const std::int64_t countYZ = countY[j] * slice.countZ;
+      out.index = base + j * nx;
+      if constexpr (narrow && sixteenBit)
+      {
+        if (raw)
+        {
+          out.raw.type = std::is_signed<T>::value ? ScalarType::Int16 : ScalarType::UInt16;
+          out.raw.value = contents.values ? row : nullptr;
+          out.raw.minimum = sliceExtrema.minima(j);
+          out.raw.maximum = sliceExtrema.maxima(j);
+          // The 32-bit sums hold the bits of exact int32 sums (MomentPlanes.h).
+          out.raw.sum = reinterpret_cast<const std::int32_t*>(slice.sum + j * nx);
+          out.countX = countX.data();
+          out.countYZ = countYZ;
+          visit(static_cast<const NeighbourhoodRow&>(out));
+          continue;
+        }
+      }
       if (contents.values)
         runRows<WidenRow<T>>(simd, row, volume.stride, nx, value.data());
       if constexpr (MomentTraits<T>::exactInteger)
@@ -355,7 +395,6 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
         runRows<WidenRow<T>>(simd, sliceExtrema.minima(j), std::int64_t(1), nx, minimum.data());
         runRows<WidenRow<T>>(simd, sliceExtrema.maxima(j), std::int64_t(1), nx, maximum.data());
       }
-      out.index = base + j * nx;
       visit(static_cast<const NeighbourhoodRow&>(out));
     }
   };

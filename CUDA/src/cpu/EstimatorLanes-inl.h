@@ -110,6 +110,32 @@ VAO_LANES_ENTRY void opennessRowLanes(const Row& row, const double* query, doubl
   plain(i);
 }
 
+#if VAO_VECTOR_MATH
+/// CDF Reconstruction on a raw row (NeighbourhoodRow::raw) of voxels of type T (int16 or
+/// uint16), kWidth at a time: the query, the extrema and the means formed in the lanes as
+/// the widening passes and meanVarianceRowExact form them (exact conversions, then the same
+/// division), so the bits are opennessRowLanes'; `plain(begin)` does the voxels from
+/// `begin` on (the row's tail).
+template <class T, class Row, class Plain>
+VAO_LANES_ENTRY void cdfReconstructionRawLanes(const Row& row, const double* query, double isoValue,
+  float* openness, Plain&& plain)
+{
+  const T* value = static_cast<const T*>(row.raw.value);
+  const T* minimum = static_cast<const T*>(row.raw.minimum);
+  const T* maximum = static_cast<const T*>(row.raw.maximum);
+  const D yz = set1(static_cast<double>(row.countYZ));
+  std::int64_t i = 0;
+  for (; i + kWidth <= row.size; i += kWidth)
+  {
+    const D q = query ? load(query + i) : value ? loadWidened(value + i) : set1(isoValue);
+    const D count = mul(smallIntegersToDouble(loadIntegers(row.countX + i)), yz);
+    const D mean = div(loadWidened(row.raw.sum + i), count);
+    storeFloats(openness + i, cdfReconstruction(q, mean, loadWidened(minimum + i), loadWidened(maximum + i)));
+  }
+  plain(i);
+}
+#endif
+
 /// The lanes whose integer sum lies within +-2^50, where its conversion and small multiples
 /// are exact.
 VAO_LANES Mask smallSums(I s)
@@ -231,7 +257,7 @@ VAO_LANES_ENTRY void opennessFromExactSumsLanes(const std::int64_t* sum, const s
 }
 
 /// This width's row loops for a dispatch written once over the widths (EstimatorRows.cxx):
-/// on a row's statistics, and on its exact sums.
+/// on a row's statistics, on its exact sums, and on a raw row.
 struct RowLoops
 {
   template <Method M, class Row, class Plain>
@@ -245,4 +271,12 @@ struct RowLoops
     opennessFromExactSumsLanes<M>(
       row.sum, row.sumSquares, row.countX, row.countYZ, row.size, query, isoValue, openness, plain);
   }
+#if VAO_VECTOR_MATH
+  template <class T, class Row, class Plain>
+  static void cdfReconstructionOnRaw(const Row& row, const double* query, double isoValue, float* openness,
+    Plain&& plain)
+  {
+    cdfReconstructionRawLanes<T>(row, query, isoValue, openness, plain);
+  }
+#endif
 };

@@ -23,15 +23,36 @@ bool takesExactSums(Method method, const NeighbourhoodRow& row)
   return row.sum && (method == Method::Chebyshev || method == Method::GaussianCdf);
 }
 
+/// Value i of a raw row's array p (NeighbourhoodRow::raw), as a double.
+double rawAt(const RawRow& raw, const void* p, std::int64_t i)
+{
+  return raw.type == ScalarType::Int16 ? static_cast<const std::int16_t*>(p)[i]
+                                       : static_cast<const std::uint16_t*>(p)[i];
+}
+
+/// The statistics of a raw row's box i, as the widening passes and meanVarianceRowExact
+/// give them (the mean alone of the moments, as CDF Reconstruction asks).
+NeighbourhoodStats rawStats(const NeighbourhoodRow& row, std::int64_t i)
+{
+  NeighbourhoodStats s{ 0.0, 0.0, rawAt(row.raw, row.raw.minimum, i), rawAt(row.raw, row.raw.maximum, i),
+    row.roundingVariance };
+  double variance = 0.0;
+  meanVarianceFromExactSums(row.raw.sum[i], 0, row.countX[i] * row.countYZ, s.mean, variance);
+  return s;
+}
+
 /// The plain loop over the voxels of [begin, end).
 void opennessRange(Method method, ErfMode erfMode, const NeighbourhoodRow& row, const double* query,
   double isoValue, float* openness, std::int64_t begin, std::int64_t end)
 {
   const bool sums = takesExactSums(method, row);
+  const bool raw = row.raw.sum != nullptr;
   for (std::int64_t i = begin; i < end; ++i)
   {
-    const double q = query ? query[i] : isoValue;
-    if (sums)
+    const double q = query ? query[i] : raw && row.raw.value ? rawAt(row.raw, row.raw.value, i) : isoValue;
+    if (raw)
+      openness[i] = static_cast<float>(opennessFromStats(method, q, rawStats(row, i), erfMode));
+    else if (sums)
     {
       const std::int64_t c = row.countX[i] * row.countYZ;
       openness[i] = static_cast<float>(opennessFromExactSums(method, q, static_cast<double>(c),
@@ -63,6 +84,16 @@ void opennessRowVector(
   const auto plain = [&](std::int64_t begin) {
     opennessRange(method, ErfMode::Exact, row, query, isoValue, openness, begin, row.size);
   };
+#if VAO_VECTOR_MATH
+  if (row.raw.sum) // CDF Reconstruction's alone (RowContents::raw)
+  {
+    if (row.raw.type == ScalarType::Int16)
+      Loops::template cdfReconstructionOnRaw<std::int16_t>(row, query, isoValue, openness, plain);
+    else
+      Loops::template cdfReconstructionOnRaw<std::uint16_t>(row, query, isoValue, openness, plain);
+    return;
+  }
+#endif
   if (method == Method::Chebyshev)
     Loops::template onStatistics<Method::Chebyshev>(row, query, isoValue, openness, plain);
   else if (method == Method::CdfReconstruction)
