@@ -46,9 +46,10 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   const bool fromSums = p.method == Method::Chebyshev || p.method == Method::GaussianCdf;
   // CDF Reconstruction takes the mean alone from the moments.
   const bool variance = output.variance || (output.openness && p.method != Method::CdfReconstruction);
-  // Raw rows (16-bit voxels) where CDF Reconstruction asks for the means and extrema alone.
-  const detail::RowContents contents{ withExtrema, output.variance != nullptr || !output.openness || !fromSums,
-    output.openness && voxelQuery && !query, variance, withExtrema && !variance };
+  // The openness alone reads raw rows where they come (16-bit voxels).
+  const bool moments = output.variance != nullptr || !output.openness || !fromSums;
+  const detail::RowContents contents{ withExtrema, moments, output.openness && voxelQuery && !query, variance,
+    output.openness && !output.variance };
   // Kept where the rows' extremes take vector instructions; the plain loop would cost
   // several times the separate, threaded pass the caller then makes (vao/ValueRanges.h).
   const bool keepRange = output.openness && output.opennessRange && detail::cpuHasAvx2();

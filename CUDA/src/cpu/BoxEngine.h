@@ -220,15 +220,15 @@ struct WidenSums
   }
 };
 
-/// A row of 16-bit voxels (Int16 or UInt16) with its box extrema and exact 32-bit box sums
-/// as the passes leave them (RowContents::raw): CDF Reconstruction's lanes widen these
-/// themselves (opennessRow), where widening them into rows of doubles first, and the means
-/// in a pass of their own, cost a sixth of its time.
+/// A row of 16-bit voxels (Int16 or UInt16) with its exact 32-bit box sums (and box extrema)
+/// as the passes leave them (RowContents::raw): the estimators' lanes widen these
+/// themselves (opennessRow), where widening them into rows of doubles first, and CDF
+/// Reconstruction's means in a pass of their own, cost a sixth of its time.
 struct RawRow
 {
   ScalarType type = ScalarType::Int16;
   const void* value = nullptr; // the voxels' own, contiguous; null unless RowContents::values
-  const void* minimum = nullptr;
+  const void* minimum = nullptr; // null unless RowContents::extrema
   const void* maximum = nullptr;
   const std::int32_t* sum = nullptr; // null: the row is not raw
 };
@@ -252,8 +252,8 @@ struct NeighbourhoodRow
   const std::int64_t* sumSquares = nullptr;
   const std::int64_t* countX = nullptr;
   std::int64_t countYZ = 0;
-  // Where raw.sum is set, the row holds raw, countX and countYZ alone: value, count, mean,
-  // minimum and maximum are null.
+  // Where raw.sum is set, the row holds raw, sumSquares, countX and countYZ alone: value,
+  // count, mean, variance, minimum, maximum and sum are null.
   RawRow raw;
 
   NeighbourhoodStats stats(std::int64_t i) const
@@ -274,8 +274,8 @@ struct RowContents
   bool moments = true;
   bool values = true;
   bool variance = true;
-  // Rows of 16-bit voxels with 32-bit sums may come raw (NeighbourhoodRow::raw): for CDF
-  // Reconstruction, which takes the means and the extrema alone.
+  // Rows of 16-bit voxels with 32-bit sums may come raw (NeighbourhoodRow::raw), for a
+  // consumer that reads raw rows (opennessRow) and asks for no other output.
   bool raw = false;
 };
 
@@ -336,9 +336,12 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
     out.maximum = withExtrema ? maximum.data() : nullptr;
     out.roundingVariance = slice.roundingVariance;
     constexpr bool sixteenBit = std::is_same<T, std::int16_t>::value || std::is_same<T, std::uint16_t>::value;
-    const bool raw = narrow && sixteenBit && contents.raw && withExtrema && volume.stride == 1;
+    const bool raw = narrow && sixteenBit && contents.raw && volume.stride == 1;
     if (raw)
-      out.value = out.count = out.mean = out.minimum = out.maximum = nullptr;
+    {
+      out.value = out.count = out.mean = out.variance = out.minimum = out.maximum = nullptr;
+      out.raw.type = std::is_signed<T>::value ? ScalarType::Int16 : ScalarType::UInt16;
+    }
     for (std::int64_t j = 0; j < ny; ++j)
     {
       const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
@@ -348,12 +351,12 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
       {
         if (raw)
         {
-          out.raw.type = std::is_signed<T>::value ? ScalarType::Int16 : ScalarType::UInt16;
           out.raw.value = contents.values ? row : nullptr;
-          out.raw.minimum = sliceExtrema.minima(j);
-          out.raw.maximum = sliceExtrema.maxima(j);
+          out.raw.minimum = withExtrema ? sliceExtrema.minima(j) : nullptr;
+          out.raw.maximum = withExtrema ? sliceExtrema.maxima(j) : nullptr;
           // The 32-bit sums hold the bits of exact int32 sums (MomentPlanes.h).
           out.raw.sum = reinterpret_cast<const std::int32_t*>(slice.sum + j * nx);
+          out.sumSquares = slice.sumSquares ? slice.sumSquares + j * nx : nullptr;
           out.countX = countX.data();
           out.countYZ = countYZ;
           visit(static_cast<const NeighbourhoodRow&>(out));

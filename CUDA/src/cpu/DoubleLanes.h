@@ -53,16 +53,17 @@ VAO_LANES D zero() { return _mm256_setzero_pd(); }
 VAO_LANES D load(const double* p) { return _mm256_loadu_pd(p); }
 VAO_LANES I loadIntegers(const std::int64_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
 VAO_LANES void store(double* p, D x) { _mm256_storeu_pd(p, x); }
-/// kWidth integers of a narrower type from p, as doubles (exact).
-VAO_LANES D loadWidened(const std::int16_t* p)
+/// kWidth values from p as doubles (integers of a narrower type converted exactly).
+VAO_LANES D loadAsDoubles(const double* p) { return load(p); }
+VAO_LANES D loadAsDoubles(const std::int16_t* p)
 {
   return _mm256_cvtepi32_pd(_mm_cvtepi16_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
 }
-VAO_LANES D loadWidened(const std::uint16_t* p)
+VAO_LANES D loadAsDoubles(const std::uint16_t* p)
 {
   return _mm256_cvtepi32_pd(_mm_cvtepu16_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
 }
-VAO_LANES D loadWidened(const std::int32_t* p)
+VAO_LANES D loadAsDoubles(const std::int32_t* p)
 {
   return _mm256_cvtepi32_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
 }
@@ -125,15 +126,16 @@ VAO_LANES D zero() { return _mm512_setzero_pd(); }
 VAO_LANES D load(const double* p) { return _mm512_loadu_pd(p); }
 VAO_LANES I loadIntegers(const std::int64_t* p) { return _mm512_loadu_si512(p); }
 VAO_LANES void store(double* p, D x) { _mm512_storeu_pd(p, x); }
-VAO_LANES D loadWidened(const std::int16_t* p)
+VAO_LANES D loadAsDoubles(const double* p) { return load(p); }
+VAO_LANES D loadAsDoubles(const std::int16_t* p)
 {
   return _mm512_cvtepi32_pd(_mm256_cvtepi16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))));
 }
-VAO_LANES D loadWidened(const std::uint16_t* p)
+VAO_LANES D loadAsDoubles(const std::uint16_t* p)
 {
   return _mm512_cvtepi32_pd(_mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))));
 }
-VAO_LANES D loadWidened(const std::int32_t* p)
+VAO_LANES D loadAsDoubles(const std::int32_t* p)
 {
   return _mm512_cvtepi32_pd(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
 }

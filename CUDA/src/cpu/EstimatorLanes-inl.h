@@ -83,10 +83,11 @@ VAO_LANES D cdfReconstruction(D q, D mean, D minimum, D maximum)
 #endif
 
 /// The openness of a row of neighbourhoods (EstimatorRows.h's NeighbourhoodRow) by method
-/// M (opennessRowIsVector says which), kWidth voxels at a time; `plain(begin)` does the
-/// voxels from `begin` on (the row's tail).
-template <Method M, class Row, class Plain>
-VAO_LANES_ENTRY void opennessRowLanes(const Row& row, const double* query, double isoValue, float* openness,
+/// M (opennessRowIsVector says which), kWidth voxels at a time, with q = query[i] (doubles,
+/// or a raw row's own 16-bit values) or isoValue where query is null; `plain(begin)` does
+/// the voxels from `begin` on (the row's tail). The row loops below take q alike.
+template <Method M, class Row, class Q, class Plain>
+VAO_LANES_ENTRY void opennessRowLanes(const Row& row, const Q* query, double isoValue, float* openness,
   Plain&& plain)
 {
   const D roundingVariance = set1(row.roundingVariance);
@@ -94,7 +95,7 @@ VAO_LANES_ENTRY void opennessRowLanes(const Row& row, const double* query, doubl
   std::int64_t i = 0;
   for (; i + kWidth <= row.size; i += kWidth)
   {
-    const D q = query ? load(query + i) : set1(isoValue);
+    const D q = query ? loadAsDoubles(query + i) : set1(isoValue);
     const D mean = load(row.mean + i);
     D open = zero();
     if constexpr (M == Method::Chebyshev)
@@ -112,25 +113,23 @@ VAO_LANES_ENTRY void opennessRowLanes(const Row& row, const double* query, doubl
 
 #if VAO_VECTOR_MATH
 /// CDF Reconstruction on a raw row (NeighbourhoodRow::raw) of voxels of type T (int16 or
-/// uint16), kWidth at a time: the query, the extrema and the means formed in the lanes as
-/// the widening passes and meanVarianceRowExact form them (exact conversions, then the same
-/// division), so the bits are opennessRowLanes'; `plain(begin)` does the voxels from
-/// `begin` on (the row's tail).
-template <class T, class Row, class Plain>
-VAO_LANES_ENTRY void cdfReconstructionRawLanes(const Row& row, const double* query, double isoValue,
-  float* openness, Plain&& plain)
+/// uint16), kWidth at a time: the extrema and the means formed in the lanes as the widening
+/// passes and meanVarianceRowExact form them (exact conversions, then the same division),
+/// so the bits are opennessRowLanes'.
+template <class T, class Row, class Q, class Plain>
+VAO_LANES_ENTRY void cdfReconstructionRawLanes(const Row& row, const Q* query, double isoValue, float* openness,
+  Plain&& plain)
 {
-  const T* value = static_cast<const T*>(row.raw.value);
   const T* minimum = static_cast<const T*>(row.raw.minimum);
   const T* maximum = static_cast<const T*>(row.raw.maximum);
   const D yz = set1(static_cast<double>(row.countYZ));
   std::int64_t i = 0;
   for (; i + kWidth <= row.size; i += kWidth)
   {
-    const D q = query ? load(query + i) : value ? loadWidened(value + i) : set1(isoValue);
+    const D q = query ? loadAsDoubles(query + i) : set1(isoValue);
     const D count = mul(smallIntegersToDouble(loadIntegers(row.countX + i)), yz);
-    const D mean = div(loadWidened(row.raw.sum + i), count);
-    storeFloats(openness + i, cdfReconstruction(q, mean, loadWidened(minimum + i), loadWidened(maximum + i)));
+    const D mean = div(loadAsDoubles(row.raw.sum + i), count);
+    storeFloats(openness + i, cdfReconstruction(q, mean, loadAsDoubles(minimum + i), loadAsDoubles(maximum + i)));
   }
   plain(i);
 }
@@ -143,19 +142,34 @@ VAO_LANES Mask smallSums(I s)
   return both(lessThan(s, set1(std::int64_t(1) << 50)), lessThan(set1(-(std::int64_t(1) << 50)), s));
 }
 
-/// The kWidth boxes from box i in doubles: their counts c (countX times yz), sums S, S^2
-/// and numerators c sumSquares - S^2 (exactSumsNumerator before its clamp at 0), when all
-/// are exact (sums of magnitude below 2^50, both products below 2^52); false otherwise.
-VAO_LANES bool exactBoxes(const std::int64_t* sum, const std::int64_t* sumSquares, const std::int64_t* countX, D yz,
+/// kWidth exact sums from p as doubles (total), and the lanes where that conversion and
+/// small multiples are exact: sums of magnitude below 2^50, and every 32-bit sum.
+VAO_LANES Mask loadSums(const std::int64_t* p, D& total)
+{
+  const I s = loadIntegers(p);
+  total = smallIntegersToDouble(s);
+  return smallSums(s);
+}
+VAO_LANES Mask loadSums(const std::int32_t* p, D& total)
+{
+  total = loadAsDoubles(p);
+  return everyLane();
+}
+
+/// The kWidth boxes from box i in doubles: their counts c (countX times yz), sums S (64- or
+/// 32-bit, S), S^2 and numerators c sumSquares - S^2 (exactSumsNumerator before its clamp
+/// at 0), when all are exact (sums of magnitude below 2^50, both products below 2^52);
+/// false otherwise.
+template <class S>
+VAO_LANES bool exactBoxes(const S* sum, const std::int64_t* sumSquares, const std::int64_t* countX, D yz,
   std::int64_t i, D& c, D& total, D& totalSquared, D& numerator)
 {
   const D exact = set1(4503599627370496.0); // 2^52
-  const I s = loadIntegers(sum + i);
+  const Mask small = loadSums(sum + i, total);
   const I s2 = loadIntegers(sumSquares + i);
-  if (!all(both(smallSums(s), lessThan(s2, set1(std::int64_t(1) << 50)))))
+  if (!all(both(small, lessThan(s2, set1(std::int64_t(1) << 50)))))
     return false;
   c = mul(smallIntegersToDouble(loadIntegers(countX + i)), yz);
-  total = smallIntegersToDouble(s);
   const D a = mul(c, smallIntegersToDouble(s2));
   totalSquared = mul(total, total);
   numerator = sub(a, totalSquared);
@@ -205,13 +219,13 @@ VAO_LANES_ENTRY void meanVarianceRowLanes(const std::int64_t* sum, const std::in
 }
 
 /// opennessFromExactSums (Chebyshev or the Gaussian CDF, by M) of n boxes from their exact
-/// sums, kWidth at a time, with q_i = query[i] (isoValue where query is null): c, S and N
-/// in doubles, exact while c sumSquares and S^2 stay below 2^52 (as meanVarianceRowLanes);
-/// `plain(end, begin)` does the boxes of [begin, end) that could leave that range, and the
-/// row's tail.
-template <Method M, class Plain>
-VAO_LANES_ENTRY void opennessFromExactSumsLanes(const std::int64_t* sum, const std::int64_t* sumSquares,
-  const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, const double* query, double isoValue,
+/// sums (64- or 32-bit, S), kWidth at a time, with q_i = query[i] (isoValue where query is
+/// null): c, S and N in doubles, exact while c sumSquares and S^2 stay below 2^52 (as
+/// meanVarianceRowLanes); `plain(end, begin)` does the boxes of [begin, end) that could
+/// leave that range, and the row's tail.
+template <Method M, class S, class Q, class Plain>
+VAO_LANES_ENTRY void opennessFromExactSumsLanes(const S* sum, const std::int64_t* sumSquares,
+  const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, const Q* query, double isoValue,
   float* openness, Plain&& plain)
 {
   const D yz = set1(static_cast<double>(countYZ));
@@ -222,7 +236,7 @@ VAO_LANES_ENTRY void opennessFromExactSumsLanes(const std::int64_t* sum, const s
     if (exactBoxes(sum, sumSquares, countX, yz, i, c, total, totalSquared, numerator))
     {
       const D positive = onlyWhere(greaterThan(numerator, zero()), numerator);
-      const D q = query ? load(query + i) : set1(isoValue);
+      const D q = query ? loadAsDoubles(query + i) : set1(isoValue);
       const D d = sub(mul(q, c), total);
       const Mask flat = lessEqual(positive, mul(set1(kFlatEpsilon), max(mul(c, c), totalSquared)));
       const D flatOpen =
@@ -260,20 +274,24 @@ VAO_LANES_ENTRY void opennessFromExactSumsLanes(const std::int64_t* sum, const s
 /// on a row's statistics, on its exact sums, and on a raw row.
 struct RowLoops
 {
-  template <Method M, class Row, class Plain>
-  static void onStatistics(const Row& row, const double* query, double isoValue, float* openness, Plain&& plain)
+  template <Method M, class Row, class Q, class Plain>
+  static void onStatistics(const Row& row, const Q* query, double isoValue, float* openness, Plain&& plain)
   {
     opennessRowLanes<M>(row, query, isoValue, openness, plain);
   }
-  template <Method M, class Row, class Plain>
-  static void onExactSums(const Row& row, const double* query, double isoValue, float* openness, Plain&& plain)
+  template <Method M, class Row, class Q, class Plain>
+  static void onExactSums(const Row& row, const Q* query, double isoValue, float* openness, Plain&& plain)
   {
-    opennessFromExactSumsLanes<M>(
-      row.sum, row.sumSquares, row.countX, row.countYZ, row.size, query, isoValue, openness, plain);
+    if (row.raw.sum)
+      opennessFromExactSumsLanes<M>(
+        row.raw.sum, row.sumSquares, row.countX, row.countYZ, row.size, query, isoValue, openness, plain);
+    else
+      opennessFromExactSumsLanes<M>(
+        row.sum, row.sumSquares, row.countX, row.countYZ, row.size, query, isoValue, openness, plain);
   }
 #if VAO_VECTOR_MATH
-  template <class T, class Row, class Plain>
-  static void cdfReconstructionOnRaw(const Row& row, const double* query, double isoValue, float* openness,
+  template <class T, class Row, class Q, class Plain>
+  static void cdfReconstructionOnRaw(const Row& row, const Q* query, double isoValue, float* openness,
     Plain&& plain)
   {
     cdfReconstructionRawLanes<T>(row, query, isoValue, openness, plain);

@@ -20,7 +20,13 @@ namespace
 /// Chebyshev and the Gaussian CDF take exact sums directly (opennessFromExactSums).
 bool takesExactSums(Method method, const NeighbourhoodRow& row)
 {
-  return row.sum && (method == Method::Chebyshev || method == Method::GaussianCdf);
+  return (row.sum || row.raw.sum) && (method == Method::Chebyshev || method == Method::GaussianCdf);
+}
+
+/// Box i's exact sum: a row's 64-bit one, or a raw row's 32-bit one.
+std::int64_t exactSum(const NeighbourhoodRow& row, std::int64_t i)
+{
+  return row.raw.sum ? row.raw.sum[i] : row.sum[i];
 }
 
 /// Value i of a raw row's array p (NeighbourhoodRow::raw), as a double.
@@ -46,29 +52,29 @@ void opennessRange(Method method, ErfMode erfMode, const NeighbourhoodRow& row, 
   double isoValue, float* openness, std::int64_t begin, std::int64_t end)
 {
   const bool sums = takesExactSums(method, row);
-  const bool raw = row.raw.sum != nullptr;
   for (std::int64_t i = begin; i < end; ++i)
   {
-    const double q = query ? query[i] : raw && row.raw.value ? rawAt(row.raw, row.raw.value, i) : isoValue;
-    if (raw)
-      openness[i] = static_cast<float>(opennessFromStats(method, q, rawStats(row, i), erfMode));
-    else if (sums)
+    const double q = query ? query[i] : row.raw.value ? rawAt(row.raw, row.raw.value, i) : isoValue;
+    if (sums)
     {
       const std::int64_t c = row.countX[i] * row.countYZ;
+      const std::int64_t sum = exactSum(row, i);
       openness[i] = static_cast<float>(opennessFromExactSums(method, q, static_cast<double>(c),
-        static_cast<double>(row.sum[i]), exactSumsNumerator(row.sum[i], row.sumSquares[i], c), erfMode));
+        static_cast<double>(sum), exactSumsNumerator(sum, row.sumSquares[i], c), erfMode));
     }
     else
-      openness[i] = static_cast<float>(opennessFromStats(method, q, row.stats(i), erfMode));
+      openness[i] =
+        static_cast<float>(opennessFromStats(method, q, row.raw.sum ? rawStats(row, i) : row.stats(i), erfMode));
   }
 }
 
 #if VAO_HAVE_AVX2_TARGET
 /// The row loops of a width (avx2::RowLoops or avx512::RowLoops) by method: on exact sums
-/// where the row has them for it, else on its statistics.
-template <class Loops>
-void opennessRowVector(
-  Method method, const NeighbourhoodRow& row, const double* query, double isoValue, float* openness)
+/// where the row has them for it, else on its statistics, with the queries of lanesQuery
+/// (query, or a raw row's own values where query is null) or isoValue.
+template <class Loops, class Q>
+void opennessRowVectorFrom(Method method, const NeighbourhoodRow& row, const double* query, const Q* lanesQuery,
+  double isoValue, float* openness)
 {
   if (takesExactSums(method, row))
   {
@@ -76,30 +82,45 @@ void opennessRowVector(
       opennessRange(method, ErfMode::Exact, row, query, isoValue, openness, begin, end);
     };
     if (method == Method::Chebyshev)
-      Loops::template onExactSums<Method::Chebyshev>(row, query, isoValue, openness, plain);
+      Loops::template onExactSums<Method::Chebyshev>(row, lanesQuery, isoValue, openness, plain);
     else
-      Loops::template onExactSums<Method::GaussianCdf>(row, query, isoValue, openness, plain);
+      Loops::template onExactSums<Method::GaussianCdf>(row, lanesQuery, isoValue, openness, plain);
     return;
   }
   const auto plain = [&](std::int64_t begin) {
     opennessRange(method, ErfMode::Exact, row, query, isoValue, openness, begin, row.size);
   };
 #if VAO_VECTOR_MATH
-  if (row.raw.sum) // CDF Reconstruction's alone (RowContents::raw)
+  if (row.raw.sum) // CDF Reconstruction's (RowContents::raw)
   {
     if (row.raw.type == ScalarType::Int16)
-      Loops::template cdfReconstructionOnRaw<std::int16_t>(row, query, isoValue, openness, plain);
+      Loops::template cdfReconstructionOnRaw<std::int16_t>(row, lanesQuery, isoValue, openness, plain);
     else
-      Loops::template cdfReconstructionOnRaw<std::uint16_t>(row, query, isoValue, openness, plain);
+      Loops::template cdfReconstructionOnRaw<std::uint16_t>(row, lanesQuery, isoValue, openness, plain);
     return;
   }
 #endif
   if (method == Method::Chebyshev)
-    Loops::template onStatistics<Method::Chebyshev>(row, query, isoValue, openness, plain);
+    Loops::template onStatistics<Method::Chebyshev>(row, lanesQuery, isoValue, openness, plain);
   else if (method == Method::CdfReconstruction)
-    Loops::template onStatistics<Method::CdfReconstruction>(row, query, isoValue, openness, plain);
+    Loops::template onStatistics<Method::CdfReconstruction>(row, lanesQuery, isoValue, openness, plain);
   else
-    Loops::template onStatistics<Method::GaussianCdf>(row, query, isoValue, openness, plain);
+    Loops::template onStatistics<Method::GaussianCdf>(row, lanesQuery, isoValue, openness, plain);
+}
+
+/// opennessRowVectorFrom with a raw row's own values as the queries where query is null.
+template <class Loops>
+void opennessRowVector(
+  Method method, const NeighbourhoodRow& row, const double* query, double isoValue, float* openness)
+{
+  if (query || !row.raw.value)
+    opennessRowVectorFrom<Loops>(method, row, query, query, isoValue, openness);
+  else if (row.raw.type == ScalarType::Int16)
+    opennessRowVectorFrom<Loops>(
+      method, row, query, static_cast<const std::int16_t*>(row.raw.value), isoValue, openness);
+  else
+    opennessRowVectorFrom<Loops>(
+      method, row, query, static_cast<const std::uint16_t*>(row.raw.value), isoValue, openness);
 }
 #endif
 
