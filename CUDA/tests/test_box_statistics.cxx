@@ -289,3 +289,31 @@ TEST(BoxStatistics, SumsExactOnBothSidesOfTheirThirtyTwoBitLimit)
     value = rng() % 8 ? 65535 : 0;
   expectStatsMatchBruteForce(row, dims, { 3, 0, 0 }, vao::Region::whole(viewOf(row, dims)), 2);
 }
+
+// The x sums of squares of 8-bit and int16 rows run in 32 bits where no window's sum can
+// leave int32's range (the row's greatest |a^2 - b^2| times the window's width below
+// 2^31), and in 64 bits otherwise: 5 x 20724^2 is just below 2^31, 5 x 20725^2 just above
+// (below 2^32, so that only the right limit keeps it exact). Values of two neighbours, so
+// that a wrapped sum shows in the variance (a flat box's would be clamped to 0).
+TEST(BoxStatistics, SquaresExactOnBothSidesOfTheirThirtyTwoBitLimit)
+{
+  const vao::Index3 dims = { 40, 6, 3 };
+  for (const int value : { 20724, 20725, -20724, -20725 })
+  {
+    SCOPED_TRACE(value);
+    std::mt19937 rng(value + 50000);
+    std::vector<std::int16_t> v(dims[0] * dims[1] * dims[2]);
+    for (auto& x : v)
+      x = static_cast<std::int16_t>(rng() % 2 ? value : value - (value > 0 ? 1 : -1));
+    expectStatsMatchBruteForce(v, dims, { 2, 1, 1 }, vao::Region::whole(viewOf(v, dims)), 2);
+  }
+  // Rows of small values (32-bit squares) among rows of int16's ends (64-bit ones).
+  const vao::Index3 mixedDims = { 37, 9, 5 };
+  auto v = randomVolume<std::int16_t>(mixedDims, -100, 100, 41);
+  std::mt19937 rng(42);
+  for (std::int64_t y = 0; y < mixedDims[1]; y += 3)
+    for (std::int64_t x = 0; x < mixedDims[0]; ++x)
+      v[(2 * mixedDims[1] + y) * mixedDims[0] + x] = rng() % 2 ? 32767 : -32768;
+  for (const vao::Radius r : { vao::Radius{ 2, 1, 1 }, vao::Radius{ 6, 2, 2 } })
+    expectStatsMatchBruteForce(v, mixedDims, r, vao::Region::whole(viewOf(v, mixedDims)), 2);
+}

@@ -105,19 +105,58 @@ struct RowDifferences
   }
 };
 
+/// A window's sum of squares from the difference of two prefix sums: as it is in Acc, or
+/// the bits of an int32 sum modulo 2^32 (WindowDifferences).
+template <class Acc, class Sq>
+VAO_ALWAYS_INLINE Acc squaresWindow(Sq difference)
+{
+  if constexpr (std::is_same<Sq, std::uint32_t>::value && !std::is_same<Acc, std::uint32_t>::value)
+    return static_cast<Acc>(static_cast<std::int32_t>(difference));
+  else
+    return difference;
+}
+
+/// RowDifferences of 8-bit and int16 values, whose squares' differences fit in int32, with
+/// those in 32 bits too (d2, the bits of int32 ones) and `largest` the greatest |d2|:
+/// boxRowDifference then sums them modulo 2^32 where no window's sum can leave int32's
+/// range. Compiled for AVX2 too (the maximum is exact in any order).
+template <class T>
+struct NarrowRowDifferences
+{
+  static VAO_ALWAYS_INLINE void run(const T* __restrict in, const T* __restrict out, std::int64_t stride,
+    std::int64_t n, std::int32_t shift, std::uint32_t* __restrict d1, std::uint32_t* __restrict d2,
+    std::int32_t* largest)
+  {
+    std::int32_t most = 0;
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      const std::int32_t a = in ? static_cast<std::int32_t>(in[i * stride]) - shift : 0;
+      const std::int32_t b = out ? static_cast<std::int32_t>(out[i * stride]) - shift : 0;
+      const std::int32_t d = a * a - b * b; // |d| <= 2^30
+      d1[i] = static_cast<std::uint32_t>(a - b);
+      d2[i] = static_cast<std::uint32_t>(d);
+      const std::int32_t magnitude = d < 0 ? -d : d;
+      most = magnitude > most ? magnitude : most;
+    }
+    *largest = most;
+  }
+};
+
 /// box[i] = p[i + offset + width] - p[i + offset] for i in [begin, end), for both prefix
-/// rows (the first, in Lin, alone without Squares). Compiled for AVX2 too.
-template <class Acc, bool Squares = true, class Lin = Acc>
+/// rows (the first, in Lin, alone without Squares). The second's prefix sums are in Sq:
+/// Acc, or std::uint32_t modulo 2^32 where every window's sum fits in int32, whose
+/// differences are then those sums' bits. Compiled for AVX2 too.
+template <class Acc, bool Squares = true, class Lin = Acc, class Sq = Acc>
 struct WindowDifferences
 {
-  static VAO_ALWAYS_INLINE void run(const Lin* __restrict p1, const Acc* __restrict p2, std::int64_t offset,
+  static VAO_ALWAYS_INLINE void run(const Lin* __restrict p1, const Sq* __restrict p2, std::int64_t offset,
     std::int64_t width, Lin* __restrict box1, Acc* __restrict box2, std::int64_t begin, std::int64_t end)
   {
     for (std::int64_t i = begin; i < end; ++i)
     {
       box1[i] = p1[i + offset + width] - p1[i + offset];
       if constexpr (Squares)
-        box2[i] = p2[i + offset + width] - p2[i + offset];
+        box2[i] = squaresWindow<Acc>(p2[i + offset + width] - p2[i + offset]);
     }
   }
 };
@@ -147,6 +186,11 @@ class MomentPlanes
 {
 public:
   using Acc = typename MomentTraits<T>::Accumulator;
+  // 8-bit and int16 values with 32-bit sums of v: each row's differences of squares
+  // a^2 - b^2 fit in int32 (NarrowRowDifferences), and their x sums run modulo 2^32 too
+  // in the rows where no window can leave int32's range (boxRowDifference).
+  static constexpr bool kNarrowSquares = std::is_same<Lin, std::uint32_t>::value &&
+    std::is_integral<T>::value && (sizeof(T) == 1 || (sizeof(T) == 2 && std::is_signed<T>::value));
 
   MomentPlanes(const TypedVolume<T>& volume, const BoxGeometry& geometry, Acc shift, bool squares)
     : Volume(volume)
@@ -157,6 +201,7 @@ public:
     , SumSquares(squares ? geometry.planeSize() : 0)
     , Row1(geometry.xs.size() + 1)
     , Row2(squares ? geometry.xs.size() + 1 : 0)
+    , Row2Narrow(squares && kNarrowSquares ? geometry.xs.size() + 1 : 0)
     , RingRows(std::min<std::int64_t>(2 * std::int64_t(geometry.radius.y) + 2, geometry.ys.size()))
     , XBox1(RingRows * geometry.region.size[0])
     , XBox2(squares ? RingRows * geometry.region.size[0] : 0)
@@ -247,24 +292,47 @@ private:
   {
     const std::int64_t span = this->Geo.xs.size();
     const std::int64_t stride = this->Volume.stride;
+    const std::int64_t r = this->Geo.radius.x;
     Lin* p1 = this->Row1.data();
     Acc* p2 = this->Row2.data();
+    std::uint32_t* q2 = this->Row2Narrow.data();
     const T* in = entering >= 0 ? this->Volume.row(y, entering) + this->Geo.xs.lo * stride : nullptr;
     const T* out = leaving >= 0 ? this->Volume.row(y, leaving) + this->Geo.xs.lo * stride : nullptr;
     // The differences of the two rows (a vector loop), then their prefix sums:
     // p[i] = sum of the first i values.
-    if (this->Squares)
-    {
-      runRows<RowDifferences<T, Acc, true, Lin>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
-      p2[0] = 0;
-    }
-    else
-      runRows<RowDifferences<T, Acc, false, Lin>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2);
     p1[0] = 0;
+    bool narrowSquares = false; // the squares' prefix sums are q2's, modulo 2^32
+    if constexpr (kNarrowSquares)
+    {
+      if (this->Squares)
+      {
+        std::int32_t largest = 0;
+        runRows<NarrowRowDifferences<T>>(
+          this->Simd, in, out, stride, span, static_cast<std::int32_t>(this->Shift), p1 + 1, q2 + 1, &largest);
+        q2[0] = 0;
+        // No window (at most 2r + 1 values of the row) sums past int32's range.
+        narrowSquares = double(std::min<std::int64_t>(2 * r + 1, span)) * largest < 2147483648.0;
+        if (narrowSquares)
+          runningTotals(q2, span + 1, this->Simd);
+        else // the 64-bit sums below, from the same differences
+          for (std::int64_t i = 0; i <= span; ++i)
+            p2[i] = static_cast<std::int32_t>(q2[i]);
+      }
+    }
+    if (!(kNarrowSquares && this->Squares))
+    {
+      if (this->Squares)
+      {
+        runRows<RowDifferences<T, Acc, true, Lin>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
+        p2[0] = 0;
+      }
+      else
+        runRows<RowDifferences<T, Acc, false, Lin>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2);
+    }
     if constexpr (std::is_same<Lin, std::uint32_t>::value)
     {
       runningTotals(p1, span + 1, this->Simd); // modulo 2^32, as every box sum below
-      if (this->Squares)
+      if (this->Squares && !narrowSquares)
         runningTotals(p2, nullptr, span + 1, this->Simd);
     }
     else if constexpr (std::is_same<Acc, std::int64_t>::value)
@@ -276,11 +344,23 @@ private:
         if (this->Squares)
           p2[i + 1] += p2[i];
       }
+    if (narrowSquares)
+      this->windowSums(p1, q2, y);
+    else
+      this->windowSums(p1, this->Squares ? p2 : nullptr, y);
+  }
+
+  /// The x-box sums of row y from its prefix sums (those of the squares in Acc or, modulo
+  /// 2^32, in std::uint32_t; null without the squares) into the ring.
+  template <class Sq>
+  void windowSums(const Lin* p1, const Sq* p2, std::int64_t y)
+  {
+    const std::int64_t span = this->Geo.xs.size();
     const std::int64_t nx = this->Geo.region.size[0];
     const std::int64_t r = this->Geo.radius.x;
     const std::int64_t x0 = this->Geo.region.begin[0] - this->Geo.xs.lo; // first output in span
     Lin* box1 = this->xbox1(y);
-    Acc* box2 = this->Squares ? this->xbox2(y) : nullptr;
+    Acc* box2 = p2 ? this->xbox2(y) : nullptr;
     // Outputs whose window lies inside the span (a vector loop) and the clamped ends.
     const std::int64_t first = std::min(nx, std::max<std::int64_t>(0, r - x0));
     const std::int64_t end = std::max(first, std::min(nx, span - r - x0));
@@ -289,14 +369,14 @@ private:
       const std::int64_t hi = std::min<std::int64_t>(span, x0 + i + r + 1);
       box1[i] = p1[hi] - p1[lo];
       if (box2)
-        box2[i] = p2[hi] - p2[lo];
+        box2[i] = squaresWindow<Acc>(p2[hi] - p2[lo]);
     };
     for (std::int64_t i = 0; i < first; ++i)
       clamped(i);
     if (box2)
-      runRows<WindowDifferences<Acc, true, Lin>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+      runRows<WindowDifferences<Acc, true, Lin, Sq>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
     else
-      runRows<WindowDifferences<Acc, false, Lin>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+      runRows<WindowDifferences<Acc, false, Lin, Sq>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
     for (std::int64_t i = end; i < nx; ++i)
       clamped(i);
   }
@@ -309,6 +389,7 @@ private:
   std::vector<Acc> SumSquares;
   std::vector<Lin> Row1;
   std::vector<Acc> Row2;
+  std::vector<std::uint32_t> Row2Narrow; // kNarrowSquares: the squares' differences, 32-bit
   std::int64_t RingRows; // x-box rows kept: a window's and the next entering one
   std::vector<Lin> XBox1;
   std::vector<Acc> XBox2;
