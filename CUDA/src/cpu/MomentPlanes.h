@@ -81,27 +81,43 @@ struct SlideColumns
 };
 
 /// d1 = a - b (in Lin, modulo 2^32 for std::uint32_t) and, with Squares, d2 = a^2 - b^2,
-/// with a, b the values of rows `in` and `out` less the shift (0 for a missing row).
-/// Compiled for AVX2 too.
-template <class T, class Acc, bool Squares = true, class Lin = Acc>
+/// with a, b the values of rows `in` and `out` less the shift (0 for a missing row). d2 is
+/// in Sq: Acc, or for 8-bit and int16 values, whose squares' differences fit in int32,
+/// std::uint32_t holding those int32 bits, with *largest the greatest |d2| (exact in any
+/// order): boxRowDifference then sums them modulo 2^32 where no window's sum can leave
+/// int32's range. Compiled for AVX2 too.
+template <class T, class Acc, bool Squares = true, class Lin = Acc, class Sq = Acc>
 struct RowDifferences
 {
   static VAO_ALWAYS_INLINE void run(const T* __restrict in, const T* __restrict out, std::int64_t stride,
-    std::int64_t n, Acc shift, Lin* __restrict d1, Acc* __restrict d2)
+    std::int64_t n, Acc shift, Lin* __restrict d1, Sq* __restrict d2, std::int32_t* largest = nullptr)
   {
     // Squares of 8-bit and int16 values and their differences fit in 32 bits, whose
     // products vectorise (64-bit ones do not on AVX2).
     using Product = typename std::conditional<std::is_integral<T>::value && (sizeof(T) == 1 ||
       (sizeof(T) == 2 && std::is_signed<T>::value)), std::int32_t, Acc>::type;
+    constexpr bool narrowSquares = Squares && !std::is_same<Sq, Acc>::value;
+    static_assert(!narrowSquares || std::is_same<Product, std::int32_t>::value, "32-bit squares of 8- and 16-bit values");
     const auto s = static_cast<Product>(shift);
+    std::int32_t most = 0;
     for (std::int64_t i = 0; i < n; ++i)
     {
       const Product a = in ? static_cast<Product>(in[i * stride]) - s : Product(0);
       const Product b = out ? static_cast<Product>(out[i * stride]) - s : Product(0);
       d1[i] = static_cast<Lin>(a - b);
       if constexpr (Squares)
-        d2[i] = static_cast<Acc>(a * a - b * b);
+      {
+        const Product d = a * a - b * b; // |d| <= 2^30 where narrowSquares
+        d2[i] = static_cast<Sq>(d);
+        if constexpr (narrowSquares)
+        {
+          const std::int32_t magnitude = d < 0 ? -d : d;
+          most = magnitude > most ? magnitude : most;
+        }
+      }
     }
+    if constexpr (narrowSquares)
+      *largest = most;
   }
 };
 
@@ -115,32 +131,6 @@ VAO_ALWAYS_INLINE Acc squaresWindow(Sq difference)
   else
     return difference;
 }
-
-/// RowDifferences of 8-bit and int16 values, whose squares' differences fit in int32, with
-/// those in 32 bits too (d2, the bits of int32 ones) and `largest` the greatest |d2|:
-/// boxRowDifference then sums them modulo 2^32 where no window's sum can leave int32's
-/// range. Compiled for AVX2 too (the maximum is exact in any order).
-template <class T>
-struct NarrowRowDifferences
-{
-  static VAO_ALWAYS_INLINE void run(const T* __restrict in, const T* __restrict out, std::int64_t stride,
-    std::int64_t n, std::int32_t shift, std::uint32_t* __restrict d1, std::uint32_t* __restrict d2,
-    std::int32_t* largest)
-  {
-    std::int32_t most = 0;
-    for (std::int64_t i = 0; i < n; ++i)
-    {
-      const std::int32_t a = in ? static_cast<std::int32_t>(in[i * stride]) - shift : 0;
-      const std::int32_t b = out ? static_cast<std::int32_t>(out[i * stride]) - shift : 0;
-      const std::int32_t d = a * a - b * b; // |d| <= 2^30
-      d1[i] = static_cast<std::uint32_t>(a - b);
-      d2[i] = static_cast<std::uint32_t>(d);
-      const std::int32_t magnitude = d < 0 ? -d : d;
-      most = magnitude > most ? magnitude : most;
-    }
-    *largest = most;
-  }
-};
 
 /// box[i] = p[i + offset + width] - p[i + offset] for i in [begin, end), for both prefix
 /// rows (the first, in Lin, alone without Squares). The second's prefix sums are in Sq:
@@ -187,7 +177,7 @@ class MomentPlanes
 public:
   using Acc = typename MomentTraits<T>::Accumulator;
   // 8-bit and int16 values with 32-bit sums of v: each row's differences of squares
-  // a^2 - b^2 fit in int32 (NarrowRowDifferences), and their x sums run modulo 2^32 too
+  // a^2 - b^2 fit in int32 (RowDifferences), and their x sums run modulo 2^32 too
   // in the rows where no window can leave int32's range (boxRowDifference).
   static constexpr bool kNarrowSquares = std::is_same<Lin, std::uint32_t>::value &&
     std::is_integral<T>::value && (sizeof(T) == 1 || (sizeof(T) == 2 && std::is_signed<T>::value));
@@ -307,8 +297,8 @@ private:
       if (this->Squares)
       {
         std::int32_t largest = 0;
-        runRows<NarrowRowDifferences<T>>(
-          this->Simd, in, out, stride, span, static_cast<std::int32_t>(this->Shift), p1 + 1, q2 + 1, &largest);
+        runRows<RowDifferences<T, Acc, true, Lin, std::uint32_t>>(
+          this->Simd, in, out, stride, span, this->Shift, p1 + 1, q2 + 1, &largest);
         q2[0] = 0;
         // No window (at most 2r + 1 values of the row) sums past int32's range.
         narrowSquares = double(std::min<std::int64_t>(2 * r + 1, span)) * largest < 2147483648.0;
