@@ -105,7 +105,8 @@ inline float godunov(float ax, float ay, float az, const SweepConstants& k)
 /// One row of a sweep. Pointers are at the row's first voxel in sweep order; the row
 /// advances by Step (+1 or -1). dy/dz and vy/vz are the upwind row and plane (a row of
 /// open sky, D = +inf and V = 1, outside the volume); startD/startV, the x-upwind
-/// neighbour of the first voxel (the open sky, or a ghost voxel of a block).
+/// neighbour of the first voxel (the open sky, or a ghost voxel of a block). scratch:
+/// 3 x the row's length, the row's upwind terms (UpwindTerms).
 struct RowView
 {
   float* d;
@@ -118,6 +119,7 @@ struct RowView
   const float* vz;
   float startD;
   float startV;
+  float* scratch;
 };
 
 struct RowResult
@@ -126,31 +128,71 @@ struct RowResult
   bool reachedNew = false;    // some |D| went from infinity to finite
 };
 
+/// What each voxel of a row takes from its upwind row and plane, and the transmittance
+/// of its D as the sweep finds it: nothing there depends on the row's own x chain, so it
+/// is computed for the whole row first, in vector registers, and the serial loop keeps
+/// only the chain (Eq. 6's multiply-add, the Godunov update). Indexed like the row's
+/// voxels: element x at the returned pointers' [x].
+struct UpwindTerms
+{
+  float* nearest; // min(|dy|, |dz|)
+  float* inflow;  // Eq. 6's terms of the upwind row and plane: vy tau/3(dy) + vz tau/3(dz)
+  float* tau;     // tau/3(d), d before this row's update
+
+  template <int Step, bool Visibility>
+  static UpwindTerms of(const RowView& row, std::int64_t count, const SweepConstants& k)
+  {
+    // In memory order, from the row's lowest address.
+    const std::int64_t low = Step > 0 ? 0 : -(count - 1);
+    float* __restrict nearest = row.scratch;
+    float* __restrict inflow = row.scratch + count;
+    float* __restrict tau = row.scratch + 2 * count;
+    const float* __restrict d = row.d + low;
+    const float* __restrict dy = row.dy + low;
+    const float* __restrict dz = row.dz + low;
+    for (std::int64_t i = 0; i < count; ++i)
+      nearest[i] = std::min(std::abs(dy[i]), std::abs(dz[i]));
+    if (Visibility)
+    {
+      const SweepConstants c = k; // a copy the stores cannot alias
+      const float* __restrict vy = row.vy + low;
+      const float* __restrict vz = row.vz + low;
+      for (std::int64_t i = 0; i < count; ++i)
+      {
+        inflow[i] = vy[i] * c.tauThird(dy[i]) + vz[i] * c.tauThird(dz[i]);
+        tau[i] = c.tauThird(d[i]);
+      }
+    }
+    return { nearest - low, inflow - low, tau - low };
+  }
+};
+
 template <int Step, bool Visibility>
 RowResult sweepRow(const RowView& row, std::int64_t count, const SweepConstants& k)
 {
+  const UpwindTerms upwind = UpwindTerms::of<Step, Visibility>(row, count, k);
   RowResult result;
   float previousD = row.startD; // the x-upwind neighbour
   float previousV = row.startV;
+  float previousTau = k.tauThird(previousD);
   for (std::int64_t i = 0; i < count; ++i)
   {
     const std::int64_t x = i * Step;
-    const float dy = row.dy[x];
-    const float dz = row.dz[x];
     if (Visibility)
     {
       // Eq. 6 with the upwind D as this sweep has left it.
-      previousV = previousV * k.tauThird(previousD) + (row.vy[x] * k.tauThird(dy) + row.vz[x] * k.tauThird(dz));
+      previousV = previousV * previousTau + upwind.inflow[x];
       row.v[x] = previousV;
+      previousTau = upwind.tau[x];
     }
     float d = row.d[x];
-    const float ax = std::abs(previousD), ay = std::abs(dy), az = std::abs(dz);
+    const float ax = std::abs(previousD);
     const float old = std::abs(d);
     const std::int64_t f = row.fixedIndex + x;
     const bool fixed = (row.fixedWords[f >> 6] >> (f & 63)) & 1u;
-    if (!fixed && old > std::min({ ax, ay, az }) + k.lowerBound)
+    if (!fixed && old > std::min(ax, upwind.nearest[x]) + k.lowerBound)
     {
-      const float candidate = godunov(ax, ay, az, k);
+      const float candidate = godunov(ax, std::abs(row.dy[x]), std::abs(row.dz[x]), k);
       if (candidate < old)
       {
         if (old < kInfinity)
@@ -163,6 +205,8 @@ RowResult sweepRow(const RowView& row, std::int64_t count, const SweepConstants&
         }
         d = std::copysign(candidate, d);
         row.d[x] = d;
+        if (Visibility)
+          previousTau = k.tauThird(d);
       }
     }
     previousD = d;
@@ -210,9 +254,10 @@ public:
     // One plane per chunk: member t sweeps planes t, t + T, ... (the wavefront, Parallel.h).
     const bool finished = detail::parallelFor(planes, static_cast<int>(planes), this->Threads, execution,
       [&](std::int64_t k0, std::int64_t k1, detail::ChunkProgress& progress) {
+        std::vector<float> scratch(static_cast<std::size_t>(3 * this->Layout.size[0]));
         for (std::int64_t k = k0; k < k1 && !progress.stopped(); ++k)
         {
-          if (!this->sweepPlane(state, k, progress))
+          if (!this->sweepPlane(state, k, scratch.data(), progress))
           {
             return;
           }
@@ -248,7 +293,7 @@ private:
   };
 
   /// Plane k of the sweep (k counts in sweep order). Waits, row by row, for plane k - 1.
-  bool sweepPlane(SweepState& state, std::int64_t k, const detail::ChunkProgress& progress)
+  bool sweepPlane(SweepState& state, std::int64_t k, float* scratch, const detail::ChunkProgress& progress)
   {
     const Grid& g = this->Storage;
     const Index3& n = this->Layout.size;
@@ -263,7 +308,7 @@ private:
       }
       const std::int64_t y = this->Layout.offset[1] + (state.dir[1] > 0 ? j : n[1] - 1 - j);
       const RowResult r = state.rowKernel(
-        this->rowView(state, y, z, ghosted || j > 0, ghosted || k > 0), n[0], this->Constants);
+        this->rowView(state, y, z, ghosted || j > 0, ghosted || k > 0, scratch), n[0], this->Constants);
       result.largestChange = std::max(result.largestChange, r.largestChange);
       result.reachedNew = result.reachedNew || r.reachedNew;
       if (state.visibility && !this->Visibility.kept)
@@ -283,8 +328,8 @@ private:
   /// Row (y, z) (storage coordinates) with its upwind row and plane, or the open sky where
   /// they are outside; the x-upwind neighbour of its first voxel likewise (from storage when
   /// the layout is ghosted).
-  RowView rowView(
-    const SweepState& state, std::int64_t y, std::int64_t z, bool hasUpwindRow, bool hasUpwindPlane)
+  RowView rowView(const SweepState& state, std::int64_t y, std::int64_t z, bool hasUpwindRow, bool hasUpwindPlane,
+    float* scratch)
   {
     const Grid& g = this->Storage;
     const std::int64_t sky0 = state.dir[0] > 0 ? 0 : this->Layout.size[0] - 1; // in the sky rows
@@ -294,7 +339,7 @@ private:
     const bool ghosted = this->Layout.ghosted;
     RowView row{ this->Distance + i, hasUpwindRow ? this->Distance + i - rowStep : this->SkyDistance.data() + sky0,
       hasUpwindPlane ? this->Distance + i - planeStep : this->SkyDistance.data() + sky0, this->Fixed, i, nullptr,
-      nullptr, nullptr, ghosted ? this->Distance[i - state.dir[0]] : kInfinity, 1.0f };
+      nullptr, nullptr, ghosted ? this->Distance[i - state.dir[0]] : kInfinity, 1.0f, scratch };
     if (state.visibility)
     {
       VisibilityStore& vis = this->Visibility;
