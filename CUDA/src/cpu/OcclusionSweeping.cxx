@@ -40,7 +40,7 @@ VisibilityStore planVisibility(
   }
   else if (computedCount > 0)
   {
-    vis.ringPlanes = std::min<std::int64_t>(grid.nz, sweepThreads + 1);
+    vis.ringPlanes = ringPlanesFor(sweepThreads, grid.nz);
     vis.ring.resize(static_cast<std::size_t>(vis.ringPlanes * grid.plane));
     vis.sum = out.ambientOcclusion;
   }

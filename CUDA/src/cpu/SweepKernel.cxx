@@ -1,12 +1,15 @@
 // The sweeps of occlusion sweeping: the Godunov update of the signed distance (Eq. 1) with
-// the octant visibility of Eq. 6 carried along, row by row, and the passes of 8 sweeps.
+// the octant visibility of Eq. 6 carried along (the rows: SweepRows.h), plane by plane,
+// and the passes of 8 sweeps.
 //
 // A sweep visits z-planes, rows and voxels in its direction; every value it needs from
 // upwind is in the previous voxel (kept in registers), the previous row, or the previous
 // plane. The result of a sweep does not depend on the visiting order as long as every voxel
 // comes after its upwind neighbours, so planes run as a wavefront on the members of one
-// parallelFor team: plane k may start row j once plane k-1 has finished row j.
+// parallelFor team: plane k may start row j once plane k-1 has finished row j. Each
+// member sweeps two planes at a time, the second a row behind, their rows interleaved.
 #include "SweepingCore.h"
+#include "SweepRows.h"
 
 #include "Parallel.h"
 
@@ -25,205 +28,6 @@ namespace sweeping
 {
 namespace
 {
-
-constexpr float kInfinity = std::numeric_limits<float>::infinity();
-
-struct SweepConstants
-{
-  float h[3];       // spacing
-  float w[3];       // 1 / h^2
-  float lowerBound; // no update lands closer than 1/sqrt(w0 + w1 + w2) to the nearest neighbour
-  float invTauH;    // 1 / smallest spacing (Eq. 7)
-  float alphaThird; // opacity (Eq. 8) / 3
-  float thirdClear; // (1 - opacity) / 3
-
-  SweepConstants(const std::array<double, 3>& spacing, double opacity)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      h[a] = static_cast<float>(spacing[a]);
-      w[a] = static_cast<float>(1.0 / (spacing[a] * spacing[a]));
-    }
-    // A little below the bound, so that rounding never skips a real update.
-    lowerBound = static_cast<float>(0.999 /
-      std::sqrt(1.0 / (spacing[0] * spacing[0]) + 1.0 / (spacing[1] * spacing[1]) +
-        1.0 / (spacing[2] * spacing[2])));
-    invTauH = static_cast<float>(1.0 / std::min({ spacing[0], spacing[1], spacing[2] }));
-    alphaThird = static_cast<float>(opacity / 3.0);
-    thirdClear = static_cast<float>((1.0 - opacity) / 3.0);
-  }
-
-  /// A third of the transmittance of a voxel with signed distance d (Eq. 7), made
-  /// translucent by Eq. 8: 1/3 - alpha/3 + alpha/3 * opaque. Eq. 6's mean of three then
-  /// needs no multiply after the sum, which shortens the chain from voxel to voxel.
-  float tauThird(float d) const
-  {
-    const float opaque = std::min(1.0f, std::max(0.0f, d * invTauH + 0.5f));
-    return alphaThird * opaque + thirdClear;
-  }
-};
-
-/// The Godunov upwind update (Eq. 1, anisotropic form): the largest u with
-/// sum_i max(u - a_i, 0)^2 / h_i^2 = 1, trying the active sets of the 1, 2, 3 smallest a_i.
-/// Infinite neighbours need no special case: they never enter an accepted active set.
-inline float godunov(float ax, float ay, float az, const SweepConstants& k)
-{
-  float a[3] = { ax, ay, az };
-  float h[3] = { k.h[0], k.h[1], k.h[2] };
-  float w[3] = { k.w[0], k.w[1], k.w[2] };
-  auto order = [&](int i, int j) {
-    if (a[j] < a[i])
-    {
-      std::swap(a[i], a[j]);
-      std::swap(h[i], h[j]);
-      std::swap(w[i], w[j]);
-    }
-  };
-  order(0, 1);
-  order(1, 2);
-  order(0, 1);
-  const float u1 = a[0] + h[0];
-  if (u1 <= a[1])
-  {
-    return u1;
-  }
-  // The quadratics in difference form: no cancellation between large a_i.
-  const float d01 = a[1] - a[0];
-  float sumW = w[0] + w[1];
-  float disc = sumW - w[0] * w[1] * d01 * d01;
-  const float u2 = (a[0] * w[0] + a[1] * w[1] + std::sqrt(std::max(0.0f, disc))) / sumW;
-  if (u2 <= a[2])
-  {
-    return u2;
-  }
-  const float d02 = a[2] - a[0], d12 = a[2] - a[1];
-  sumW += w[2];
-  disc = sumW - (w[0] * w[1] * d01 * d01 + w[0] * w[2] * d02 * d02 + w[1] * w[2] * d12 * d12);
-  return (a[0] * w[0] + a[1] * w[1] + a[2] * w[2] + std::sqrt(std::max(0.0f, disc))) / sumW;
-}
-
-/// One row of a sweep. Pointers are at the row's first voxel in sweep order; the row
-/// advances by Step (+1 or -1). dy/dz and vy/vz are the upwind row and plane (a row of
-/// open sky, D = +inf and V = 1, outside the volume); startD/startV, the x-upwind
-/// neighbour of the first voxel (the open sky, or a ghost voxel of a block). scratch:
-/// 3 x the row's length, the row's upwind terms (UpwindTerms).
-struct RowView
-{
-  float* d;
-  const float* dy;
-  const float* dz;
-  const std::uint64_t* fixedWords; // FixedMask, bit fixedIndex + x for voxel x of the row
-  std::int64_t fixedIndex;
-  float* v;
-  const float* vy;
-  const float* vz;
-  float startD;
-  float startV;
-  float* scratch;
-};
-
-struct RowResult
-{
-  float largestChange = 0.0f; // of finite |D|
-  bool reachedNew = false;    // some |D| went from infinity to finite
-};
-
-/// What each voxel of a row takes from its upwind row and plane, and the transmittance
-/// of its D as the sweep finds it: nothing there depends on the row's own x chain, so it
-/// is computed for the whole row first, in vector registers, and the serial loop keeps
-/// only the chain (Eq. 6's multiply-add, the Godunov update). Indexed like the row's
-/// voxels: element x at the returned pointers' [x].
-struct UpwindTerms
-{
-  float* nearest; // min(|dy|, |dz|)
-  float* inflow;  // Eq. 6's terms of the upwind row and plane: vy tau/3(dy) + vz tau/3(dz)
-  float* tau;     // tau/3(d), d before this row's update
-
-  template <int Step, bool Visibility>
-  static UpwindTerms of(const RowView& row, std::int64_t count, const SweepConstants& k)
-  {
-    // In memory order, from the row's lowest address.
-    const std::int64_t low = Step > 0 ? 0 : -(count - 1);
-    float* __restrict nearest = row.scratch;
-    float* __restrict inflow = row.scratch + count;
-    float* __restrict tau = row.scratch + 2 * count;
-    const float* __restrict d = row.d + low;
-    const float* __restrict dy = row.dy + low;
-    const float* __restrict dz = row.dz + low;
-    for (std::int64_t i = 0; i < count; ++i)
-      nearest[i] = std::min(std::abs(dy[i]), std::abs(dz[i]));
-    if (Visibility)
-    {
-      const SweepConstants c = k; // a copy the stores cannot alias
-      const float* __restrict vy = row.vy + low;
-      const float* __restrict vz = row.vz + low;
-      for (std::int64_t i = 0; i < count; ++i)
-      {
-        inflow[i] = vy[i] * c.tauThird(dy[i]) + vz[i] * c.tauThird(dz[i]);
-        tau[i] = c.tauThird(d[i]);
-      }
-    }
-    return { nearest - low, inflow - low, tau - low };
-  }
-};
-
-template <int Step, bool Visibility>
-RowResult sweepRow(const RowView& row, std::int64_t count, const SweepConstants& k)
-{
-  const UpwindTerms upwind = UpwindTerms::of<Step, Visibility>(row, count, k);
-  RowResult result;
-  float previousD = row.startD; // the x-upwind neighbour
-  float previousV = row.startV;
-  float previousTau = k.tauThird(previousD);
-  for (std::int64_t i = 0; i < count; ++i)
-  {
-    const std::int64_t x = i * Step;
-    if (Visibility)
-    {
-      // Eq. 6 with the upwind D as this sweep has left it.
-      previousV = previousV * previousTau + upwind.inflow[x];
-      row.v[x] = previousV;
-      previousTau = upwind.tau[x];
-    }
-    float d = row.d[x];
-    const float ax = std::abs(previousD);
-    const float old = std::abs(d);
-    const std::int64_t f = row.fixedIndex + x;
-    const bool fixed = (row.fixedWords[f >> 6] >> (f & 63)) & 1u;
-    if (!fixed && old > std::min(ax, upwind.nearest[x]) + k.lowerBound)
-    {
-      const float candidate = godunov(ax, std::abs(row.dy[x]), std::abs(row.dz[x]), k);
-      if (candidate < old)
-      {
-        if (old < kInfinity)
-        {
-          result.largestChange = std::max(result.largestChange, old - candidate);
-        }
-        else
-        {
-          result.reachedNew = true;
-        }
-        d = std::copysign(candidate, d);
-        row.d[x] = d;
-        if (Visibility)
-          previousTau = k.tauThird(d);
-      }
-    }
-    previousD = d;
-  }
-  return result;
-}
-
-using RowFunction = RowResult (*)(const RowView&, std::int64_t, const SweepConstants&);
-
-RowFunction rowFunction(int xDirection, bool visibility)
-{
-  if (xDirection > 0)
-  {
-    return visibility ? &sweepRow<1, true> : &sweepRow<1, false>;
-  }
-  return visibility ? &sweepRow<-1, true> : &sweepRow<-1, false>;
-}
 
 struct alignas(64) RowCounter
 {
@@ -251,17 +55,20 @@ public:
   {
     const std::int64_t planes = this->Layout.size[2];
     SweepState state(octant, visibility, planes);
-    // One plane per chunk: member t sweeps planes t, t + T, ... (the wavefront, Parallel.h).
-    const bool finished = detail::parallelFor(planes, static_cast<int>(planes), this->Threads, execution,
+    // Pairs of planes per chunk: member t sweeps pairs t, t + T, ... (the wavefront,
+    // Parallel.h), each pair's two planes together (sweepPlanes).
+    const std::int64_t chunks = (planes + kPlanesTogether - 1) / kPlanesTogether;
+    const bool finished = detail::parallelFor(planes, static_cast<int>(chunks), this->Threads, execution,
       [&](std::int64_t k0, std::int64_t k1, detail::ChunkProgress& progress) {
-        std::vector<float> scratch(static_cast<std::size_t>(3 * this->Layout.size[0]));
-        for (std::int64_t k = k0; k < k1 && !progress.stopped(); ++k)
+        std::vector<float> scratch(static_cast<std::size_t>(kPlanesTogether * 3 * this->Layout.size[0]));
+        for (std::int64_t k = k0; k < k1 && !progress.stopped(); k += kPlanesTogether)
         {
-          if (!this->sweepPlane(state, k, scratch.data(), progress))
+          const int count = static_cast<int>(std::min<std::int64_t>(kPlanesTogether, k1 - k));
+          if (!this->sweepPlanes(state, k, count, scratch.data(), progress))
           {
             return;
           }
-          progress.advance();
+          progress.advance(count);
         }
       });
     for (const RowResult& r : state.planeResults)
@@ -292,46 +99,80 @@ private:
     {}
   };
 
-  /// Plane k of the sweep (k counts in sweep order). Waits, row by row, for plane k - 1.
-  bool sweepPlane(SweepState& state, std::int64_t k, float* scratch, const detail::ChunkProgress& progress)
+  /// Planes k and k + 1 (count 2) or plane k alone (count 1) of the sweep (k counts in
+  /// sweep order). Row j of plane k waits for plane k - 1's; plane k + 1 follows one row
+  /// behind plane k, so the two rows of a step are independent and run interleaved.
+  bool sweepPlanes(
+    SweepState& state, std::int64_t k, int count, float* scratch, const detail::ChunkProgress& progress)
   {
-    const Grid& g = this->Storage;
-    const Index3& n = this->Layout.size;
-    const std::int64_t z = this->Layout.offset[2] + (state.dir[2] > 0 ? k : n[2] - 1 - k);
-    const bool ghosted = this->Layout.ghosted;
-    RowResult& result = state.planeResults[k];
-    for (std::int64_t j = 0; j < n[1]; ++j)
+    const std::int64_t rows = this->Layout.size[1];
+    for (std::int64_t step = 0; step < rows + count - 1; ++step)
     {
-      if (k > 0 && !waitForRow(state.rowsDone[k - 1], j, progress))
+      if (step < rows && k > 0 && !waitForRow(state.rowsDone[k - 1], step, progress))
       {
         return false;
       }
-      const std::int64_t y = this->Layout.offset[1] + (state.dir[1] > 0 ? j : n[1] - 1 - j);
-      const RowResult r = state.rowKernel(
-        this->rowView(state, y, z, ghosted || j > 0, ghosted || k > 0, scratch), n[0], this->Constants);
-      result.largestChange = std::max(result.largestChange, r.largestChange);
-      result.reachedNew = result.reachedNew || r.reachedNew;
-      if (state.visibility && !this->Visibility.kept)
+      // (plane, row) of this step's rows: plane k's row `step`, plane k + 1's the one before.
+      std::int64_t plane[kPlanesTogether], row[kPlanesTogether];
+      int n = 0;
+      for (int p = 0; p < count; ++p)
       {
-        float* sum = this->Visibility.sum + g.index(this->Layout.offset[0], y, z);
-        const float* v = this->Visibility.row(state.octant, y, z, g) + this->Layout.offset[0];
-        for (std::int64_t x = 0; x < n[0]; ++x)
+        if (step - p >= 0 && step - p < rows)
         {
-          sum[x] += v[x];
+          plane[n] = k + p;
+          row[n] = step - p;
+          ++n;
         }
       }
-      state.rowsDone[k].done.store(j + 1, std::memory_order_release);
+      RowView views[kPlanesTogether];
+      RowResult results[kPlanesTogether];
+      for (int r = 0; r < n; ++r)
+        views[r] = this->rowView(state, plane[r], row[r], scratch + r * 3 * this->Layout.size[0]);
+      state.rowKernel(views, n, this->Layout.size[0], this->Constants, results);
+      for (int r = 0; r < n; ++r)
+        this->finishRow(state, plane[r], row[r], results[r]);
     }
     return true;
   }
 
-  /// Row (y, z) (storage coordinates) with its upwind row and plane, or the open sky where
+  /// Row j of plane k is done: its changes, its octant's share of the sum, and the
+  /// wavefront's count.
+  void finishRow(SweepState& state, std::int64_t k, std::int64_t j, const RowResult& r)
+  {
+    RowResult& result = state.planeResults[k];
+    result.largestChange = std::max(result.largestChange, r.largestChange);
+    result.reachedNew = result.reachedNew || r.reachedNew;
+    if (state.visibility && !this->Visibility.kept)
+    {
+      const Grid& g = this->Storage;
+      const std::int64_t y = this->storageY(state, j), z = this->storageZ(state, k);
+      float* sum = this->Visibility.sum + g.index(this->Layout.offset[0], y, z);
+      const float* v = this->Visibility.row(state.octant, y, z, g) + this->Layout.offset[0];
+      for (std::int64_t x = 0; x < this->Layout.size[0]; ++x)
+      {
+        sum[x] += v[x];
+      }
+    }
+    state.rowsDone[k].done.store(j + 1, std::memory_order_release);
+  }
+
+  std::int64_t storageY(const SweepState& state, std::int64_t j) const
+  {
+    return this->Layout.offset[1] + (state.dir[1] > 0 ? j : this->Layout.size[1] - 1 - j);
+  }
+  std::int64_t storageZ(const SweepState& state, std::int64_t k) const
+  {
+    return this->Layout.offset[2] + (state.dir[2] > 0 ? k : this->Layout.size[2] - 1 - k);
+  }
+
+  /// Row j of plane k (in sweep order) with its upwind row and plane, or the open sky where
   /// they are outside; the x-upwind neighbour of its first voxel likewise (from storage when
   /// the layout is ghosted).
-  RowView rowView(const SweepState& state, std::int64_t y, std::int64_t z, bool hasUpwindRow, bool hasUpwindPlane,
-    float* scratch)
+  RowView rowView(const SweepState& state, std::int64_t k, std::int64_t j, float* scratch)
   {
     const Grid& g = this->Storage;
+    const std::int64_t y = this->storageY(state, j), z = this->storageZ(state, k);
+    const bool hasUpwindRow = this->Layout.ghosted || j > 0, hasUpwindPlane = this->Layout.ghosted || k > 0;
     const std::int64_t sky0 = state.dir[0] > 0 ? 0 : this->Layout.size[0] - 1; // in the sky rows
     const std::int64_t x0 = this->Layout.offset[0] + sky0;
     const std::int64_t rowStep = state.dir[1] * g.nx, planeStep = state.dir[2] * g.plane;

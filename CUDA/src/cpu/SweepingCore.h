@@ -1,7 +1,8 @@
 // The stages of occlusion sweeping, shared by the whole-volume driver
 // computeOcclusionSweeping (OcclusionSweeping.cxx) and the block driver BlockSweeper
 // (BlockSweeping.cxx). Where each lives: SweepStages.cxx (checks, initial distance, fixed
-// mask, combination), SweepKernel.cxx (the sweeps), SweepGeometryTerm.cxx (G_s(N)).
+// mask, combination), SweepKernel.cxx (the sweeps) with SweepRows.h (their rows),
+// SweepGeometryTerm.cxx (G_s(N)).
 //
 // A SweepLayout says where the swept voxels lie in the arrays (D, fixed, V) and in the whole
 // volume. The whole volume: the arrays are the volume, and upwind neighbours outside it are
@@ -14,6 +15,7 @@
 #include "vao/OcclusionSweeping.h"
 #include "vao/Storage.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -86,12 +88,9 @@ struct VisibilityStore
   // floats per voxel, and its first touch.
   std::int64_t rowPitch = 0;
   bool inOutput = false;
-  // When not kept, a ring of planes. Plane k of a sweep overwrites the slot of plane
-  // k - ringPlanes, which must be finished and no longer read (as the upwind plane of
-  // k - ringPlanes + 1). With T threads the planes in flight are at most the last T (thread
-  // t sweeps planes t, t + T, ... in order, and a plane waits for its upwind one), so T + 1
-  // slots are enough; two slots would let a third thread overwrite a row of plane k - 1
-  // while plane k - 1 still reads it as its upwind row.
+  // When not kept, a ring of planes (ringPlanesFor). Plane k of a sweep overwrites the slot
+  // of plane k - ringPlanes, which must be finished and no longer read (as the upwind plane
+  // of k - ringPlanes + 1).
   std::vector<float> ring;
   std::int64_t ringPlanes = 0;
   float* sum = nullptr; // sum of m_s V_s, when not kept (the whole volume only)
@@ -128,6 +127,19 @@ struct VisibilityStore
       }
   }
 };
+
+/// Planes one member of the sweeping team sweeps together, a row apart (SweepKernel.cxx).
+constexpr int kPlanesTogether = 2;
+
+/// Slots of the ring of visibility planes that T sweeping threads need. Member t sweeps
+/// the groups of kPlanesTogether planes t, t + T, ... in order, and a plane waits for its
+/// upwind one, so the planes in flight are at most the last kPlanesTogether * T: one slot
+/// more is enough. One fewer would let a member overwrite a row of a plane that its
+/// downwind neighbour still reads as its upwind row.
+inline std::int64_t ringPlanesFor(int threads, std::int64_t planes)
+{
+  return std::min<std::int64_t>(planes, kPlanesTogether * std::int64_t(threads) + 1);
+}
 
 /// The unit the sweeps measure distances in: the power of two at or below the smallest
 /// spacing. Scaling by a power of two is exact, so the sweeps give the bits they would
