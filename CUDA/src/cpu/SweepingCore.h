@@ -131,11 +131,11 @@ struct VisibilityStore
 /// Planes one member of the sweeping team sweeps together, a row apart (SweepKernel.cxx).
 constexpr int kPlanesTogether = 2;
 
-/// Slots of the ring of visibility planes that T sweeping threads need. Member t sweeps
+/// Slots of the ring of visibility planes enough for T sweeping threads. Member t sweeps
 /// the groups of kPlanesTogether planes t, t + T, ... in order, and a plane waits for its
-/// upwind one, so the planes in flight are at most the last kPlanesTogether * T: one slot
-/// more is enough. One fewer would let a member overwrite a row of a plane that its
-/// downwind neighbour still reads as its upwind row.
+/// upwind one, so the planes in flight are at most the last kPlanesTogether * T: with one
+/// slot more, no plane overwrites a slot whose plane is still swept (it reads its own
+/// rows as upwind rows) or read as an upwind plane.
 inline std::int64_t ringPlanesFor(int threads, std::int64_t planes)
 {
   return std::min<std::int64_t>(planes, kPlanesTogether * std::int64_t(threads) + 1);
