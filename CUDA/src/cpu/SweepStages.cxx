@@ -227,62 +227,101 @@ struct Combiner
   const VisibilityStore& vis;
   double maskCount;
 
-  /// The unclamped A of own voxel (x, y, z), storage index i, whose octants' V are v.
-  double occlusion(const float* v, std::int64_t i, std::int64_t x, std::int64_t y, std::int64_t z) const
+  /// The unclamped A of own voxel (x, y, z) with the geometry term, whose octants' V are v.
+  double weightedOcclusion(const float* v, std::int64_t x, std::int64_t y, std::int64_t z) const
   {
-    if (!this->vis.kept)
-    {
-      return this->vis.sum[i] / this->maskCount;
-    }
-    const bool geometry = this->p.useGeometryTerm;
     const bool twoSided = this->p.opacity < 1.0;
     double g[8];
-    if (geometry)
-      allGeometryTerms(distanceNormal(this->distance, this->layout, x, y, z), twoSided, g);
+    allGeometryTerms(distanceNormal(this->distance, this->layout, x, y, z), twoSided, g);
     double sum = 0.0;
     for (int s = 0; s < 8; ++s)
       if (this->p.octantMask[s])
-        sum += geometry ? v[s] * g[s] : v[s];
-    return sum / (!geometry ? this->maskCount : twoSided ? 2.0 * kPi : kPi);
+        sum += v[s] * g[s];
+    return sum / (twoSided ? 2.0 * kPi : kPi);
   }
 
   /// Own plane z. `rows` holds a row of the eight fields while the row-interleaved output
-  /// (VisibilityStore::inOutput) is transposed in place.
-  void plane(std::int64_t z, std::vector<float>& rows) const
+  /// (VisibilityStore::inOutput) is transposed in place; `occlusion`, a row of A. Each
+  /// step is a loop over the row, which the compiler vectorises where it has no call.
+  void plane(std::int64_t z, std::vector<float>& rows, std::vector<double>& occlusion) const
   {
-    const double exponent = 1.0 / this->p.gamma;
     const Index3& n = this->layout.size;
-    float v[8] = {};
+    occlusion.resize(static_cast<std::size_t>(n[0]));
     for (std::int64_t y = 0; y < n[1]; ++y)
     {
       const std::int64_t first = this->layout.index(0, y, z);
+      const std::int64_t o = (z * n[1] + y) * n[0]; // the row's first output voxel
       if (this->vis.inOutput)
       {
         const float* block = this->vis.field[0] + (z * n[1] + y) * this->vis.rowPitch; // whole volume
         rows.assign(block, block + 8 * n[0]);
       }
-      for (std::int64_t x = 0; x < n[0]; ++x)
+      // Row y of each octant's field (null where not computed: V = 0).
+      const float* field[8] = {};
+      for (int s = 0; s < 8 && this->vis.kept; ++s)
+        field[s] = this->vis.inOutput ? rows.data() + s * n[0] : this->vis.field[s] ? this->vis.field[s] + first : nullptr;
+      if (this->out.octantVisibility)
       {
-        const std::int64_t i = first + x;
-        const std::int64_t o = (z * n[1] + y) * n[0] + x;
-        for (int s = 0; s < 8 && this->vis.kept; ++s)
-          v[s] = this->vis.inOutput ? rows[s * n[0] + x] : this->vis.field[s] ? this->vis.field[s][i] : 0.0f;
-        if (this->out.octantVisibility)
-        {
+        for (std::int64_t x = 0; x < n[0]; ++x)
           for (int s = 0; s < 8; ++s)
-            this->out.octantVisibility[8 * o + s] = v[s];
-        }
-        if (this->out.ambientOcclusion)
+            this->out.octantVisibility[8 * (o + x) + s] = field[s] ? field[s][x] : 0.0f;
+      }
+      if (this->out.ambientOcclusion)
+        this->occlusionRow(field, first, o, y, z, occlusion.data());
+    }
+  }
+
+  /// Row y of plane z's AmbientOcclusion (Eq. 4/5, clamped, to the power 1 / gamma).
+  void occlusionRow(const float* const* field, std::int64_t first, std::int64_t o, std::int64_t y,
+    std::int64_t z, double* __restrict a) const
+  {
+    const std::int64_t n = this->layout.size[0];
+    if (!this->vis.kept)
+    {
+      const float* sum = this->vis.sum + first;
+      for (std::int64_t x = 0; x < n; ++x)
+        a[x] = sum[x] / this->maskCount;
+    }
+    else if (!this->p.useGeometryTerm)
+    {
+      // The masked octants' V summed in octant order, as the geometry's sum.
+      std::fill(a, a + n, 0.0);
+      for (int s = 0; s < 8; ++s)
+        if (this->p.octantMask[s] && field[s])
         {
-          double a = std::min(1.0, std::max(0.0, this->occlusion(v, i, x, y, z)));
-          if (exponent != 1.0)
-          {
-            a = exponent == 0.5 ? std::sqrt(a) : std::pow(a, exponent); // the paper's gamma 2, fast
-          }
-          this->out.ambientOcclusion[o] = static_cast<float>(a);
+          const float* __restrict v = field[s];
+          for (std::int64_t x = 0; x < n; ++x)
+            a[x] += v[x];
         }
+      for (std::int64_t x = 0; x < n; ++x)
+        a[x] /= this->maskCount;
+    }
+    else
+    {
+      for (std::int64_t x = 0; x < n; ++x)
+      {
+        float v[8];
+        for (int s = 0; s < 8; ++s)
+          v[s] = field[s] ? field[s][x] : 0.0f;
+        a[x] = this->weightedOcclusion(v, x, y, z);
       }
     }
+    for (std::int64_t x = 0; x < n; ++x)
+      a[x] = std::min(1.0, std::max(0.0, a[x]));
+    const double exponent = 1.0 / this->p.gamma;
+    if (exponent == 0.5) // the paper's gamma 2, fast
+    {
+      for (std::int64_t x = 0; x < n; ++x)
+        a[x] = std::sqrt(a[x]);
+    }
+    else if (exponent != 1.0)
+    {
+      for (std::int64_t x = 0; x < n; ++x)
+        a[x] = std::pow(a[x], exponent);
+    }
+    float* __restrict ao = this->out.ambientOcclusion + o;
+    for (std::int64_t x = 0; x < n; ++x)
+      ao[x] = static_cast<float>(a[x]);
   }
 };
 
@@ -323,9 +362,10 @@ Status combine(const SweepLayout& layout, const SweepParameters& p, const SweepO
   const bool finished = detail::parallelFor(layout.size[2], threads, threads, execution,
     [&](std::int64_t z0, std::int64_t z1, detail::ChunkProgress& progress) {
       std::vector<float> rows;
+      std::vector<double> occlusion;
       for (std::int64_t z = z0; z < z1 && !progress.stopped(); ++z)
       {
-        combiner.plane(z, rows);
+        combiner.plane(z, rows, occlusion);
         progress.advance();
       }
     });
