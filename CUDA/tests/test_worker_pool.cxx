@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <new>
 #include <numeric>
@@ -84,6 +85,32 @@ TEST(WorkerPool, AnExceptionInAChunkReachesTheCallerAndThePoolStaysUsable)
       sum += i;
   });
   EXPECT_EQ(sum.load(), 4950);
+}
+
+TEST(WorkerPool, AChunkThatThrowsStopsTheMembersThatWaitOnIt)
+{
+  // A wavefront: chunk 1 waits until chunk 0 has done its work or the loop has stopped.
+  // Chunk 0 throws instead (as an allocation may), so only the stop lets chunk 1 return.
+  // (Chunk 1 may also never start, when the stop comes first.)
+  std::atomic<bool> oneTimedOut{ false };
+  EXPECT_THROW(parallelFor(2, 2, 2, vao::Execution{},
+                 [&](std::int64_t begin, std::int64_t, ChunkProgress& progress) {
+                   if (begin == 0)
+                     throw std::bad_alloc();
+                   const auto start = std::chrono::steady_clock::now();
+                   while (!progress.stopped())
+                   {
+                     // A bound, so that the test fails instead of hanging.
+                     if (std::chrono::steady_clock::now() - start > std::chrono::seconds(20))
+                     {
+                       oneTimedOut = true;
+                       return;
+                     }
+                     std::this_thread::yield();
+                   }
+                 }),
+    std::bad_alloc);
+  EXPECT_FALSE(oneTimedOut.load());
 }
 
 TEST(WorkerPool, CancellationStopsTheLoop)

@@ -277,7 +277,7 @@ bool LoopControl::advance(std::int64_t work, bool onCallingThread)
     }
     if (this->Exec.abortRequested && this->Exec.abortRequested())
     {
-      this->Stop.store(true, std::memory_order_relaxed);
+      this->stop();
     }
   }
   return !this->stopped();
@@ -295,9 +295,17 @@ bool parallelFor(std::int64_t n, int chunks, int threads, const Execution& execu
   const int wanted = std::max(1, std::min(resolveThreadCount(threads), chunks));
   WorkerPool::shared().run(wanted, [&](int member, int team) {
     ChunkProgress progress(control, member == 0);
-    for (int c = member; c < chunks && !control.stopped(); c += team)
+    try
     {
-      body(n * c / chunks, n * (c + 1) / chunks, progress);
+      for (int c = member; c < chunks && !control.stopped(); c += team)
+      {
+        body(n * c / chunks, n * (c + 1) / chunks, progress);
+      }
+    }
+    catch (...)
+    {
+      control.stop();
+      throw;
     }
   });
   return !control.stopped();

@@ -61,6 +61,8 @@ public:
   /// Called by any thread after finishing `work` units; returns false to stop.
   bool advance(std::int64_t work, bool onCallingThread);
   bool stopped() const { return this->Stop.load(std::memory_order_relaxed); }
+  /// Stops the loop: the other members' ChunkProgress::stopped() turns true.
+  void stop() { this->Stop.store(true, std::memory_order_relaxed); }
 
 private:
   const Execution& Exec;
@@ -92,8 +94,9 @@ using ChunkBody = std::function<void(std::int64_t begin, std::int64_t end, Chunk
 /// Runs body over `chunks` equal chunks of [0, n) with up to `threads` threads (0: the
 /// default; chunk c goes to team member c mod team, in increasing order). Progress is the
 /// work the chunks report out of `totalWork` (-1: n). An exception thrown by a chunk (say,
-/// std::bad_alloc) is rethrown on the caller after every member has finished. Returns
-/// false when the execution asked to abort.
+/// std::bad_alloc) stops the loop, so that members waiting on that chunk's work (a
+/// wavefront) see stopped() instead of waiting for ever, and is rethrown on the caller
+/// after every member has finished. Returns false when the execution asked to abort.
 bool parallelFor(std::int64_t n, int chunks, int threads, const Execution& execution,
   const ChunkBody& body, std::int64_t totalWork = -1);
 
