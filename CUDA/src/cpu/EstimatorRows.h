@@ -14,9 +14,8 @@ namespace detail
 /// row's voxels, with q_i = query[i], or isoValue when query is null; for Chebyshev and the
 /// Gaussian CDF on a row with exact sums (row.sum), opennessFromExactSums of them instead
 /// (the same formulas without the divisions: the mean and variance need not be formed).
-/// A raw row (row.raw, CDF Reconstruction's alone) gives the same bits from its 16-bit
-/// values and 32-bit sums, with q_i = query[i], else its voxel's value where it has them
-/// (raw.value), else isoValue.
+/// A raw row (row.raw) gives the same bits from its 16-bit values and 32-bit sums, with
+/// q_i = query[i], else its voxel's value where it has them (raw.value), else isoValue.
 void opennessRow(Method method, ErfMode erfMode, const NeighbourhoodRow& row, const double* query,
   double isoValue, float* openness);
 

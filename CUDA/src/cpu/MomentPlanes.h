@@ -80,6 +80,12 @@ struct SlideColumns
   }
 };
 
+/// Values whose squares, and the differences of two squares, fit in int32: 8-bit and int16
+/// (whose 32-bit products vectorise where 64-bit ones do not on AVX2).
+template <class T>
+constexpr bool kSquaresFitInt32 =
+  std::is_integral<T>::value && (sizeof(T) == 1 || (sizeof(T) == 2 && std::is_signed<T>::value));
+
 /// d1 = a - b (in Lin, modulo 2^32 for std::uint32_t) and, with Squares, d2 = a^2 - b^2,
 /// with a, b the values of rows `in` and `out` less the shift (0 for a missing row). d2 is
 /// in Sq: Acc, or for 8-bit and int16 values, whose squares' differences fit in int32,
@@ -92,10 +98,7 @@ struct RowDifferences
   static VAO_ALWAYS_INLINE void run(const T* __restrict in, const T* __restrict out, std::int64_t stride,
     std::int64_t n, Acc shift, Lin* __restrict d1, Sq* __restrict d2, std::int32_t* largest = nullptr)
   {
-    // Squares of 8-bit and int16 values and their differences fit in 32 bits, whose
-    // products vectorise (64-bit ones do not on AVX2).
-    using Product = typename std::conditional<std::is_integral<T>::value && (sizeof(T) == 1 ||
-      (sizeof(T) == 2 && std::is_signed<T>::value)), std::int32_t, Acc>::type;
+    using Product = typename std::conditional<kSquaresFitInt32<T>, std::int32_t, Acc>::type;
     constexpr bool narrowSquares = Squares && !std::is_same<Sq, Acc>::value;
     static_assert(!narrowSquares || std::is_same<Product, std::int32_t>::value, "32-bit squares of 8- and 16-bit values");
     const auto s = static_cast<Product>(shift);
@@ -179,8 +182,7 @@ public:
   // 8-bit and int16 values with 32-bit sums of v: each row's differences of squares
   // a^2 - b^2 fit in int32 (RowDifferences), and their x sums run modulo 2^32 too
   // in the rows where no window can leave int32's range (boxRowDifference).
-  static constexpr bool kNarrowSquares = std::is_same<Lin, std::uint32_t>::value &&
-    std::is_integral<T>::value && (sizeof(T) == 1 || (sizeof(T) == 2 && std::is_signed<T>::value));
+  static constexpr bool kNarrowSquares = std::is_same<Lin, std::uint32_t>::value && kSquaresFitInt32<T>;
 
   MomentPlanes(const TypedVolume<T>& volume, const BoxGeometry& geometry, Acc shift, bool squares)
     : Volume(volume)

@@ -29,6 +29,8 @@ namespace sweeping
 namespace
 {
 
+static_assert(kPlanesTogether >= 1 && kPlanesTogether <= 2, "sweepRows takes one or two rows at a time");
+
 struct alignas(64) RowCounter
 {
   std::atomic<std::int64_t> done{ 0 };
@@ -60,7 +62,7 @@ public:
     const std::int64_t chunks = (planes + kPlanesTogether - 1) / kPlanesTogether;
     const bool finished = detail::parallelFor(planes, static_cast<int>(chunks), this->Threads, execution,
       [&](std::int64_t k0, std::int64_t k1, detail::ChunkProgress& progress) {
-        std::vector<float> scratch(static_cast<std::size_t>(kPlanesTogether * 3 * this->Layout.size[0]));
+        std::vector<float> scratch(static_cast<std::size_t>(kPlanesTogether * this->scratchPerRow()));
         for (std::int64_t k = k0; k < k1 && !progress.stopped(); k += kPlanesTogether)
         {
           const int count = static_cast<int>(std::min<std::int64_t>(kPlanesTogether, k1 - k));
@@ -127,7 +129,7 @@ private:
       RowView views[kPlanesTogether];
       RowResult results[kPlanesTogether];
       for (int r = 0; r < n; ++r)
-        views[r] = this->rowView(state, plane[r], row[r], scratch + r * 3 * this->Layout.size[0]);
+        views[r] = this->rowView(state, plane[r], row[r], scratch + r * this->scratchPerRow());
       state.rowKernel(views, n, this->Layout.size[0], this->Constants, results);
       for (int r = 0; r < n; ++r)
         this->finishRow(state, plane[r], row[r], results[r]);
@@ -155,6 +157,9 @@ private:
     }
     state.rowsDone[k].done.store(j + 1, std::memory_order_release);
   }
+
+  /// A row's scratch for its upwind terms (RowView::scratch).
+  std::int64_t scratchPerRow() const { return UpwindTerms::kRows * this->Layout.size[0]; }
 
   std::int64_t storageY(const SweepState& state, std::int64_t j) const
   {

@@ -99,7 +99,7 @@ inline float godunov(float ax, float ay, float az, const SweepConstants& k)
 /// advances by Step (+1 or -1). dy/dz and vy/vz are the upwind row and plane (a row of
 /// open sky, D = +inf and V = 1, outside the volume); startD/startV, the x-upwind
 /// neighbour of the first voxel (the open sky, or a ghost voxel of a block). scratch:
-/// 3 x the row's length, the row's upwind terms (UpwindTerms).
+/// UpwindTerms::kRows rows of the row's length, for its upwind terms.
 struct RowView
 {
   float* d;
@@ -131,6 +131,7 @@ struct UpwindTerms
   float* nearest; // min(|dy|, |dz|)
   float* inflow;  // Eq. 6's terms of the upwind row and plane: vy tau/3(dy) + vz tau/3(dz)
   float* tau;     // tau/3(d), d before this row's update
+  static constexpr int kRows = 3; // of RowView::scratch
 
   template <int Step, bool Visibility>
   static UpwindTerms of(const RowView& row, std::int64_t count, const SweepConstants& k)
