@@ -1,8 +1,10 @@
 // The estimators over rows of neighbourhoods (EstimatorRows.h, four voxels at a time on
-// AVX2 and eight on AVX-512, with glibc's vector erf and pow; each tier the processor has) against the formulas of METHODS.md written out again
+// AVX2 and eight on AVX-512, with glibc's vector erf, exp and log and AVX-512's piecewise erf;
+// each tier the processor has) against the formulas of METHODS.md written out again
 // (ReferenceFormulas.h): rows of every length around the vector width, queries per voxel
 // and one iso value, flat boxes among noisy ones, small and large magnitudes.
 #include "../src/cpu/CpuDispatch.h"
+#include "../src/cpu/DoubleLanes.h"
 #include "../src/cpu/EstimatorRows.h"
 #include "../src/cpu/MomentRows.h"
 #include "ReferenceFormulas.h"
@@ -11,6 +13,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -254,6 +257,63 @@ TEST(EstimatorRows, ExactSumsAgainstTheReference)
     EXPECT_LE(offByOneUlp * 1000, compared);
   });
 }
+
+#if VAO_HAVE_AVX2_TARGET
+/// AVX-512's erf (DoubleLanes.h: 16 polynomial pieces) on n values, padded to whole vectors.
+VAO_AVX512_INLINE std::vector<double> erfOnAvx512(std::vector<double> x)
+{
+  x.resize((x.size() + 7) / 8 * 8, 0.0);
+  std::vector<double> out(x.size());
+  for (std::size_t i = 0; i < x.size(); i += 8)
+    vao::detail::avx512::store(out.data() + i, vao::detail::avx512::erf(vao::detail::avx512::load(x.data() + i)));
+  return out;
+}
+
+// The piecewise erf against glibc's scalar erf (within an ulp): within 2^-52 absolute on a
+// fine grid over [-7, 7], at and beside every piece's ends, near 0 and 6, and within 2^-51
+// relative on the first piece (|x| < 3/8, down to subnormals); odd; +-1 at
+// +-infinity and NaN kept.
+TEST(EstimatorRows, PiecewiseErfOfAvx512WithinTwoToTheMinus52OfErf)
+{
+  if (vao::detail::cpuSimdTier() < vao::detail::SimdTier::Avx512)
+    GTEST_SKIP() << "no AVX-512: glibc's vector erf runs on AVX2";
+  std::vector<double> x;
+  for (int i = -7 * 8192; i <= 7 * 8192; ++i)
+    x.push_back(i / 8192.0 + 1e-6 * std::sin(i)); // off the grid of the pieces' ends too
+  for (int k = 0; k <= 17; ++k)
+  {
+    const double end = 0.375 * k; // where the pieces meet
+    for (const double e : { end, std::nextafter(end, 0.0), std::nextafter(end, 10.0) })
+      x.insert(x.end(), { e, -e });
+  }
+  for (const double e : { 5.9999999, 6.0000001, 1e-300, 4.9e-324, 1e300, -1e300, -0.0 })
+    x.push_back(e);
+  const std::size_t finite = x.size();
+  const double inf = std::numeric_limits<double>::infinity();
+  x.insert(x.end(), { inf, -inf, std::numeric_limits<double>::quiet_NaN() });
+  const std::vector<double> y = erfOnAvx512(x);
+  double worst = 0.0, worstRelative = 0.0;
+  for (std::size_t i = 0; i < finite; ++i)
+  {
+    const double error = std::fabs(y[i] - std::erf(x[i]));
+    worst = std::fmax(worst, error);
+    ASSERT_LE(error, 2.220446049250313e-16) << "x " << x[i] << ": " << y[i] << " against " << std::erf(x[i]);
+    ASSERT_LE(std::fabs(y[i]), 1.0) << "x " << x[i];
+    if (std::fabs(x[i]) < 0.375 && x[i] != 0.0) // the first piece: relative accuracy too
+    {
+      worstRelative = std::fmax(worstRelative, error / std::fabs(std::erf(x[i])));
+      ASSERT_LE(error, std::ldexp(1.0, -51) * std::fabs(std::erf(x[i]))) << "x " << x[i];
+    }
+  }
+  for (std::size_t i = 0; i + 1 < finite; ++i) // odd: the pieces fit |x|, the sign comes back
+    if (x[i + 1] == -x[i])
+      ASSERT_EQ(y[i + 1], -y[i]) << "x " << x[i];
+  EXPECT_EQ(y[finite], 1.0);
+  EXPECT_EQ(y[finite + 1], -1.0);
+  EXPECT_TRUE(std::isnan(y[finite + 2]));
+  std::printf("%zu values: within %.3g of glibc's erf (%.3g relative below 0.375)\n", finite, worst, worstRelative);
+}
+#endif
 
 // The mean and variance of rows of boxes from exact sums: against the definition (double of
 // the exact integer numerator count * sum(v^2) - sum(v)^2, over count^2), bit for bit, for
