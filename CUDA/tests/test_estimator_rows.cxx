@@ -270,7 +270,7 @@ VAO_AVX512_INLINE std::vector<double> erfOnAvx512(std::vector<double> x)
 }
 
 // The piecewise erf against glibc's scalar erf (within an ulp): within 2^-52 absolute on a
-// fine grid over [-7, 7], at and beside every piece's ends, near 0 and 6, and within 2^-51
+// fine grid over [-7, 7], at and beside every piece's ends, near 0 and 6, and within 2^-50
 // relative on the first piece (|x| < 3/8, down to subnormals); odd; +-1 at
 // +-infinity and NaN kept.
 TEST(EstimatorRows, PiecewiseErfOfAvx512WithinTwoToTheMinus52OfErf)
@@ -302,7 +302,7 @@ TEST(EstimatorRows, PiecewiseErfOfAvx512WithinTwoToTheMinus52OfErf)
     if (std::fabs(x[i]) < 0.375 && x[i] != 0.0) // the first piece: relative accuracy too
     {
       worstRelative = std::fmax(worstRelative, error / std::fabs(std::erf(x[i])));
-      ASSERT_LE(error, std::ldexp(1.0, -51) * std::fabs(std::erf(x[i]))) << "x " << x[i];
+      ASSERT_LE(error, std::ldexp(1.0, -50) * std::fabs(std::erf(x[i]))) << "x " << x[i];
     }
   }
   for (std::size_t i = 0; i + 1 < finite; ++i) // odd: the pieces fit |x|, the sign comes back
