@@ -7,8 +7,9 @@
 // scipy.ndimage.distance_transform_edt in the same run.
 //
 // Usage: vao_benchmark [--shared DIR] [--scipy PATH/TO/scipy_peer.py] [--repeat N]
-//                      [--exact] [--threads N] [--volumetric | --sweeping | --penner | --relight]
-//                      (one table only; --relight: the surface query rates alone)
+//                      [--exact] [--threads N] [--volumetric | --sweeping | --penner | --relight | --bytes]
+//                      (one table only; --relight: the surface query rates alone; --bytes: the
+//                      bytes per voxel each kernel moves, under valgrind, BytesPerVoxel.cxx)
 // Last, the variance occlusion maps (PennerRows.cxx): pyramid builds against their floor
 // and scipy's level-0 blur, and the surface query rates (AO, soft shadows) on the CT heads'
 // bone surfaces.
@@ -19,6 +20,7 @@
 #include "vtkVolumetricAmbientOcclusion.h"
 
 #include "BenchmarkSupport.h"
+#include "BytesPerVoxel.h"
 #include "PennerRows.h"
 #include "SweepScene.h"
 #include "vao/AmbientOcclusion.h"
@@ -370,9 +372,16 @@ int main(int argc, char* argv[])
       options.pennerOnly = options.relightOnly = true;
     else if (arg == "--volumetric")
       options.volumetricOnly = true;
+    else if (arg == "--bytes")
+    {
+      BenchmarkBytes();
+      return 0;
+    }
+    else if (arg == "--bytes-of" && i + 1 < argc)
+      return RunBytesWorkload(argv[i + 1]);
     else
     {
-      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--volumetric | --sweeping | --penner | --relight]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--volumetric | --sweeping | --penner | --relight | --bytes]\n", argv[0]);
       return 2;
     }
   }
