@@ -1,9 +1,10 @@
 // The bytes each kernel moves per voxel, measured by valgrind's cache simulation (callgrind
 // --cache-sim=yes): this machine's virtual processor has no hardware counters, and the
 // simulation counts every load and store the kernel makes through a model of the caches.
-// The table runs this program again under valgrind once per workload (--one NAME), which
-// builds its input uninstrumented and turns the instrumentation on around the kernel call
-// alone. A miss of the simulated last-level cache moves one 64-byte line to or from memory.
+// The table runs this program again under valgrind once per workload (--bytes-of NAME),
+// which builds its input uninstrumented and turns the instrumentation on around the kernel
+// call alone. Memory traffic: a 64-byte line for each miss of the simulated last level
+// (read, or allocated for a write) and for each dirty line it evicts (--simulate-wb).
 #include "BytesPerVoxel.h"
 
 #include "SweepScene.h"
@@ -30,7 +31,8 @@
 #include <unistd.h>
 
 #include <cstdio>
-#include <cstring>
+#include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -147,17 +149,20 @@ int RunOne(const std::string& name)
   return s.ok ? 0 : 1;
 }
 
-/// "1,234 (1,000 rd + 234 wr)" after `label` in valgrind's summary: the total, or -1.
-double CountAfter(const std::string& text, const char* label)
+/// The events callgrind collected, by name ("Events :" and "Collected :" of its summary).
+std::map<std::string, double> CollectedEvents(const std::string& text)
 {
-  const std::size_t at = text.find(label);
-  if (at == std::string::npos)
-    return -1.0;
-  std::string digits;
-  for (std::size_t i = at + std::strlen(label); i < text.size() && text[i] != '('; ++i)
-    if (text[i] >= '0' && text[i] <= '9')
-      digits += text[i];
-  return digits.empty() ? -1.0 : std::stod(digits);
+  std::map<std::string, double> events;
+  const std::size_t names = text.find("Events    :"), values = text.find("Collected :");
+  if (names == std::string::npos || values == std::string::npos)
+    return events;
+  std::istringstream n(text.substr(names + 11, text.find('\n', names) - names - 11));
+  std::istringstream v(text.substr(values + 11, text.find('\n', values) - values - 11));
+  std::string name;
+  double value = 0.0;
+  while (n >> name && v >> value)
+    events[name] = value;
+  return events;
 }
 
 } // namespace
@@ -169,10 +174,11 @@ int RunBytesWorkload(const std::string& name)
 
 void BenchmarkBytes()
 {
-  std::printf("\nBytes moved per voxel (valgrind's cache simulation of %s: bytes = 64 x the\n"
-              "  simulated misses; 'memory' beyond the last level, 'L1' into the L1d); 'must' reads the\n"
-              "  input once and writes each output once. Int16 workloads on the 256 x 256 x 128 generated\n"
-              "  phantom, the sweeping on the 160^3 Fig. 3 scene\n",
+  std::printf("\nBytes moved per voxel (valgrind's cache simulation of %s): 'memory', a\n"
+              "  64-byte line per last-level miss and per dirty line written back; 'L1', a line per L1d\n"
+              "  miss; 'must', the input read once and each output written once (a cache that allocates\n"
+              "  lines for writes reads each output line first: the floor's 1.6x). Int16 workloads on the\n"
+              "  256 x 256 x 128 generated phantom, the sweeping on the 160^3 Fig. 3 scene\n",
     kCacheModel);
   if (!VAO_HAVE_CALLGRIND)
   {
@@ -188,8 +194,9 @@ void BenchmarkBytes()
   std::printf("  %-32s %8s %10s %8s %10s\n", "workload", "must", "memory", "x must", "L1");
   for (const Workload& w : kWorkloads)
   {
-    const std::string command = std::string("valgrind --tool=callgrind --cache-sim=yes --instr-atstart=no ") +
-      kCacheModel + " --callgrind-out-file=/dev/null '" + self + "' --bytes-of " + w.name + " 2>&1";
+    const std::string command = std::string("valgrind --tool=callgrind --cache-sim=yes --simulate-wb=yes ") +
+      "--instr-atstart=no " + kCacheModel + " --callgrind-out-file=/dev/null '" + self + "' --bytes-of " + w.name +
+      " 2>&1";
     std::string text;
     if (FILE* pipe = popen(command.c_str(), "r"))
     {
@@ -200,14 +207,16 @@ void BenchmarkBytes()
         text.clear();
     }
     const double voxels = std::string(w.name) == "sweeping" ? 160.0 * 160 * 160 : 256.0 * 256 * 128;
-    const double memory = CountAfter(text, "LLd misses:"), l1 = CountAfter(text, "D1  misses:");
-    if (memory < 0 || l1 < 0)
+    std::map<std::string, double> e = CollectedEvents(text);
+    if (!e.count("DLmr") || !e.count("DLdmw"))
     {
       std::printf("  %-32s could not run valgrind on it (apt-get install valgrind)\n", w.what);
       continue;
     }
-    std::printf("  %-32s %8.1f %10.1f %7.2fx %10.1f\n", w.what, w.mustMove, 64.0 * memory / voxels,
-      64.0 * memory / voxels / w.mustMove, 64.0 * l1 / voxels);
+    const double lines = e["DLmr"] + e["DLmw"] + e["ILmr"] + e["DLdmr"] + e["DLdmw"] + e["ILdmr"];
+    const double memory = 64.0 * lines / voxels;
+    std::printf("  %-32s %8.1f %10.1f %7.2fx %10.1f\n", w.what, w.mustMove, memory, memory / w.mustMove,
+      64.0 * (e["D1mr"] + e["D1mw"]) / voxels);
     std::fflush(stdout);
   }
 }
