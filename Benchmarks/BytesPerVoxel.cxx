@@ -45,13 +45,18 @@ namespace
 /// core's share of a shared L3; the inputs below are several times larger.
 const char* const kCacheModel = "--D1=49152,12,64 --LL=4194304,16,64";
 
-/// One kernel call measured: the bytes a pass must move (its input read once, each output
-/// written once) and its voxels.
+/// The inputs: the generated int16 phantom (8.4 M voxels, 16.8 MB) and, for the sweeping,
+/// the Fig. 3 scene in float32 (4.1 M voxels, 16 MB in, 180 MB out).
+constexpr int kPhantom[3] = { 256, 256, 128 };
+constexpr int kScene = 160;
+
+/// One kernel call measured: the bytes a pass must move per voxel (its input read once,
+/// each output written once).
 struct Workload
 {
   const char* name;
   const char* what;
-  double mustMove; // bytes per voxel
+  double mustMove;
 };
 
 const Workload kWorkloads[] = {
@@ -64,11 +69,11 @@ const Workload kWorkloads[] = {
   { "sweeping", "sweeping, 8 octants (float32)", 4.0 + 4.0 + 4.0 + 32.0 },
 };
 
-/// The generated int16 phantom of the benchmark, 256 x 256 x 128 (8.4 M voxels, 16.8 MB).
+/// The generated int16 phantom of the benchmark, kPhantom in size.
 vtkSmartPointer<vtkImageData> Phantom()
 {
   vtkNew<vtkAmbientOcclusionPhantom> phantom;
-  phantom->SetDimensions(256, 256, 128);
+  phantom->SetDimensions(kPhantom[0], kPhantom[1], kPhantom[2]);
   phantom->Update();
   return phantom->GetOutput();
 }
@@ -78,7 +83,7 @@ int RunOne(const std::string& name)
 {
   if (name == "sweeping")
   {
-    const int n = 160; // 4.1 M voxels: 16 MB in, 180 MB out
+    const int n = kScene;
     const std::vector<float> volume = vaotest::SceneVolume(n, n, n);
     vao::VolumeView view;
     view.data = volume.data();
@@ -178,8 +183,8 @@ void BenchmarkBytes()
               "  64-byte line per last-level miss and per dirty line written back; 'L1', a line per L1d\n"
               "  miss; 'must', the input read once and each output written once (a cache that allocates\n"
               "  lines for writes reads each output line first: the floor's 1.6x). Int16 workloads on the\n"
-              "  256 x 256 x 128 generated phantom, the sweeping on the 160^3 Fig. 3 scene\n",
-    kCacheModel);
+              "  %d x %d x %d generated phantom, the sweeping on the %d^3 Fig. 3 scene\n",
+    kCacheModel, kPhantom[0], kPhantom[1], kPhantom[2], kScene);
   if (!VAO_HAVE_CALLGRIND)
   {
     std::printf("  not measured: built without valgrind/callgrind.h (apt-get install valgrind)\n");
@@ -206,7 +211,8 @@ void BenchmarkBytes()
       if (pclose(pipe) != 0)
         text.clear();
     }
-    const double voxels = std::string(w.name) == "sweeping" ? 160.0 * 160 * 160 : 256.0 * 256 * 128;
+    const double voxels = std::string(w.name) == "sweeping" ? double(kScene) * kScene * kScene
+                                                            : double(kPhantom[0]) * kPhantom[1] * kPhantom[2];
     std::map<std::string, double> e = CollectedEvents(text);
     if (!e.count("DLmr") || !e.count("DLdmw"))
     {
