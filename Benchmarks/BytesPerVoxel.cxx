@@ -174,7 +174,16 @@ std::map<std::string, double> CollectedEvents(const std::string& text)
 
 int RunBytesWorkload(const std::string& name)
 {
-  return RunOne(name);
+  if (name != "all")
+    return RunOne(name);
+  for (const Workload& w : kWorkloads) // the ctest that keeps the table's runs working
+    if (const int status = RunOne(w.name))
+    {
+      std::fprintf(stderr, "workload %s failed\n", w.name);
+      return status;
+    }
+  std::printf("every workload ran\n");
+  return 0;
 }
 
 void BenchmarkBytes()

@@ -9,7 +9,8 @@ namespace vaobench
 /// The table: this program run again under valgrind's cache simulation, once per workload.
 void BenchmarkBytes();
 
-/// One workload, its kernel call alone instrumented (what the table runs); 0 on success.
+/// One workload, its kernel call alone instrumented (what the table runs), or "all" of
+/// them one after another; 0 on success.
 int RunBytesWorkload(const std::string& name);
 
 } // namespace vaobench
