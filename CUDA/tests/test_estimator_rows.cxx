@@ -280,13 +280,15 @@ TEST(EstimatorRows, PiecewiseErfOfAvx512WithinTwoToTheMinus52OfErf)
   std::vector<double> x;
   for (int i = -7 * 8192; i <= 7 * 8192; ++i)
     x.push_back(i / 8192.0 + 1e-6 * std::sin(i)); // off the grid of the pieces' ends too
-  for (int k = 0; k <= 17; ++k)
+  using vao::detail::kErfPieceWidth;
+  const double top = vao::detail::kErfTop;
+  for (int k = 0; k <= vao::detail::kErfPieces + 1; ++k)
   {
-    const double end = 0.375 * k; // where the pieces meet
+    const double end = kErfPieceWidth * k; // where the pieces meet
     for (const double e : { end, std::nextafter(end, 0.0), std::nextafter(end, 10.0) })
       x.insert(x.end(), { e, -e });
   }
-  for (const double e : { 5.9999999, 6.0000001, 1e-300, 4.9e-324, 1e300, -1e300, -0.0 })
+  for (const double e : { top - 1e-7, top + 1e-7, 1e-300, 4.9e-324, 1e300, -1e300, -0.0 })
     x.push_back(e);
   const std::size_t finite = x.size();
   const double inf = std::numeric_limits<double>::infinity();
@@ -299,7 +301,7 @@ TEST(EstimatorRows, PiecewiseErfOfAvx512WithinTwoToTheMinus52OfErf)
     worst = std::fmax(worst, error);
     ASSERT_LE(error, 2.220446049250313e-16) << "x " << x[i] << ": " << y[i] << " against " << std::erf(x[i]);
     ASSERT_LE(std::fabs(y[i]), 1.0) << "x " << x[i];
-    if (std::fabs(x[i]) < 0.375 && x[i] != 0.0) // the first piece: relative accuracy too
+    if (std::fabs(x[i]) < kErfPieceWidth && x[i] != 0.0) // the first piece: relative accuracy too
     {
       worstRelative = std::fmax(worstRelative, error / std::fabs(std::erf(x[i])));
       ASSERT_LE(error, std::ldexp(1.0, -50) * std::fabs(std::erf(x[i]))) << "x " << x[i];

@@ -180,7 +180,7 @@ VAO_LANES D ofPiece(const double* table, I piece)
 /// absolute error alone.
 VAO_LANES D erf(D x)
 {
-  const D a = min(abs(x), set1(6.0)); // 6 for NaN, which is put back below
+  const D a = min(abs(x), set1(kErfTop)); // kErfTop for NaN, which is put back below
   const I piece =
     _mm512_min_epi64(_mm512_cvttpd_epi64(mul(a, set1(1.0 / kErfPieceWidth))), set1(std::int64_t(kErfPieces - 1)));
   const D u = sub(a, ofPiece(kErfOrigins, piece));
@@ -197,7 +197,7 @@ VAO_LANES D erf(D x)
   const D t9 = fusedMultiplyAdd(fusedMultiplyAdd(c[12], u, c[11]), u2, fusedMultiplyAdd(c[10], u, c[9]));
   const D t = fusedMultiplyAdd(t9, u8, fusedMultiplyAdd(t5, u4, t1));
   D p = fusedMultiplyAdd(t, u, c[0]);
-  p = select(greaterEqual(a, set1(6.0)), set1(1.0), p);
+  p = select(greaterEqual(a, set1(kErfTop)), set1(1.0), p);
   const D signed_ = _mm512_xor_pd(p, _mm512_and_pd(x, set1(-0.0)));
   return select(ordered(x), signed_, x);
 }

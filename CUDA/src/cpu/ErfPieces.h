@@ -12,6 +12,8 @@ namespace detail
 constexpr int kErfPieces = 16;
 constexpr int kErfDegree = 12;
 constexpr double kErfPieceWidth = 0.375;
+/// The pieces' end: from here on erf is +-1 in doubles (1 - erf(6) ~ 2e-17).
+constexpr double kErfTop = kErfPieces * kErfPieceWidth;
 /// Piece k's u = x - kErfOrigins[k]: its centre, 0 for the first (erf(x) = x q(x) there).
 alignas(64) constexpr double kErfOrigins[kErfPieces] = { 0.0, 0.5625, 0.9375, 1.3125, 1.6875, 2.0625, 2.4375, 2.8125,
   3.1875, 3.5625, 3.9375, 4.3125, 4.6875, 5.0625, 5.4375, 5.8125 };

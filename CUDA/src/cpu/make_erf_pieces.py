@@ -56,6 +56,8 @@ print("#pragma once\n\nnamespace vao\n{\nnamespace detail\n{\n")
 print("constexpr int kErfPieces = %d;" % PIECES)
 print("constexpr int kErfDegree = %d;" % DEGREE)
 print("constexpr double kErfPieceWidth = %r;" % float(WIDTH))
+print("/// The pieces' end: from here on erf is +-1 in doubles (1 - erf(6) ~ 2e-17).")
+print("constexpr double kErfTop = kErfPieces * kErfPieceWidth;")
 print("/// Piece k's u = x - kErfOrigins[k]: its centre, 0 for the first (erf(x) = x q(x) there).")
 origins = [repr(float(r[1])) for r in rows]
 print("alignas(64) constexpr double kErfOrigins[kErfPieces] = { " + ", ".join(origins[:8]) + ",")
