@@ -56,6 +56,7 @@ VAO_LANES Idx onlyWhere(Mask m, Idx x)
   return _mm_and_si128(narrow, x);
 }
 VAO_LANES void storeIndices(std::int32_t* to, Idx x) { _mm_storeu_si128(reinterpret_cast<__m128i*>(to), x); }
+VAO_LANES Idx loadIndices(const std::int32_t* from) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(from)); }
 VAO_LANES Idx gather(const std::int32_t* base, Idx at)
 {
   alignas(16) std::int32_t i[4];
@@ -101,6 +102,10 @@ VAO_LANES Idx truncate(D u) { return _mm512_cvttpd_epi32(u); }
 VAO_LANES D toDouble(Idx x) { return _mm512_cvtepi32_pd(x); }
 VAO_LANES Idx onlyWhere(Mask m, Idx x) { return _mm256_maskz_mov_epi32(m, x); }
 VAO_LANES void storeIndices(std::int32_t* to, Idx x) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(to), x); }
+VAO_LANES Idx loadIndices(const std::int32_t* from)
+{
+  return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(from));
+}
 VAO_LANES Idx gather(const std::int32_t* base, Idx at)
 {
   alignas(32) std::int32_t i[8];

@@ -64,6 +64,18 @@ struct PointLanes
   {
     return { this->x[k] + d * this->nx[k], this->y[k] + d * this->ny[k], this->z[k] + d * this->nz[k] };
   }
+
+  /// Those positions of every lane, as three arrays (the vector lanes' input).
+  void along(double d, double* atX, double* atY, double* atZ) const
+  {
+    for (int k = 0; k < kLanes; ++k)
+    {
+      const std::array<double, 3> at = this->along(k, d);
+      atX[k] = at[0];
+      atY[k] = at[1];
+      atZ[k] = at[2];
+    }
+  }
 };
 
 /// f(lanes) for every batch of kLanes points of `range`, on every thread, reporting

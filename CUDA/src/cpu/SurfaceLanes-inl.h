@@ -142,6 +142,83 @@ VAO_LANES_ENTRY void prefetchLanes(const LevelGrid& g, const double* x, const do
   }
 }
 
+/// The raw values base[at[k]] as doubles, whatever the volume's type: one load a lane.
+/// Types of up to 16 bits go through one vector of 32-bit integers and one conversion
+/// (a conversion a lane cost the CT head's bone surface AO a tenth more).
+template <class T>
+VAO_LANES D gatherAsDoubles(const T* base, Idx at)
+{
+  alignas(32) std::int32_t i[kWidth];
+  storeIndices(i, at);
+  if constexpr (std::is_integral<T>::value && sizeof(T) <= 2)
+  {
+    alignas(32) std::int32_t v[kWidth];
+    for (int k = 0; k < kWidth; ++k)
+      v[k] = base[i[k]];
+    return toDouble(loadIndices(v));
+  }
+  else
+  {
+    alignas(64) double v[kWidth];
+    for (int k = 0; k < kWidth; ++k)
+      v[k] = static_cast<double>(base[i[k]]);
+    return load(v);
+  }
+}
+
+/// A row's blend along x: v0 (1 - f) + v1 f, with g = 1 - f.
+template <class T>
+VAO_LANES D rawRow(const T* data, Idx at, Idx step, D g, D f)
+{
+  return add(mul(gatherAsDoubles(data, at), g), mul(gatherAsDoubles(data, add(at, step)), f));
+}
+
+/// RawSampler's values at kLanes positions: its clamps, cells and blends, operation for
+/// operation (no fused multiply-add), so the same bits.
+template <class T>
+VAO_LANES_ENTRY void rawLanes(const RawSampler<T>& s, const double* x, const double* y, const double* z, double* out)
+{
+  const D one = set1(1.0);
+  for (int h = 0; h < kLanes; h += kWidth)
+  {
+    const D position[3] = { load(x + h), load(y + h), load(z + h) };
+    Idx base = indices(0), step[3];
+    D f[3], g[3]; // the fractions towards the upper corners, and 1 - them
+    for (int a = 0; a < 3; ++a)
+    {
+      const D maxIndex = set1(s.maxIndex[a]);
+      // max(x, 0) gives 0 for NaN, as RawSampler's std::max(0.0, x) does.
+      const D u = min(max(mul(sub(position[a], set1(s.origin[a])), set1(s.inverseSpacing[a])), zero()), maxIndex);
+      const Idx lower = truncate(u);
+      f[a] = sub(u, toDouble(lower));
+      g[a] = sub(one, f[a]);
+      const Idx stride = indices(s.stride[a]);
+      base = add(base, mul(lower, stride));
+      step[a] = onlyWhere(lessThan(u, maxIndex), stride);
+    }
+    const Idx upper = add(base, step[2]);
+    const D lowerPlane = add(mul(rawRow(s.data, base, step[0], g[0], f[0]), g[1]),
+      mul(rawRow(s.data, add(base, step[1]), step[0], g[0], f[0]), f[1]));
+    const D upperPlane = add(mul(rawRow(s.data, upper, step[0], g[0], f[0]), g[1]),
+      mul(rawRow(s.data, add(upper, step[1]), step[0], g[0], f[0]), f[1]));
+    store(out + h, add(mul(lowerPlane, g[2]), mul(upperPlane, f[2])));
+  }
+}
+
+/// trilinearSample's means at kLanes positions (for the rounding of the blends' fused
+/// multiply-adds).
+VAO_LANES_ENTRY void meanLanes(const LevelGrid& g, const double* x, const double* y, const double* z, double* mean)
+{
+  for (int h = 0; h < kLanes; h += kWidth)
+  {
+    const D position[3] = { load(x + h), load(y + h), load(z + h) };
+    D variance;
+    D m;
+    blend(g, cellsOf(g, position), m, variance);
+    store(mean + h, m);
+  }
+}
+
 /// occlusionLanesPlain for Chebyshev.
 VAO_LANES_ENTRY void chebyshevLanes(const LevelGrid& g, const double* x, const double* y, const double* z,
   const double* query, double* occlusion)

@@ -8,6 +8,7 @@
 #include "EstimatorLanes.h"
 #include "GatherLanes.h"
 #include "LevelGrid.h"
+#include "RawSampler.h"
 
 #include <cmath>
 #include <vector>
@@ -100,6 +101,48 @@ inline void occlusionLanes(const LevelGrid& g, Method estimator, const double* x
   }
 #endif
   occlusionLanesPlain(g, estimator, x, y, z, query, occlusion);
+}
+
+/// RawSampler's values at kLanes positions: rawLanes (SurfaceLanes-inl.h) on AVX2 or
+/// AVX-512 where the volume's indices fit in 32 bits, else one position at a time.
+template <class T>
+void rawLanes(const RawSampler<T>& s, const double* x, const double* y, const double* z, double* out)
+{
+#if VAO_HAVE_AVX2_TARGET
+  const SimdTier tier = cpuSimdTier();
+  if (tier >= SimdTier::Avx2 && s.narrowIndices)
+  {
+    if (tier == SimdTier::Avx512)
+      avx512::rawLanes(s, x, y, z, out);
+    else
+      avx2::rawLanes(s, x, y, z, out);
+    return;
+  }
+#endif
+  for (int k = 0; k < kLanes; ++k)
+    out[k] = s({ x[k], y[k], z[k] });
+}
+
+/// trilinearSample's means at kLanes positions: meanLanes (SurfaceLanes-inl.h) where the
+/// vector lanes apply.
+inline void meanLanes(const LevelGrid& g, const double* x, const double* y, const double* z, double* mean)
+{
+#if VAO_HAVE_AVX2_TARGET
+  const SimdTier tier = cpuSimdTier();
+  if (tier >= SimdTier::Avx2 && g.narrowIndices)
+  {
+    if (tier == SimdTier::Avx512)
+      avx512::meanLanes(g, x, y, z, mean);
+    else
+      avx2::meanLanes(g, x, y, z, mean);
+    return;
+  }
+#endif
+  for (int k = 0; k < kLanes; ++k)
+  {
+    double variance;
+    trilinearSample(g, x[k], y[k], z[k], mean[k], variance);
+  }
 }
 
 /// prefetchLanes (SurfaceLanes-inl.h) where the vector lanes apply.

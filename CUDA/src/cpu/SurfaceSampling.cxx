@@ -22,57 +22,7 @@ namespace
 
 using detail::MarchBounds;
 using detail::PointLanes;
-
-/// Trilinear values of the raw volume at world positions, clamped to its bounds, with the
-/// divisions by the spacing and the strides done once for a query's many samples.
-template <class T>
-struct RawSampler
-{
-  detail::TypedVolume<T> volume;
-  double origin[3], inverseSpacing[3], maxIndex[3];
-  std::int64_t stride[3];
-
-  RawSampler(const detail::TypedVolume<T>& typed, const std::array<double, 3>& origin,
-    const std::array<double, 3>& spacing)
-    : volume(typed)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      this->origin[a] = origin[a];
-      this->inverseSpacing[a] = 1.0 / spacing[a];
-      this->maxIndex[a] = static_cast<double>(typed.dims[a] - 1);
-    }
-    this->stride[0] = typed.stride;
-    this->stride[1] = typed.dims[0] * typed.stride;
-    this->stride[2] = typed.dims[0] * typed.dims[1] * typed.stride;
-  }
-
-  /// The cell's lower corner, the steps to the upper one (0 where clamped) and the
-  /// fractions towards it; then nested blends along x, y, z.
-  double operator()(const std::array<double, 3>& position) const
-  {
-    std::int64_t base = 0, step[3];
-    double f[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      // max(0, ...) first: a position on the origin of a spacing whose inverse overflows
-      // (a subnormal one) gives 0 * inf, NaN, which this takes to the first voxel.
-      const double u = std::min(std::max(0.0, (position[a] - this->origin[a]) * this->inverseSpacing[a]),
-        this->maxIndex[a]);
-      const std::int64_t lower = static_cast<std::int64_t>(u); // u >= 0: truncation is the floor
-      f[a] = u - static_cast<double>(lower);
-      base += lower * this->stride[a];
-      step[a] = u < this->maxIndex[a] ? this->stride[a] : 0;
-    }
-    const T* c = this->volume.data + base;
-    auto row = [&](std::int64_t i) {
-      return static_cast<double>(c[i]) * (1 - f[0]) + static_cast<double>(c[i + step[0]]) * f[0];
-    };
-    const double lowerPlane = row(0) * (1 - f[1]) + row(step[1]) * f[1];
-    const double upperPlane = row(step[2]) * (1 - f[1]) + row(step[2] + step[1]) * f[1];
-    return lowerPlane * (1 - f[2]) + upperPlane * f[2];
-  }
-};
+using detail::RawSampler;
 
 /// The levels a query uses, prepared for sampling.
 struct PreparedPyramid
@@ -138,22 +88,16 @@ namespace
 
 /// The occlusions of a batch of surface points from the levels used (sampled at
 /// p + k r_l n, combined by maximum or mean).
-void batchOcclusion(const PreparedPyramid& pyramid, int levels, const PointLanes& lanes,
-  const SurfaceOcclusionParameters& parameters, double* combined)
+template <class Query>
+void batchOcclusion(const PreparedPyramid& pyramid, int levels, PointLanes& lanes,
+  const SurfaceOcclusionParameters& parameters, const Query& query, double* combined)
 {
   constexpr int W = detail::kLanes;
   double x[2][W], y[2][W], z[2][W], occlusion[W];
   std::fill(combined, combined + W, 0.0);
   // Level l's sample positions, in slot l % 2.
   const auto positions = [&](int l) {
-    const double offset = parameters.offsetFactor * pyramid.kernelRadius[l];
-    for (int k = 0; k < W; ++k)
-    {
-      const std::array<double, 3> at = lanes.along(k, offset);
-      x[l % 2][k] = at[0];
-      y[l % 2][k] = at[1];
-      z[l % 2][k] = at[2];
-    }
+    lanes.along(parameters.offsetFactor * pyramid.kernelRadius[l], x[l % 2], y[l % 2], z[l % 2]);
   };
   // Levels 0 and 1 (96% of a pyramid's bytes) are far larger than the caches: the batch
   // first asks for their lines, so their misses overlap (CT head bone surface AO on the
@@ -163,6 +107,7 @@ void batchOcclusion(const PreparedPyramid& pyramid, int levels, const PointLanes
     positions(l);
     detail::prefetchLanes(pyramid.grids[l], x[l], y[l], z[l]);
   }
+  query(lanes); // after the requests: its own misses (the raw volume's) overlap theirs
   for (int l = 0; l < levels; ++l)
   {
     if (l >= 2)
@@ -275,13 +220,19 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles
   const bool finished = detail::dispatchScalarType(half ? volume.type : ScalarType::Float32, [&](auto tag) {
     const RawSampler<decltype(tag)> raw(detail::TypedVolume<decltype(tag)>(half ? volume : VolumeView{}),
       half ? origin : std::array<double, 3>{ 0, 0, 0 }, half ? spacing : std::array<double, 3>{ 1, 1, 1 });
-    return detail::sweepPoints(tiles, points, normals, count, execution, mark, [&](PointLanes& lanes) {
-      for (int k = 0; k < detail::kLanes; ++k)
+    const auto query = [&](PointLanes& lanes) {
+      if (half)
       {
-        lanes.query[k] = half ? raw(lanes.along(k, -0.5 * h)) : parameters.isoValue;
+        double x[detail::kLanes], y[detail::kLanes], z[detail::kLanes];
+        lanes.along(-0.5 * h, x, y, z);
+        detail::rawLanes(raw, x, y, z, lanes.query);
       }
+      else
+        std::fill(lanes.query, lanes.query + detail::kLanes, parameters.isoValue);
+    };
+    return detail::sweepPoints(tiles, points, normals, count, execution, mark, [&](PointLanes& lanes) {
       double occlusion[detail::kLanes];
-      batchOcclusion(prepared, levels, lanes, parameters, occlusion);
+      batchOcclusion(prepared, levels, lanes, parameters, query, occlusion);
       for (int k = 0; k < lanes.used; ++k)
       {
         out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
@@ -340,17 +291,15 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
   };
   prepared.boundCells(count);
   const bool finished = detail::sweepPoints(tiles, points, normals, count, execution, mark, [&](PointLanes& lanes) {
-    for (int k = 0; k < detail::kLanes; ++k)
+    if (parameters.query == SurfaceQuery::HalfVoxelInside)
     {
-      lanes.query[k] = parameters.isoValue;
-      if (parameters.query == SurfaceQuery::HalfVoxelInside)
-      {
-        // No raw volume here: level 0's (blurred) mean half a voxel inside.
-        const std::array<double, 3> inside = lanes.along(k, -0.5 * h);
-        double variance = 0.0;
-        detail::trilinearSample(prepared.grids[0], inside[0], inside[1], inside[2], lanes.query[k], variance);
-      }
+      // No raw volume here: level 0's (blurred) mean half a voxel inside.
+      double x[detail::kLanes], y[detail::kLanes], z[detail::kLanes];
+      lanes.along(-0.5 * h, x, y, z);
+      detail::meanLanes(prepared.grids[0], x, y, z, lanes.query);
     }
+    else
+      std::fill(lanes.query, lanes.query + detail::kLanes, parameters.isoValue);
     double occlusion[detail::kLanes];
     batchMarch(prepared, bounds, schedule, lanes, light, parameters.estimator, occlusion);
     for (int k = 0; k < lanes.used; ++k)

@@ -1,0 +1,159 @@
+// The surface queries' per-point query values in vector lanes (SurfaceLanes.h): the raw
+// volume half a voxel inside (AO) and level 0's mean there (shadows), on each vector tier,
+// against the scalar definitions (RawSampler.h, trilinearSample) and against a trilinear
+// value written here from its definition.
+#include "../src/cpu/SurfaceLanes.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+namespace
+{
+
+using Vec3 = std::array<double, 3>;
+
+/// The trilinear value at world p of a grid of `dims` values get(i, j, k), p clamped to
+/// the grid: linear along x on the cell's four x edges, then along y, then along z.
+template <class Get>
+double nestedTrilinear(const vao::Index3& dims, const Vec3& origin, const Vec3& spacing, const Vec3& p, Get get)
+{
+  std::int64_t lower[3], upper[3];
+  double t[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const double u = std::min(std::max((p[a] - origin[a]) / spacing[a], 0.0), static_cast<double>(dims[a] - 1));
+    lower[a] = static_cast<std::int64_t>(std::floor(u));
+    upper[a] = std::min<std::int64_t>(lower[a] + 1, dims[a] - 1);
+    t[a] = u - std::floor(u);
+  }
+  const auto along = [](double a, double b, double f) { return a + f * (b - a); };
+  double plane[2];
+  for (int k = 0; k < 2; ++k)
+  {
+    const std::int64_t z = k ? upper[2] : lower[2];
+    const double front = along(get(lower[0], lower[1], z), get(upper[0], lower[1], z), t[0]);
+    const double back = along(get(lower[0], upper[1], z), get(upper[0], upper[1], z), t[0]);
+    plane[k] = along(front, back, t[1]);
+  }
+  return along(plane[0], plane[1], t[2]);
+}
+
+/// rawLanes on each vector tier against RawSampler (the same bits: the same operations)
+/// and against refTrilinear, for a volume of T with `components` values a voxel.
+template <class T>
+void checkRawLanes(T low, T high, int components)
+{
+  const vao::Index3 dims{ 7, 5, 4 };
+  const Vec3 origin{ -1.0, 2.0, 0.25 }, spacing{ 0.5, 1.5, 3.0 };
+  std::vector<T> values(static_cast<std::size_t>(components * dims[0] * dims[1] * dims[2]));
+  std::mt19937_64 rng(static_cast<unsigned>(sizeof(T) * 10 + components));
+  std::uniform_real_distribution<double> fraction(0.0, 1.0);
+  const double lowest = static_cast<double>(low), span = static_cast<double>(high) - lowest;
+  for (T& v : values) // the far ends of the type, and values between
+    v = fraction(rng) < 0.2 ? (fraction(rng) < 0.5 ? low : high) : static_cast<T>(lowest + fraction(rng) * span);
+  vao::VolumeView view;
+  view.data = values.data();
+  view.dims = dims;
+  view.voxelStride = components;
+  const vao::detail::RawSampler<T> sampler(vao::detail::TypedVolume<T>(view), origin, spacing);
+  ASSERT_TRUE(sampler.narrowIndices);
+  std::uniform_real_distribution<double> where(-5.0, 15.0);
+  constexpr int W = vao::detail::kLanes;
+  for (int batch = 0; batch < 100; ++batch)
+  {
+    double x[W], y[W], z[W], vector[W];
+    for (int k = 0; k < W; ++k)
+    {
+      x[k] = k == 0 ? origin[0] + (dims[0] - 1) * spacing[0] : where(rng); // on the last x face
+      y[k] = k == 1 ? std::nan("") : where(rng);                            // NaN: the first voxel
+      z[k] = k == 2 ? origin[2] : where(rng);
+    }
+    for (const vao::detail::SimdTier tier : { vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
+    {
+      vao::detail::limitSimdTier(tier);
+      vao::detail::rawLanes(sampler, x, y, z, vector);
+      vao::detail::limitSimdTier(vao::detail::SimdTier::Avx512);
+      for (int k = 0; k < W; ++k)
+      {
+        const double scalar = sampler({ x[k], y[k], z[k] });
+        EXPECT_EQ(vector[k], scalar) << "lane " << k << ", tier " << static_cast<int>(tier) << ", " << sizeof(T) << " bytes";
+        const Vec3 p{ x[k], std::isnan(y[k]) ? origin[1] : y[k], z[k] };
+        const double reference = nestedTrilinear(dims, origin, spacing, p, [&](std::int64_t i, std::int64_t j, std::int64_t l) {
+          return static_cast<double>(values[static_cast<std::size_t>(components * ((l * dims[1] + j) * dims[0] + i))]);
+        });
+        EXPECT_NEAR(vector[k], reference, 1e-12 * std::max(1.0, static_cast<double>(high))) << "lane " << k;
+      }
+    }
+  }
+}
+
+} // namespace
+
+TEST(SurfaceLanes, RawQueryLanesEqualTheScalarSamplerForEveryType)
+{
+  for (const int components : { 1, 3 })
+  {
+    checkRawLanes<std::int8_t>(-128, 127, components);
+    checkRawLanes<std::uint8_t>(0, 255, components);
+    checkRawLanes<std::int16_t>(-32768, 32767, components);
+    checkRawLanes<std::uint16_t>(0, 65535, components);
+    checkRawLanes<std::int32_t>(
+      std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max(), components);
+    checkRawLanes<std::uint32_t>(0, std::numeric_limits<std::uint32_t>::max(), components);
+    checkRawLanes<std::int64_t>(-(std::int64_t(1) << 62), std::int64_t(1) << 62, components);
+    checkRawLanes<std::uint64_t>(0, std::uint64_t(1) << 63, components);
+    checkRawLanes<float>(-3e38f, 3e38f, components);
+    checkRawLanes<double>(-1e300, 1e300, components);
+  }
+}
+
+TEST(SurfaceLanes, MeanLanesEqualTheTrilinearSample)
+{
+  for (const vao::Index3 dims : { vao::Index3{ 9, 7, 5 }, vao::Index3{ 1, 5, 3 } })
+  {
+    vao::MomentLevel level;
+    level.dims = dims;
+    level.origin = { 1.0, -2.0, 0.5 };
+    level.spacing = { 1.5, 0.5, 2.0 };
+    const auto n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> value(-50.0, 50.0), where(-4.0, 16.0);
+    level.mean.resize(n);
+    level.variance.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      level.mean[i] = static_cast<float>(value(rng));
+    const vao::detail::LevelGrid grid(level);
+    constexpr int W = vao::detail::kLanes;
+    for (int batch = 0; batch < 100; ++batch)
+    {
+      double x[W], y[W], z[W], vector[W];
+      for (int k = 0; k < W; ++k)
+      {
+        x[k] = where(rng);
+        y[k] = where(rng);
+        z[k] = where(rng);
+      }
+      for (const vao::detail::SimdTier tier : { vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
+      {
+        vao::detail::limitSimdTier(tier);
+        vao::detail::meanLanes(grid, x, y, z, vector);
+        vao::detail::limitSimdTier(vao::detail::SimdTier::Avx512);
+        for (int k = 0; k < W; ++k)
+        {
+          const double reference = nestedTrilinear(
+            dims, level.origin, level.spacing, { x[k], y[k], z[k] }, [&](std::int64_t i, std::int64_t j, std::int64_t l) {
+              return static_cast<double>(level.mean[static_cast<std::size_t>((l * dims[1] + j) * dims[0] + i)]);
+            });
+          EXPECT_NEAR(vector[k], reference, 1e-12) << "lane " << k << ", tier " << static_cast<int>(tier);
+        }
+      }
+    }
+  }
+}
