@@ -1,7 +1,8 @@
 // The surface queries' per-point query values in vector lanes (SurfaceLanes.h): the raw
 // volume half a voxel inside (AO) and level 0's mean there (shadows), on each vector tier,
 // against the scalar definitions (RawSampler.h, trilinearSample) and against a trilinear
-// value written here from its definition.
+// value written here from its definition. Also the ray bounds of the shadow march.
+#include "../src/cpu/RayBounds.h"
 #include "../src/cpu/SurfaceLanes.h"
 
 #include <gtest/gtest.h>
@@ -83,11 +84,13 @@ void checkRawLanes(T low, T high, int components)
       for (int k = 0; k < W; ++k)
       {
         const double scalar = sampler({ x[k], y[k], z[k] });
-        EXPECT_EQ(vector[k], scalar) << "lane " << k << ", tier " << static_cast<int>(tier) << ", " << sizeof(T) << " bytes";
+        EXPECT_EQ(vector[k], scalar) << "lane " << k << ", tier " << static_cast<int>(tier) << ", " << sizeof(T)
+                                     << " bytes";
         const Vec3 p{ x[k], std::isnan(y[k]) ? origin[1] : y[k], z[k] };
-        const double reference = nestedTrilinear(dims, origin, spacing, p, [&](std::int64_t i, std::int64_t j, std::int64_t l) {
+        const auto value = [&](std::int64_t i, std::int64_t j, std::int64_t l) {
           return static_cast<double>(values[static_cast<std::size_t>(components * ((l * dims[1] + j) * dims[0] + i))]);
-        });
+        };
+        const double reference = nestedTrilinear(dims, origin, spacing, p, value);
         EXPECT_NEAR(vector[k], reference, 1e-12 * std::max(1.0, static_cast<double>(high))) << "lane " << k;
       }
     }
@@ -147,13 +150,83 @@ TEST(SurfaceLanes, MeanLanesEqualTheTrilinearSample)
         vao::detail::limitSimdTier(vao::detail::SimdTier::Avx512);
         for (int k = 0; k < W; ++k)
         {
-          const double reference = nestedTrilinear(
-            dims, level.origin, level.spacing, { x[k], y[k], z[k] }, [&](std::int64_t i, std::int64_t j, std::int64_t l) {
-              return static_cast<double>(level.mean[static_cast<std::size_t>((l * dims[1] + j) * dims[0] + i)]);
-            });
+          const auto mean = [&](std::int64_t i, std::int64_t j, std::int64_t l) {
+            return static_cast<double>(level.mean[static_cast<std::size_t>((l * dims[1] + j) * dims[0] + i)]);
+          };
+          const double reference = nestedTrilinear(dims, level.origin, level.spacing, { x[k], y[k], z[k] }, mean);
           EXPECT_NEAR(vector[k], reference, 1e-12) << "lane " << k << ", tier " << static_cast<int>(tier);
         }
       }
     }
   }
+}
+
+TEST(SurfaceLanes, RayBoundsHoldEveryCellBoundAheadOnTheRay)
+{
+  // Levels with one-voxel axes, unpaired x rows, anisotropic spacing; lights along the
+  // axes, the diagonals and at random; steps shorter and longer than a cell.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> value(-50.0, 50.0), unit(0.0, 1.0), direction(-1.0, 1.0);
+  int checked = 0;
+  for (const vao::Index3 dims : { vao::Index3{ 9, 7, 5 }, vao::Index3{ 1, 6, 4 }, vao::Index3{ 8, 1, 1 } })
+  {
+    vao::MomentLevel level;
+    level.dims = dims;
+    level.origin = { 1.0, -2.0, 0.5 };
+    level.spacing = { 1.5, 0.5, 2.0 };
+    const auto n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
+    level.mean.resize(n);
+    level.variance.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      level.mean[i] = static_cast<float>(value(rng));
+      level.variance[i] = static_cast<float>(std::fabs(value(rng)));
+    }
+    vao::detail::LevelGrid grid(level);
+    const vao::detail::CellBounds cells(level, grid);
+    for (int trial = 0; trial < 60; ++trial)
+    {
+      Vec3 light = { direction(rng), direction(rng), direction(rng) };
+      if (trial < 6) // along an axis, either way
+        light = { trial / 2 == 0 ? 1.0 : 0.0, trial / 2 == 1 ? 1.0 : 0.0, trial / 2 == 2 ? 1.0 : 0.0 };
+      if (trial < 6 && trial % 2)
+        light = { -light[0], -light[1], -light[2] };
+      const double length = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
+      for (double& c : light)
+        c /= length;
+      const double step = trial % 3 == 0 ? 0.3 : trial % 3 == 1 ? 1.7 : 4.5;
+      const vao::detail::RayBounds rays(grid, step, light);
+      for (int start = 0; start < 40; ++start)
+      {
+        // A start anywhere around the level, and the steps of a march from it.
+        Vec3 from;
+        for (int a = 0; a < 3; ++a)
+          from[a] = level.origin[a] + (unit(rng) * 1.4 - 0.2) * dims[a] * level.spacing[a];
+        // The cell of a world position: its lower corner, clamped (the last x voxel is the
+        // upper corner of the cell below it where a row has two or more).
+        const auto cellOf = [&](const Vec3& p) {
+          std::int64_t c[3];
+          for (int a = 0; a < 3; ++a)
+          {
+            const double u = std::clamp((p[a] - level.origin[a]) / level.spacing[a], 0.0, dims[a] - 1.0);
+            c[a] = static_cast<std::int64_t>(std::floor(u));
+          }
+          if (dims[0] >= 2)
+            c[0] = std::min<std::int64_t>(c[0], dims[0] - 2);
+          return (c[2] * dims[1] + c[1]) * dims[0] + c[0];
+        };
+        const std::int64_t first = cellOf(from);
+        double t = 0.0;
+        for (int k = 0; k < 30; ++k, t += step)
+        {
+          const Vec3 at = { from[0] + t * light[0], from[1] + t * light[1], from[2] + t * light[2] };
+          const std::int64_t c = cellOf(at);
+          EXPECT_LE(grid.cellBounds[2 * c], rays.data()[2 * first]) << "trial " << trial << ", step " << k;
+          EXPECT_LE(grid.cellBounds[2 * c + 1], rays.data()[2 * first + 1]) << "trial " << trial << ", step " << k;
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, 3 * 60 * 40 * 30);
 }

@@ -4,6 +4,7 @@
 // volume (no flat neighbourhood, so the flat rule never decides), anisotropic spacing, an
 // origin off zero, unnormalised normals, and point counts around the lane width of the
 // implementation. Also the lanes' vector path against their plain loop.
+#include "../src/cpu/RayBounds.h"
 #include "../src/cpu/SurfaceLanes.h"
 #include "vao/VarianceOcclusionMap.h"
 
@@ -365,9 +366,15 @@ TEST(SurfaceLanes, MarchPassingOverBoundedCellsEqualsTheFullMarch)
     using vao::detail::SimdTier;
     vao::detail::chebyshevMarch(SimdTier::Avx2, bare.data(), schedule, lo, hi, start, light.data(), q, full);
     vao::detail::chebyshevMarch(SimdTier::Avx2, bounded.data(), schedule, lo, hi, start, light.data(), q, passed);
+    // Lanes stopped where nothing ahead can raise them: the same maxima.
+    const vao::detail::RayBounds rays(bounded[levels - 1], vao::detail::kMarchStepFraction * radius[levels - 1], light);
+    double stopped[W];
+    vao::detail::chebyshevMarch(
+      SimdTier::Avx2, bounded.data(), schedule, lo, hi, start, light.data(), q, stopped, rays.data(), levels - 1);
     for (int k = 0; k < W; ++k)
     {
       EXPECT_NEAR(passed[k], full[k], 1e-12) << "batch " << batch << ", lane " << k;
+      EXPECT_EQ(stopped[k], passed[k]) << "ray bounds, batch " << batch << ", lane " << k;
       occluded += full[k] > 0.01 && full[k] < 0.99;
       ++lanes;
     }
@@ -375,8 +382,8 @@ TEST(SurfaceLanes, MarchPassingOverBoundedCellsEqualsTheFullMarch)
     if (vao::detail::cpuSimdTier() == SimdTier::Avx512)
     {
       double wide[W];
-      vao::detail::chebyshevMarch(
-        SimdTier::Avx512, bounded.data(), schedule, lo, hi, start, light.data(), q, wide);
+      vao::detail::chebyshevMarch(SimdTier::Avx512, bounded.data(), schedule, lo, hi, start, light.data(), q, wide,
+        rays.data(), levels - 1);
       for (int k = 0; k < W; ++k)
         EXPECT_EQ(wide[k], passed[k]) << "AVX-512, batch " << batch << ", lane " << k;
       ++wideBatches;

@@ -109,12 +109,13 @@ VAO_LANES D chebyshevOcclusion(const LevelGrid& g, const Cells& c, D q)
     set1(g.roundingSpread)));
 }
 
-/// Upper bounds of the Chebyshev occlusion of q in the cells, from the level's CellBounds:
-/// 1 where q is not above the cell's largest mean or the bound is NaN.
-VAO_LANES D chebyshevBound(const LevelGrid& g, const Cells& c, D q)
+/// Upper bounds of the Chebyshev occlusion of q from (largest mean, largest variance)
+/// pairs indexed like the cells (CellBounds, RayBounds): 1 where q is not above the mean
+/// or the bound is NaN.
+VAO_LANES D chebyshevBound(const float* pairs, const Cells& c, D q)
 {
   D mean, variance;
-  gatherPairs<8>(g.cellBounds, c.base, mean, variance);
+  gatherPairs<8>(pairs, c.base, mean, variance);
   const D d = sub(q, mean);
   const D share = div(variance, add(variance, mul(d, d)));
   return select(both(greaterThan(d, zero()), ordered(share)), share, set1(1.0));
@@ -233,10 +234,10 @@ VAO_LANES_ENTRY void chebyshevLanes(const LevelGrid& g, const double* x, const d
 /// it follows lane by lane) with the positions, bounds, occlusions and the lanes still
 /// marching in registers: from start (x, y, z per lane) along the unit light, inside
 /// [lo, hi], the steps of `schedule` (marchSchedule), on levels whose indices fit in 32
-/// bits.
+/// bits. `rays`: null, or the RayBounds of level `rayLevel`, the schedule's last.
 VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const MarchStep* schedule, std::size_t steps,
   const double* lo, const double* hi, const double* const* start, const double* light, const double* query,
-  double* occlusion)
+  double* occlusion, const float* rays, int rayLevel)
 {
   const D full = set1(kMarchFullOcclusion);
   D occ[kVectors], q[kVectors], from[kVectors][3];
@@ -274,9 +275,14 @@ VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const MarchStep* sch
         continue;
       const Cells cells = cellsOf(grid, at[h]);
       // No lane still marching can rise above its occlusion here: the sample is passed
-      // over, as the maximum it would enter is already held.
-      if (grid.cellBounds && none(butNot(alive[h], lessEqual(chebyshevBound(grid, cells, q[h]), occ[h]))))
+      // over, as the maximum it would enter is already held. Lanes that nothing on the
+      // rest of their ray can raise stop.
+      if (grid.cellBounds && none(butNot(alive[h], lessEqual(chebyshevBound(grid.cellBounds, cells, q[h]), occ[h]))))
+      {
+        if (rays && schedule[s].level == rayLevel)
+          alive[h] = butNot(alive[h], lessEqual(chebyshevBound(rays, cells, q[h]), occ[h]));
         continue;
+      }
       const D sample = chebyshevOcclusion(grid, cells, q[h]);
       occ[h] = select(alive[h], max(sample, occ[h]), occ[h]);
       alive[h] = both(alive[h], lessThan(occ[h], full));

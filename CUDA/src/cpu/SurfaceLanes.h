@@ -71,15 +71,14 @@ namespace avx512
 } // namespace avx512
 
 /// The Chebyshev shadow march of a batch (SurfaceLanes-inl.h) in the widest tier the
-/// processor has: `tier` is Avx2 or Avx512.
+/// processor has: `tier` is Avx2 or Avx512. `rays`: null, or the RayBounds (their data)
+/// of the schedule's last level, `rayLevel`.
 inline void chebyshevMarch(SimdTier tier, const LevelGrid* grids, const std::vector<MarchStep>& schedule,
   const double* lo, const double* hi, const double* const* start, const double* light, const double* query,
-  double* occlusion)
+  double* occlusion, const float* rays = nullptr, int rayLevel = -1)
 {
-  if (tier == SimdTier::Avx512)
-    avx512::chebyshevMarch(grids, schedule.data(), schedule.size(), lo, hi, start, light, query, occlusion);
-  else
-    avx2::chebyshevMarch(grids, schedule.data(), schedule.size(), lo, hi, start, light, query, occlusion);
+  const auto march = tier == SimdTier::Avx512 ? avx512::chebyshevMarch : avx2::chebyshevMarch;
+  march(grids, schedule.data(), schedule.size(), lo, hi, start, light, query, occlusion, rays, rayLevel);
 }
 #endif
 
