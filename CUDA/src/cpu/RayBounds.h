@@ -28,32 +28,34 @@ public:
   /// unit `light`.
   RayBounds(const LevelGrid& grid, double step, const std::array<double, 3>& light)
   {
-    std::int64_t n[3];
+    std::int64_t n[3], top[3];
+    bool forward[3];
+    Reach reach[3];
     for (int a = 0; a < 3; ++a)
     {
       n[a] = static_cast<std::int64_t>(grid.maxIndex[a]) + 1;
       // The last cell along a, as cellsOf finds it: x's last voxel is the upper corner of
       // the cell below it where the rows are paired.
-      this->top[a] = a == 0 && grid.pairedRows ? n[a] - 2 : n[a] - 1;
-      this->maxIndex[a] = grid.maxIndex[a];
-      this->move[a] = step * light[a] * grid.inverseSpacing[a];
-      this->reachable(a);
+      top[a] = a == 0 && grid.pairedRows ? n[a] - 2 : n[a] - 1;
+      const double move = step * light[a] * grid.inverseSpacing[a]; // one step in index units
+      forward[a] = move > 0;
+      reach[a] = reachable(move, top[a], grid.maxIndex[a]);
     }
     const float* cells = grid.cellBounds;
     this->pairs.assign(cells, cells + 2 * n[0] * n[1] * n[2]);
     // Every cell reached from a cell lies towards the move along each axis (or level with
     // it), so taking the cells in that order from the far side finds each one's successors
     // done.
-    auto along = [this](int a, std::int64_t i) { return this->move[a] > 0 ? this->top[a] - i : i; };
-    for (std::int64_t iz = 0; iz <= this->top[2]; ++iz)
-      for (std::int64_t iy = 0; iy <= this->top[1]; ++iy)
-        for (std::int64_t ix = 0; ix <= this->top[0]; ++ix)
+    auto along = [&](int a, std::int64_t i) { return forward[a] ? top[a] - i : i; };
+    for (std::int64_t iz = 0; iz <= top[2]; ++iz)
+      for (std::int64_t iy = 0; iy <= top[1]; ++iy)
+        for (std::int64_t ix = 0; ix <= top[0]; ++ix)
         {
           const std::int64_t c[3] = { along(0, ix), along(1, iy), along(2, iz) };
           float* at = &this->pairs[2 * ((c[2] * n[1] + c[1]) * n[0] + c[0])];
-          for (std::int64_t z = this->first[2][c[2]]; z <= this->last[2][c[2]]; ++z)
-            for (std::int64_t y = this->first[1][c[1]]; y <= this->last[1][c[1]]; ++y)
-              for (std::int64_t x = this->first[0][c[0]]; x <= this->last[0][c[0]]; ++x)
+          for (std::int64_t z = reach[2].first[c[2]]; z <= reach[2].last[c[2]]; ++z)
+            for (std::int64_t y = reach[1].first[c[1]]; y <= reach[1].last[c[1]]; ++y)
+              for (std::int64_t x = reach[0].first[c[0]]; x <= reach[0].last[c[0]]; ++x)
               {
                 const float* next = &this->pairs[2 * ((z * n[1] + y) * n[0] + x)];
                 at[0] = std::max(at[0], next[0]);
@@ -66,42 +68,44 @@ public:
   const float* data() const { return this->pairs.data(); }
 
 private:
-  /// The cells along axis a that one step reaches from each cell: its positions move
-  /// only towards the move's sign (the rounding of start + t light is monotone in t), by
-  /// the move give or take a rounding. The first and last cells hold every position
-  /// beyond them (cellsOf clamps).
-  void reachable(int a)
+  /// Along one axis, the first and last cells that one step reaches from each cell.
+  struct Reach
+  {
+    std::vector<std::int64_t> first, last;
+  };
+
+  /// The cells 0..top along an axis of maxIndex + 1 voxels that one step of `move` (index
+  /// units) reaches from each: its positions move only towards the move's sign (the
+  /// rounding of start + t light is monotone in t), by the move give or take a rounding.
+  /// The first and last cells hold every position beyond them (cellsOf clamps).
+  static Reach reachable(double move, std::int64_t top, double maxIndex)
   {
     constexpr double kSlack = 1e-6; // index units: far above the positions' rounding
-    const double d = this->move[a];
-    const std::int64_t end = this->top[a];
     auto cellOf = [&](double u) {
-      return std::min(end, static_cast<std::int64_t>(std::floor(std::min(std::max(u, 0.0), this->maxIndex[a]))));
+      return std::min(top, static_cast<std::int64_t>(std::floor(std::min(std::max(u, 0.0), maxIndex))));
     };
-    this->first[a].resize(static_cast<std::size_t>(end + 1));
-    this->last[a].resize(static_cast<std::size_t>(end + 1));
-    for (std::int64_t c = 0; c <= end; ++c)
+    Reach reach;
+    reach.first.resize(static_cast<std::size_t>(top + 1));
+    reach.last.resize(static_cast<std::size_t>(top + 1));
+    for (std::int64_t c = 0; c <= top; ++c)
     {
       std::int64_t low = c, high = c;
-      if (d > 0)
+      if (move > 0)
       {
-        low = c == 0 ? 0 : std::max(c, cellOf(c + d - kSlack));
-        high = c == end ? end : cellOf(c + 1 + d + kSlack);
+        low = c == 0 ? 0 : std::max(c, cellOf(c + move - kSlack));
+        high = c == top ? top : cellOf(c + 1 + move + kSlack);
       }
-      else if (d < 0)
+      else if (move < 0)
       {
-        low = c == 0 ? 0 : cellOf(c + d - kSlack);
-        high = c == end ? end : std::min(c, cellOf(c + 1 + d + kSlack));
+        low = c == 0 ? 0 : cellOf(c + move - kSlack);
+        high = c == top ? top : std::min(c, cellOf(c + 1 + move + kSlack));
       }
-      this->first[a][c] = low;
-      this->last[a][c] = high;
+      reach.first[c] = low;
+      reach.last[c] = high;
     }
+    return reach;
   }
 
-  std::int64_t top[3];
-  double maxIndex[3];
-  double move[3]; // one step in index units
-  std::vector<std::int64_t> first[3], last[3];
   std::vector<float> pairs;
 };
 

@@ -70,13 +70,11 @@ struct PreparedPyramid
   {
     const int last = static_cast<int>(this->grids.size()) - 1;
     if (last >= 0 && this->grids[last].cellBounds)
-    {
       this->rays.emplace_back(this->grids[last], detail::kMarchStepFraction * this->kernelRadius[last], light);
-      this->rayLevel = last;
-    }
   }
+  /// The ray bounds (null without them) and their level, the last.
   const float* rayBounds() const { return this->rays.empty() ? nullptr : this->rays.front().data(); }
-  int rayLevel = -1;
+  int rayLevel() const { return static_cast<int>(this->grids.size()) - 1; }
 
 private:
   std::vector<const MomentLevel*> levels;
@@ -161,7 +159,7 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, const
     const double* start[3] = { sx, sy, sz };
     detail::chebyshevMarch(
       pyramid.tier, pyramid.grids.data(), schedule, bounds.lo, bounds.hi, start, light.data(), lanes.query, occlusion,
-      pyramid.rayBounds(), pyramid.rayLevel);
+      pyramid.rayBounds(), pyramid.rayLevel());
     return;
   }
 #endif
