@@ -327,26 +327,27 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
   return finished ? Status::success() : Status::cancelled();
 }
 
-/// The queries on a SurfacePyramid: building tiles may run out of memory.
+/// Every query's entry: its buffers (cell and ray bounds, sweep order) and, on a
+/// SurfacePyramid, the tiles it builds may run out of memory, which becomes a Status.
+const char* const kQueryBuffers = "the surface query's buffers (tiles, cell and ray bounds)";
+
 template <class P>
-Status tiledOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const P* points, const P* normals, std::int64_t count,
-  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
+Status guardedOcclusion(const std::vector<MomentLevel>& levels, detail::PyramidTiles* tiles, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const P* points, const P* normals,
+  std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
-  return catchOutOfMemory("the tiles of the moment pyramid", [&] {
-    return occlusionOf(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), volume, origin, spacing, points,
-      normals, count, parameters, out, execution);
+  return catchOutOfMemory(kQueryBuffers, [&] {
+    return occlusionOf(levels, tiles, volume, origin, spacing, points, normals, count, parameters, out, execution);
   });
 }
 
 template <class P>
-Status tiledShadow(SurfacePyramid& pyramid, const P* points, const P* normals, std::int64_t count,
-  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution)
+Status guardedShadow(const std::vector<MomentLevel>& levels, detail::PyramidTiles* tiles, const P* points,
+  const P* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
-  return catchOutOfMemory("the tiles of the moment pyramid", [&] {
-    return shadowOf(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), points, normals, count,
-      lightDirection, parameters, out, execution);
+  return catchOutOfMemory(kQueryBuffers, [&] {
+    return shadowOf(levels, tiles, points, normals, count, lightDirection, parameters, out, execution);
   });
 }
 
@@ -357,7 +358,7 @@ Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const Vo
   const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
   const Execution& execution)
 {
-  return occlusionOf(pyramid, nullptr, volume, origin, spacing, points, normals, count, parameters, out, execution);
+  return guardedOcclusion(pyramid, nullptr, volume, origin, spacing, points, normals, count, parameters, out, execution);
 }
 
 Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
@@ -365,49 +366,53 @@ Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const Vo
   const float* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
   const Execution& execution)
 {
-  return occlusionOf(pyramid, nullptr, volume, origin, spacing, points, normals, count, parameters, out, execution);
+  return guardedOcclusion(pyramid, nullptr, volume, origin, spacing, points, normals, count, parameters, out, execution);
 }
 
 Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* points, const double* normals,
   std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
   float* out, const Execution& execution)
 {
-  return shadowOf(pyramid, nullptr, points, normals, count, lightDirection, parameters, out, execution);
+  return guardedShadow(pyramid, nullptr, points, normals, count, lightDirection, parameters, out, execution);
 }
 
 Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const float* points, const float* normals,
   std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
   float* out, const Execution& execution)
 {
-  return shadowOf(pyramid, nullptr, points, normals, count, lightDirection, parameters, out, execution);
+  return guardedShadow(pyramid, nullptr, points, normals, count, lightDirection, parameters, out, execution);
 }
 
 Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const double* points, const double* normals, std::int64_t count,
   const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
-  return tiledOcclusion(pyramid, volume, origin, spacing, points, normals, count, parameters, out, execution);
+  return guardedOcclusion(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), volume, origin, spacing,
+    points, normals, count, parameters, out, execution);
 }
 
 Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const float* points, const float* normals, std::int64_t count,
   const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
-  return tiledOcclusion(pyramid, volume, origin, spacing, points, normals, count, parameters, out, execution);
+  return guardedOcclusion(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), volume, origin, spacing,
+    points, normals, count, parameters, out, execution);
 }
 
 Status surfaceShadow(SurfacePyramid& pyramid, const double* points, const double* normals, std::int64_t count,
   const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
   const Execution& execution)
 {
-  return tiledShadow(pyramid, points, normals, count, lightDirection, parameters, out, execution);
+  return guardedShadow(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), points, normals, count,
+    lightDirection, parameters, out, execution);
 }
 
 Status surfaceShadow(SurfacePyramid& pyramid, const float* points, const float* normals, std::int64_t count,
   const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
   const Execution& execution)
 {
-  return tiledShadow(pyramid, points, normals, count, lightDirection, parameters, out, execution);
+  return guardedShadow(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), points, normals, count,
+    lightDirection, parameters, out, execution);
 }
 
 } // namespace vao
