@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -160,10 +161,22 @@ struct Status
     status.deviceFailure = true;
     return status;
   }
-  static Status noMemory(const std::string& what)
+  /// An allocation failed: "not enough memory for <what>". Callable when no memory is
+  /// left: where even that message cannot be had, it is "out of memory", short enough for
+  /// std::string to hold without allocating.
+  static Status noMemory(const char* what) noexcept
   {
-    Status status = failure("not enough memory for " + what);
+    Status status;
+    status.ok = false;
     status.outOfMemory = true;
+    try
+    {
+      status.message = std::string("not enough memory for ") + what;
+    }
+    catch (const std::bad_alloc&)
+    {
+      status.message = "out of memory";
+    }
     return status;
   }
 };

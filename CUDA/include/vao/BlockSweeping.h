@@ -65,6 +65,9 @@ struct BlockPlacement
   }
 };
 
+/// Allocation failure never throws: initialise(), runRound() and finish() return a
+/// Status that says memory (the constructor's own state included), and the other calls do
+/// nothing until an initialise() has succeeded.
 class BlockSweeper
 {
 public:
@@ -114,8 +117,11 @@ public:
   Status finish(const SweepOutput& output);
 
 private:
+  /// initialise() succeeded (the state exists and its buffers are made).
+  bool initialised() const;
+
   struct State;
-  std::unique_ptr<State> Impl;
+  std::unique_ptr<State> Impl; // null when even the state could not be allocated
 };
 
 } // namespace vao

@@ -73,8 +73,20 @@ Status checkMomentMagnitude(const ValueScan& scan);
 Status checkFiniteValues(const VolumeView& volume);
 
 /// f(), with std::bad_alloc from anywhere inside it (its buffers, its worker threads)
-/// turned into Status::noMemory(what): the entry points never throw.
-Status catchOutOfMemory(const char* what, const std::function<Status()>& f);
+/// turned into Status::noMemory(what): the entry points never throw. A template, not a
+/// std::function, whose making could itself allocate, and throw, before the guard is up.
+template <class F>
+Status catchOutOfMemory(const char* what, F&& f)
+{
+  try
+  {
+    return f();
+  }
+  catch (const std::bad_alloc&)
+  {
+    return Status::noMemory(what);
+  }
+}
 
 /// The checks of a call on box moments (Volumetric AO on the CPU or the GPU): validate(),
 /// then, where the type needs it, one scan for non-finite values and for magnitudes whose

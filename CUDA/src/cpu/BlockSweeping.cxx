@@ -1,6 +1,7 @@
 // Occlusion sweeping on one block of a distributed volume: the stages of
 // SweepingCore.h over a ghosted SweepLayout, and the face exchange of D and V_s.
 #include "vao/BlockSweeping.h"
+#include "vao/Validation.h"
 
 #include "Parallel.h"
 #include "SweepingCore.h"
@@ -21,6 +22,7 @@ using namespace detail::sweeping;
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 constexpr int kFaceValues = 5; // D and four V_s per face voxel
+const char* const kSweepBuffers = "the sweeping buffers (signed distance, fixed voxels, octant visibility)";
 
 SweepLayout blockLayout(const BlockPlacement& b, const std::array<double, 3>& spacing)
 {
@@ -130,14 +132,25 @@ struct BlockSweeper::State
 BlockSweeper::BlockSweeper(const VolumeView& scalars, const BlockPlacement& placement,
   const std::array<double, 3>& spacing, const SweepParameters& parameters,
   const Execution& execution)
-  : Impl(new State(scalars, placement, spacing, parameters, execution))
 {
+  try
+  {
+    this->Impl.reset(new State(scalars, placement, spacing, parameters, execution));
+  }
+  catch (const std::bad_alloc&)
+  {
+    // initialise() reports it: every call returns or does nothing until then.
+  }
 }
 
 BlockSweeper::~BlockSweeper() = default;
 
 Status BlockSweeper::initialise()
 {
+  if (!this->Impl)
+  {
+    return Status::noMemory("the block sweeper's state");
+  }
   State& s = *this->Impl;
   Status status = validatePlacement(s.scalars, s.placement);
   if (status.ok)
@@ -148,42 +161,34 @@ Status BlockSweeper::initialise()
   {
     return status;
   }
-  try
-  {
+  return catchOutOfMemory(kSweepBuffers, [&] {
     const std::int64_t count = s.layout.storage.count;
     s.distance.assign(static_cast<std::size_t>(count), kInfinity); // ghosts: the open sky
     s.vis = VisibilityStore();
     s.vis.computed.fill(true);
     s.vis.keep(s.layout.storage, nullptr);
     std::fill(s.vis.storage.begin(), s.vis.storage.end(), 1.0f); // ghosts: the open sky
-  }
-  catch (const std::bad_alloc&)
-  {
-    return Status::noMemory("the sweeping buffers (signed distance, octant visibility)");
-  }
-  s.threads = detail::resolveThreadCount(s.execution.threads);
-  const BlockPlacement& b = s.placement;
-  const Index3 scalarOffset = { b.begin[0] > 0 ? 1 : 0, b.begin[1] > 0 ? 1 : 0,
-    b.begin[2] > 0 ? 1 : 0 };
-  s.surfaceFound =
-    initialiseDistance(s.scalars, scalarOffset, s.layout, s.parameters, s.distance.data(), s.threads) > 0;
-  s.fixed.build(s.distance.data(), s.layout.storage.count, s.threads);
-  s.initialised = true;
-  return Status::success();
+    s.threads = detail::resolveThreadCount(s.execution.threads);
+    const BlockPlacement& b = s.placement;
+    const Index3 scalarOffset = { b.begin[0] > 0 ? 1 : 0, b.begin[1] > 0 ? 1 : 0, b.begin[2] > 0 ? 1 : 0 };
+    s.surfaceFound =
+      initialiseDistance(s.scalars, scalarOffset, s.layout, s.parameters, s.distance.data(), s.threads) > 0;
+    s.fixed.build(s.distance.data(), s.layout.storage.count, s.threads);
+    s.initialised = true;
+    return Status::success();
+  });
 }
 
 bool BlockSweeper::surfaceFound() const
 {
-  return this->Impl->surfaceFound;
+  return this->Impl && this->Impl->surfaceFound;
 }
 
 void BlockSweeper::fillWithoutSurface()
 {
-  State& s = *this->Impl;
-  if (!s.initialised)
-  {
+  if (!this->initialised())
     return;
-  }
+  State& s = *this->Impl;
   // Without a surface anywhere every voxel lies on the same side as the first own one.
   const bool allInside = s.distance[s.layout.index(0, 0, 0)] < 0.0f;
   detail::sweeping::fillWithoutSurface(s.layout, allInside, s.distance.data(), s.vis, s.maskCount);
@@ -191,8 +196,7 @@ void BlockSweeper::fillWithoutSurface()
 
 Status BlockSweeper::runRound(int maxPasses, SweepReport* report)
 {
-  State& s = *this->Impl;
-  if (!s.initialised)
+  if (!this->initialised())
   {
     return Status::failure("runRound before a successful initialise()");
   }
@@ -200,6 +204,7 @@ Status BlockSweeper::runRound(int maxPasses, SweepReport* report)
   {
     return Status::failure("a round needs at least one pass of the 8 sweeps");
   }
+  State& s = *this->Impl;
   const double unit = sweepUnit(s.spacing);
   SweepParameters p = s.parameters;
   p.iterations = maxPasses;
@@ -208,13 +213,16 @@ Status BlockSweeper::runRound(int maxPasses, SweepReport* report)
   SweepReport& r = report ? *report : local;
   r.surfaceFound = s.surfaceFound;
   const int sweepThreads = static_cast<int>(std::min<std::int64_t>(s.threads, s.layout.size[2]));
-  const Status status = runPasses(s.layout, p, s.distance.data(), s.fixed, s.vis, sweepThreads, s.execution, r);
+  const Status status = catchOutOfMemory(kSweepBuffers,
+    [&] { return runPasses(s.layout, p, s.distance.data(), s.fixed, s.vis, sweepThreads, s.execution, r); });
   r.lastChange *= unit;
   return status;
 }
 
 std::int64_t BlockSweeper::faceValueCount(int face) const
 {
+  if (!this->Impl)
+    return 0;
   const State& s = *this->Impl;
   if (face < 0 || face >= kBlockFaces || !s.placement.hasNeighbour(face))
   {
@@ -227,11 +235,11 @@ std::int64_t BlockSweeper::faceValueCount(int face) const
 
 void BlockSweeper::exportFace(int face, float* buffer) const
 {
-  const State& s = *this->Impl;
-  if (!s.initialised || this->faceValueCount(face) == 0)
+  if (!this->initialised() || this->faceValueCount(face) == 0)
   {
     return;
   }
+  const State& s = *this->Impl;
   const std::array<int, 4> octants = State::octantsMoving(face / 2, (face & 1) ? 1 : -1);
   s.forFaceVoxels(face, false, [&](std::int64_t i, std::int64_t k) {
     float* out = buffer + kFaceValues * k;
@@ -243,11 +251,11 @@ void BlockSweeper::exportFace(int face, float* buffer) const
 
 double BlockSweeper::importFace(int face, const float* buffer)
 {
-  State& s = *this->Impl;
-  if (!s.initialised || this->faceValueCount(face) == 0)
+  if (!this->initialised() || this->faceValueCount(face) == 0)
   {
     return 0.0;
   }
+  State& s = *this->Impl;
   // The sweeps that read this ghost layer move away from it, into the block.
   const std::array<int, 4> octants = State::octantsMoving(face / 2, (face & 1) ? -1 : 1);
   const double unit = sweepUnit(s.spacing); // D is exchanged in sweep units
@@ -268,11 +276,11 @@ double BlockSweeper::importFace(int face, const float* buffer)
 
 Status BlockSweeper::finish(const SweepOutput& output)
 {
-  State& s = *this->Impl;
-  if (!s.initialised)
+  if (!this->initialised())
   {
     return Status::failure("finish before a successful initialise()");
   }
+  State& s = *this->Impl;
   const Status status = validateSweepParameters(s.spacing, s.parameters, output); // the volume was checked by initialise()
   if (!status.ok)
   {
@@ -291,8 +299,14 @@ Status BlockSweeper::finish(const SweepOutput& output)
           to[x] = row[x] * unit; // sweep units to world units (exact: a power of two)
       }
   }
-  return combine(
-    s.layout, s.parameters, output, s.distance.data(), s.vis, s.maskCount, s.threads, s.execution);
+  return catchOutOfMemory(kSweepBuffers, [&] {
+    return combine(s.layout, s.parameters, output, s.distance.data(), s.vis, s.maskCount, s.threads, s.execution);
+  });
+}
+
+bool BlockSweeper::initialised() const
+{
+  return this->Impl && this->Impl->initialised;
 }
 
 } // namespace vao

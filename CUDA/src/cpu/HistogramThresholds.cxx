@@ -189,13 +189,13 @@ Status volumeThresholds(
   {
     return status;
   }
-  const ValueScan scan = scanValues(volume);
-  status = finiteStatus(scan);
-  if (!status.ok)
-  {
-    return status;
-  }
   return catchOutOfMemory("the value histogram of Histogram CDF", [&] {
+    const ValueScan scan = scanValues(volume);
+    const Status finite = finiteStatus(scan);
+    if (!finite.ok)
+    {
+      return finite;
+    }
     ValueHistogram histogram = ValueHistogram::forRange(volume.type, scan.minimum, scan.maximum);
     const Status added = addToValueHistogram(volume, Region::whole(volume), histogram, execution);
     if (added.ok)

@@ -245,18 +245,6 @@ Status validateMomentRequest(const VolumeView& volume, const Region& region, con
   return status;
 }
 
-Status catchOutOfMemory(const char* what, const std::function<Status()>& f)
-{
-  try
-  {
-    return f();
-  }
-  catch (const std::bad_alloc&)
-  {
-    return Status::noMemory(what);
-  }
-}
-
 std::int64_t countNonFinite(const VolumeView& view, std::int64_t* firstIndex)
 {
   if (scalarTypeIsIntegral(view.type))
@@ -273,7 +261,9 @@ std::int64_t countNonFinite(const VolumeView& view, std::int64_t* firstIndex)
 
 Status checkFiniteValues(const VolumeView& volume)
 {
-  return scalarTypeIsIntegral(volume.type) ? Status::success() : finiteStatus(scanValues(volume));
+  return catchOutOfMemory("the scan for non-finite values", [&] {
+    return scalarTypeIsIntegral(volume.type) ? Status::success() : finiteStatus(scanValues(volume));
+  });
 }
 
 std::array<double, 2> valueRange(const VolumeView& volume)
