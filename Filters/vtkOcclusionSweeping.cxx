@@ -329,6 +329,15 @@ std::string vtkOcclusionSweeping::StartSlab(vtkImageData* input, vtkDataArray* c
 }
 
 //------------------------------------------------------------------------------
+void vtkOcclusionSweeping::ReportStop(const vao::Status& status)
+{
+  if (status.ok || status.aborted)
+    vtkErrorMacro(<< "Occlusion sweeping stopped: another process failed (see its message).");
+  else
+    vtkErrorMacro(<< "Occlusion sweeping failed: " << status.message);
+}
+
+//------------------------------------------------------------------------------
 int vtkOcclusionSweeping::SweepRounds(vao::BlockSweeper& block, int axis, double tolerance)
 {
   // Sweep the slab with the ghosts as they are, exchange the faces, until the ghosts
@@ -343,9 +352,13 @@ int vtkOcclusionSweeping::SweepRounds(vao::BlockSweeper& block, int axis, double
   {
     vao::SweepReport report;
     const vao::Status status = block.runRound(passesPerRound, &report);
-    if (GlobalMax(controller, status.ok ? 0.0 : 1.0) > 0.0)
+    // All stop together: 1 an abort (not an error), 2 a failure (no memory) somewhere.
+    const double stopped = GlobalMax(controller, status.ok ? 0.0 : status.aborted ? 1.0 : 2.0);
+    if (stopped > 0.0)
     {
-      return -1; // aborted (an abort is not an error)
+      if (stopped > 1.0)
+        this->ReportStop(status);
+      return -1;
     }
     change = GlobalMax(controller, ExchangeFaces(controller, block, axis));
     this->LastPasses = report.passes;
@@ -397,7 +410,12 @@ int vtkOcclusionSweeping::RequestDistributedData(
   // The slab's results with the input's arrays, then to whatever extent was requested.
   vtkNew<vtkImageData> held;
   vtkAmbientOcclusionExtents::CopyRequestedExtent(input, held, slab.extent);
-  block.finish(AddOutputArrays(held, this->OutputOctantVisibility != 0));
+  const vao::Status finished = block.finish(AddOutputArrays(held, this->OutputOctantVisibility != 0));
+  if (GlobalMax(controller, finished.ok ? 0.0 : 1.0) > 0.0) // before the collective below
+  {
+    this->ReportStop(finished);
+    return 1;
+  }
   vtkNew<vtkIntArray> roundsArray;
   roundsArray->SetName("SweepingExchangeRounds");
   roundsArray->InsertNextValue(rounds);

@@ -35,6 +35,7 @@ class vtkMultiProcessController;
 namespace vao
 {
 class BlockSweeper;
+struct Status;
 struct SweepParameters;
 }
 
@@ -171,8 +172,11 @@ private:
   /// Starts the block sweeper of this process's slab; the reason when it cannot.
   std::string StartSlab(vtkImageData* input, vtkDataArray* chosen, const int whole[6], Slab& slab);
   /// Rounds of sweeps and face exchanges until the ghosts settle on every process; -1
-  /// when the run was aborted.
+  /// when the run was aborted or failed (the failure reported) on any process.
   int SweepRounds(vao::BlockSweeper& block, int axis, double tolerance);
+  /// The error of a distributed run that stopped: this process's failure, or (status ok
+  /// or aborted here) another process's.
+  void ReportStop(const vao::Status& status);
 
   vtkOcclusionSweeping(const vtkOcclusionSweeping&) = delete;
   void operator=(const vtkOcclusionSweeping&) = delete;
