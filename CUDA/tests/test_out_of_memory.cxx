@@ -130,6 +130,22 @@ TEST(OutOfMemory, AllocationsFailOnlyWhileTold)
   EXPECT_NO_THROW(std::vector<char>(1 << 20));
 }
 
+TEST(OutOfMemory, TheStatusSaysSoEvenWhenNothingCanBeAllocated)
+{
+  const std::string what = "the buffers";
+  vao::Status s = vao::Status::noMemory(what);
+  EXPECT_EQ(s.message, "not enough memory for the buffers");
+  EXPECT_TRUE(s.outOfMemory);
+  EXPECT_FALSE(s.ok);
+  {
+    FailingAllocations failing(1);
+    s = vao::Status::noMemory("the buffers");
+  }
+  EXPECT_EQ(s.message, "out of memory");
+  EXPECT_TRUE(s.outOfMemory);
+  EXPECT_FALSE(s.ok);
+}
+
 TEST(OutOfMemory, ShadowsOnWholeLevelsReportIt)
 {
   const BallScene scene;

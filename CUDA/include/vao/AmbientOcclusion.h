@@ -179,6 +179,7 @@ struct Status
     }
     return status;
   }
+  static Status noMemory(const std::string& what) noexcept { return noMemory(what.c_str()); }
 };
 
 /// Checks the volume, region and radius; returns the first problem found
