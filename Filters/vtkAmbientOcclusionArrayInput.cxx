@@ -255,8 +255,14 @@ std::string KernelError(const vao::Status& status, const ScalarVolume& scalars, 
   }
   if (status.outOfMemory)
   {
-    // Said like the filters' own allocation failures (vtkAmbientOcclusionMemory).
-    return "Not enough memory for " + status.message.substr(std::string("not enough memory for ").size()) +
+    // Said like the filters' own allocation failures (vtkAmbientOcclusionMemory). The
+    // kernel names what it could not allocate, unless even that message could not be had
+    // (Status::noMemory's short "out of memory").
+    const std::string named = "not enough memory for ";
+    const std::string what = status.message.compare(0, named.size(), named) == 0
+      ? status.message.substr(named.size())
+      : std::string("its working buffers");
+    return "Not enough memory for " + what +
       "; compute it in smaller pieces (streaming or more MPI ranks), on a smaller extent, or with "
       "lighter settings (StartAtHalfResolution, fewer outputs).";
   }

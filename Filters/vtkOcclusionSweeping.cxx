@@ -329,17 +329,16 @@ std::string vtkOcclusionSweeping::StartSlab(vtkImageData* input, vtkDataArray* c
 }
 
 //------------------------------------------------------------------------------
-void vtkOcclusionSweeping::ReportStop(const vao::Status& status)
+void vtkOcclusionSweeping::ReportStop(const std::string& error)
 {
-  if (status.ok || status.aborted)
-    vtkErrorMacro(<< "Occlusion sweeping stopped: another process failed (see its message).");
-  else
-    vtkErrorMacro(<< "Occlusion sweeping failed: " << status.message);
+  vtkErrorMacro(<< (error.empty() ? std::string("Occlusion sweeping stopped: another process failed (see its message).")
+                                  : error));
 }
 
 //------------------------------------------------------------------------------
-int vtkOcclusionSweeping::SweepRounds(vao::BlockSweeper& block, int axis, double tolerance)
+int vtkOcclusionSweeping::SweepRounds(Slab& slab, int axis, double tolerance)
 {
+  vao::BlockSweeper& block = *slab.block;
   // Sweep the slab with the ghosts as they are, exchange the faces, until the ghosts
   // settle everywhere (or the process aborts, everywhere).
   vtkMultiProcessController* controller = this->Controller;
@@ -357,7 +356,7 @@ int vtkOcclusionSweeping::SweepRounds(vao::BlockSweeper& block, int axis, double
     if (stopped > 0.0)
     {
       if (stopped > 1.0)
-        this->ReportStop(status);
+        this->ReportStop(KernelError(status, slab.scalars, "Occlusion sweeping failed"));
       return -1;
     }
     change = GlobalMax(controller, ExchangeFaces(controller, block, axis));
@@ -384,9 +383,7 @@ int vtkOcclusionSweeping::RequestDistributedData(
   const std::string error = this->StartSlab(input, chosen, whole, slab);
   if (GlobalMax(controller, error.empty() ? 0.0 : 1.0) > 0.0)
   {
-    vtkErrorMacro(<< (error.empty() ? std::string("Occlusion sweeping stopped: another process "
-                                                  "failed (see its message).")
-                                    : error));
+    this->ReportStop(error);
     return 1;
   }
   int rounds = 0;
@@ -399,7 +396,7 @@ int vtkOcclusionSweeping::RequestDistributedData(
   else
   {
     const double tolerance = ExchangeTolerance(this->ConvergenceTolerance, input->GetSpacing());
-    rounds = this->SweepRounds(block, SlabAxis(whole), tolerance);
+    rounds = this->SweepRounds(slab, SlabAxis(whole), tolerance);
     if (rounds < 0)
     {
       return 1;
@@ -413,7 +410,7 @@ int vtkOcclusionSweeping::RequestDistributedData(
   const vao::Status finished = block.finish(AddOutputArrays(held, this->OutputOctantVisibility != 0));
   if (GlobalMax(controller, finished.ok ? 0.0 : 1.0) > 0.0) // before the collective below
   {
-    this->ReportStop(finished);
+    this->ReportStop(KernelError(finished, slab.scalars, "Occlusion sweeping failed"));
     return 1;
   }
   vtkNew<vtkIntArray> roundsArray;

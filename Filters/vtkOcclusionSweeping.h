@@ -35,7 +35,6 @@ class vtkMultiProcessController;
 namespace vao
 {
 class BlockSweeper;
-struct Status;
 struct SweepParameters;
 }
 
@@ -171,12 +170,13 @@ private:
   struct Slab;
   /// Starts the block sweeper of this process's slab; the reason when it cannot.
   std::string StartSlab(vtkImageData* input, vtkDataArray* chosen, const int whole[6], Slab& slab);
-  /// Rounds of sweeps and face exchanges until the ghosts settle on every process; -1
-  /// when the run was aborted or failed (the failure reported) on any process.
-  int SweepRounds(vao::BlockSweeper& block, int axis, double tolerance);
-  /// The error of a distributed run that stopped: this process's failure, or (status ok
-  /// or aborted here) another process's.
-  void ReportStop(const vao::Status& status);
+  /// Rounds of sweeps and face exchanges over the slab's block until the ghosts settle
+  /// on every process; -1 when the run was aborted or failed (the failure reported) on
+  /// any process.
+  int SweepRounds(Slab& slab, int axis, double tolerance);
+  /// The error of a distributed run that stopped on every process: this process's
+  /// `error`, or, empty, that another process failed.
+  void ReportStop(const std::string& error);
 
   vtkOcclusionSweeping(const vtkOcclusionSweeping&) = delete;
   void operator=(const vtkOcclusionSweeping&) = delete;

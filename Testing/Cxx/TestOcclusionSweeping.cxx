@@ -1,6 +1,8 @@
-// The Occlusion Sweeping filter: outputs, pieces, bad input, an iso value off the data.
+// The Occlusion Sweeping filter: outputs, pieces, bad input, an iso value off the data;
+// the message of a kernel's shortage of memory, as its distributed run reports it.
 #include "TestHelpers.h"
 
+#include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionPhantom.h"
 #include "vtkOcclusionSweeping.h"
 
@@ -168,3 +170,17 @@ TEST(OcclusionSweepingFilter, RejectsBadInputWithAClearError)
 }
 
 } // namespace
+
+TEST(OcclusionSweeping, AKernelShortageIsSaidAsTheFiltersOwn)
+{
+  // What the kernel names, or (its short message, when even that could not be had) the
+  // working buffers; never an exception from reading the message.
+  const vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
+  const std::string named = vtkAmbientOcclusionArrayInput::KernelError(
+    vao::Status::noMemory("the sweeping buffers"), scalars, "Occlusion sweeping failed");
+  EXPECT_EQ(named.find("Not enough memory for the sweeping buffers; "), 0u) << named;
+  vao::Status bare = vao::Status::noMemory("x");
+  bare.message = "out of memory";
+  const std::string unnamed = vtkAmbientOcclusionArrayInput::KernelError(bare, scalars, "Occlusion sweeping failed");
+  EXPECT_EQ(unnamed.find("Not enough memory for its working buffers; "), 0u) << unnamed;
+}
