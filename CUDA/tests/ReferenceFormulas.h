@@ -14,13 +14,15 @@ namespace reference
 struct Statistics
 {
   double mean, variance, minimum, maximum;
+  double roundingVariance = 0.0; // what rounded sums can give a flat box (0: exact sums)
 };
 
-/// METHODS.md: flat when s2 <= eps max(1, mu^2) (eps = 1e-14) or vmax == vmin; then
-/// O = (q >= mu).
+/// METHODS.md: flat when s2 <= eps max(1, mu^2) or vmax == vmin; then O = (q >= mu). Here
+/// eps = 0 beyond the sums' rounding (README: a threshold relative to mu^2 or 1 would make
+/// data stored with a large offset or in small units flat everywhere).
 inline bool flat(const Statistics& s)
 {
-  return s.maximum == s.minimum || s.variance <= 1e-14 * std::fmax(1.0, s.mean * s.mean);
+  return s.maximum == s.minimum || s.variance <= s.roundingVariance;
 }
 
 inline double flatAnswer(double q, const Statistics& s)

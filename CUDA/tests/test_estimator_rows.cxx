@@ -30,11 +30,13 @@ constexpr double kTail = 1e-6;
 struct RowData
 {
   std::vector<double> value, count, mean, variance, minimum, maximum, query;
+  double roundingVariance = 0.0;
 
   vao::detail::NeighbourhoodRow row() const
   {
     vao::detail::NeighbourhoodRow r;
     r.size = static_cast<std::int64_t>(this->mean.size());
+    r.roundingVariance = this->roundingVariance;
     r.value = this->value.data();
     r.count = this->count.data();
     r.mean = this->mean.data();
@@ -45,19 +47,21 @@ struct RowData
   }
 };
 
-/// n neighbourhoods around `magnitude`: a quarter flat (variance 0 or far below the flat
-/// limit), the rest with spreads from 1e-3 to 10 times the magnitude; queries up to
-/// `reach` standard deviations either side, or exactly the mean of a flat box.
+/// n neighbourhoods around `magnitude`: a quarter flat (variance 0 or within the rounding
+/// that double sums of values within `magnitude` of their shift allow, 1e-12 magnitude^2),
+/// the rest with spreads from 1e-3 to 10 times the magnitude; queries up to `reach`
+/// standard deviations either side, or exactly the mean of a flat box.
 RowData makeRow(std::size_t n, double magnitude, std::mt19937& rng, double reach = 4.0)
 {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   RowData d;
+  d.roundingVariance = 1e-12 * magnitude * magnitude;
   for (std::size_t i = 0; i < n; ++i)
   {
     const double mean = magnitude * unit(rng);
     const bool flat = rng() % 4 == 0;
     const double sd = flat ? 0.0 : magnitude * std::pow(10.0, 2.0 * unit(rng) - 1.0);
-    const double variance = flat ? (rng() % 2 ? 0.0 : 1e-17 * std::fmax(1.0, mean * mean)) : sd * sd;
+    const double variance = flat ? (rng() % 2 ? 0.0 : d.roundingVariance * (0.5 + 0.5 * unit(rng))) : sd * sd;
     double q = mean + reach * sd * unit(rng);
     if (flat)
       q = rng() % 3 == 0 ? mean : mean + magnitude * unit(rng);
@@ -76,7 +80,7 @@ RowData makeRow(std::size_t n, double magnitude, std::mt19937& rng, double reach
 
 double referenceOpenness(vao::Method method, double q, const RowData& d, std::size_t i)
 {
-  const vaotest::reference::Statistics s{ d.mean[i], d.variance[i], d.minimum[i], d.maximum[i] };
+  const vaotest::reference::Statistics s{ d.mean[i], d.variance[i], d.minimum[i], d.maximum[i], d.roundingVariance };
   switch (method)
   {
     case vao::Method::Chebyshev:

@@ -67,11 +67,12 @@ TEST(Estimators, FlatRuleIgnoresTheRoundingOfTheMean)
 {
   // One voxel (radius 0) of a float volume: vmin = vmax = q exactly, but the streamed sums
   // give a mean a few ulps away, on either side (seen on an H100: the GPU's and the CPU's
-  // means straddled q). The answer must be 1 whichever side it lands.
+  // means straddled q). The answer must be 1 whichever side it lands. Double sums of a
+  // float volume carry the rounding variance of values within about 1 of their shift.
   const double q = 0.7316485643386841; // a float32 value
   for (double mean : { q * (1 + 4e-16), q * (1 - 4e-16) })
   {
-    const NeighbourhoodStats one{ mean, 3e-17, q, q };
+    const NeighbourhoodStats one{ mean, 3e-17, q, q, vao::sumRoundingVariance(1.0) };
     for (auto method : { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev })
       for (auto erf : { ErfMode::Exact, ErfMode::Winitzki })
       {
@@ -79,6 +80,25 @@ TEST(Estimators, FlatRuleIgnoresTheRoundingOfTheMean)
         EXPECT_EQ(vao::opennessFromStats(method, q * (1 - 1e-6), one, erf), 0.0);
       }
   }
+}
+
+// The estimators depend on (q - mu) / sigma alone, so adding a constant to the data and the
+// query, or scaling both, leaves the openness as it was. The flat rule must not break that:
+// with a threshold of 1e-14 max(1, mu^2) the boxes below (sigma 3) were flat at an offset
+// of 1e8 and in units of 2^-34, and the Gaussian CDF 0 or 1.
+TEST(Estimators, OpennessIsTheSameAtAnyOffsetAndScale)
+{
+  const double sigma = 3.0;
+  // Powers of two as scales, so that mu, sigma and q are exact at every offset.
+  for (const double offset : { 0.0, 1e8, -1e12 })
+    for (const double scale : { 1.0, std::ldexp(1.0, -34), std::ldexp(1.0, -100), std::ldexp(1.0, 66) })
+    {
+      const double mean = (1000.0 + offset) * scale, s = sigma * scale;
+      const NeighbourhoodStats box{ mean, s * s, mean - 4.0 * s, mean + 4.0 * s };
+      const double q = mean + 0.5 * s;
+      EXPECT_NEAR(vao::opennessGaussianCdf(q, box, ErfMode::Exact), 0.6914624612740131, 1e-6) << offset << " " << scale;
+      EXPECT_NEAR(vao::opennessChebyshev(q, box), 0.2, 1e-6) << offset << " " << scale;
+    }
 }
 
 TEST(Estimators, ChebyshevIsExactForTwoValuedNeighbourhoodAtItsUpperValue)

@@ -10,6 +10,7 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <vector>
@@ -137,6 +138,54 @@ TEST(ExtremeInputs, MomentMethodsRefuseValuesWhoseSquaresOverflow)
     vao::computeAmbientOcclusion(viewOf(unit, dims), vao::Region::whole(view), p, { openUnit.data(), nullptr }).ok);
   for (std::size_t i = 0; i < open.size(); ++i)
     ASSERT_NEAR(open[i], openUnit[i], 1e-6) << "voxel " << i;
+}
+
+/// The openness of every voxel of `values` (q = its own value) by `method`, R = 2.
+template <class T>
+std::vector<float> opennessOf(const std::vector<T>& values, const vao::Index3& dims, vao::Method method)
+{
+  vao::AmbientOcclusionParameters p;
+  p.radius = { 2, 2, 2 };
+  p.method = method;
+  std::vector<float> open(values.size(), -1.0f);
+  const vao::VolumeView view = viewOf(values, dims);
+  const vao::Status s = vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
+  EXPECT_TRUE(s.ok) << s.message;
+  return open;
+}
+
+template <class T, class F>
+std::vector<T> mapped(const std::vector<std::int16_t>& values, F&& f)
+{
+  std::vector<T> out;
+  for (const std::int16_t v : values)
+    out.push_back(static_cast<T>(f(double(v))));
+  return out;
+}
+
+// The moment estimators depend on (q - mu) / sigma alone: soft tissue of a CT (990 to 1010,
+// flat blocks among it) stored with an offset of 1e8 or 1e12, or in units of 1e-10, 2^-40
+// or 1e-30, is the same scene. Before the flat rule stopped being relative to max(1, mu^2),
+// every box there was flat and the openness 0 or 1.
+TEST(ExtremeInputs, MomentMethodsSeeTheSameSceneAtAnyOffsetAndScale)
+{
+  const vao::Index3 dims = { 14, 13, 12 };
+  const std::vector<std::int16_t> base = randomVolume<std::int16_t>(dims, 990, 1010, 5);
+  for (vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
+  {
+    SCOPED_TRACE(static_cast<int>(method));
+    const std::vector<float> expected = opennessOf(base, dims, method);
+    const std::vector<std::vector<float>> variants = {
+      opennessOf(mapped<std::int32_t>(base, [](double v) { return v + 1e8; }), dims, method),
+      opennessOf(mapped<std::int64_t>(base, [](double v) { return v - 1e12; }), dims, method),
+      opennessOf(mapped<double>(base, [](double v) { return v * 1e-10; }), dims, method),
+      opennessOf(mapped<double>(base, [](double v) { return v * 1e-30 + 5e-27; }), dims, method),
+      opennessOf(mapped<float>(base, [](double v) { return std::ldexp(v, -40); }), dims, method),
+    };
+    for (std::size_t k = 0; k < variants.size(); ++k)
+      for (std::size_t i = 0; i < expected.size(); ++i)
+        ASSERT_NEAR(variants[k][i], expected[i], 1e-5) << "variant " << k << ", voxel " << i;
+  }
 }
 
 TEST(ExtremeInputs, ByteOfNanIsZeroNotUndefined)

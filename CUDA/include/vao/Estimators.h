@@ -52,11 +52,13 @@ struct NeighbourhoodStats
   double roundingVariance = 0.0;
 };
 
-/// Relative threshold of the flat-neighbourhood rule: s2 <= kFlatEpsilon * max(1, mu^2).
-/// 1e-14 sits above double rounding of sums around mu and below the smallest variance a
-/// float32 volume can show (one ulp step in a box of 10^4 voxels at 1e6 is ~4e-7 of mu^2).
-constexpr double kFlatEpsilon = 1e-14;
-
+/// The flat-neighbourhood rule (METHODS.md: s2 <= eps max(1, mu^2)) with eps = 0 beyond
+/// rounding: a box is flat where its variance is at most what the rounding of its sums can
+/// give a flat box (roundingVariance: 0 for exact sums, sumRoundingVariance for double
+/// sums, which scales with the data's spread about the shift). A threshold relative to mu^2
+/// or to 1 would break the estimators' invariance to offset and scale: CT values stored
+/// with an offset of 1e9 (mu^2 ~ 1e18) or in units of 1e-10 (every variance below 1e-14)
+/// would make every box flat, and every openness 0 or 1.
 /// Ulps of deviation^2 that streamed double sums may be off by, in variance: the running
 /// sums of (v - shift) and (v - shift)^2 add and subtract every slice, row and voxel that
 /// enters or leaves a window, so their rounding grows with the largest |v - shift| of the
@@ -76,23 +78,22 @@ VAO_HD double sumRoundingVariance(double deviation)
   return kSumRoundingUlps * kDoubleUlp * deviation * deviation;
 }
 
-VAO_HD bool isFlatVariance(double mean, double variance, double roundingVariance = 0.0)
+VAO_HD bool isFlatVariance(double variance, double roundingVariance = 0.0)
 {
-  const double scale = mean * mean > 1.0 ? mean * mean : 1.0;
-  const double relative = kFlatEpsilon * scale;
-  return variance <= (roundingVariance > relative ? roundingVariance : relative);
+  return variance <= roundingVariance;
 }
 
-/// How far from mu the values of a flat neighbourhood can lie, relative to max(1, |mu|):
-/// sqrt(kFlatEpsilon), since their variance is at most kFlatEpsilon * max(1, mu^2).
+/// How far below its mean a flat neighbourhood's value can lie once the mean is rounded,
+/// relative to |mu|: float32 precision, which the moment pyramid's levels are stored in
+/// (a mean of sums is a few double ulps off). Relative to |mu| alone, so that it scales
+/// with the data: an iso value within this of a flat region's value counts as that value.
 constexpr double kFlatSpread = 1e-7;
 
 /// flatOpenness given the rounding spread of its sums (flatRoundingSpread): callers that
 /// query one set of sums many times take the square root once.
 VAO_HD double flatOpennessWithin(double query, double mean, double roundingSpread)
 {
-  const double scale = mean > 1.0 ? mean : (mean < -1.0 ? -mean : 1.0);
-  const double relative = kFlatSpread * scale;
+  const double relative = kFlatSpread * (mean < 0.0 ? -mean : mean);
   return query >= mean - (roundingSpread > relative ? roundingSpread : relative) ? 1.0 : 0.0;
 }
 
@@ -162,7 +163,7 @@ VAO_HD double opennessCdfReconstruction(double query, const NeighbourhoodStats& 
 /// Ruiz et al. section 3.3: O = (1 + erf((q - mu) / sqrt(2 s2))) / 2.
 VAO_HD double opennessGaussianCdf(double query, const NeighbourhoodStats& s, ErfMode erfMode)
 {
-  if (isFlatVariance(s.mean, s.variance, s.roundingVariance))
+  if (isFlatVariance(s.variance, s.roundingVariance))
   {
     return flatOpenness(query, s.mean, s.roundingVariance);
   }
@@ -181,7 +182,7 @@ VAO_HD double opennessChebyshevWithin(double query, double mean, double variance
   const double d = query - mean;
   const double occluderShare = variance / (variance + d * d);
   const double bound = d > 0.0 ? clamp01(1.0 - occluderShare) : 0.0;
-  return isFlatVariance(mean, variance, roundingVariance) ? flatOpennessWithin(query, mean, roundingSpread) : bound;
+  return isFlatVariance(variance, roundingVariance) ? flatOpennessWithin(query, mean, roundingSpread) : bound;
 }
 
 /// Cantelli's one-tailed bound on the occluder fraction P(v >= q), as METHODS.md fixes it:
@@ -288,7 +289,7 @@ VAO_HD void meanVarianceFromExactSums(
 /// sums (which have no shift and no rounding variance) without dividing out the mean and
 /// the variance: with c the count, S the sum, N = exactSumsNumerator (c^2 times the
 /// variance) and D = q c - S (c times q - mean), the box is flat where
-/// N <= kFlatEpsilon max(c^2, S^2), open then where D >= -kFlatSpread max(c, |S|); else
+/// N = 0 (exact sums: no rounding to allow for), open then where D >= -kFlatSpread |S|; else
 /// Chebyshev is 1 - N / (N + D^2) where D > 0 (0 elsewhere) and the Gaussian CDF
 /// (1 + erf(D / sqrt(2 N))) / 2. These are the formulas above multiplied through by c or
 /// c^2: they differ from them by rounding alone (an ulp or two of a double), and cost one
@@ -297,11 +298,9 @@ VAO_HD double opennessFromExactSums(
   Method method, double query, double count, double sum, double numerator, ErfMode erfMode)
 {
   const double d = query * count - sum;
-  const double magnitude = sum < 0.0 ? -sum : sum;
-  const double scale = count * count > sum * sum ? count * count : sum * sum;
-  if (numerator <= kFlatEpsilon * scale)
+  if (numerator <= 0.0)
   {
-    return d >= -(kFlatSpread * (count > magnitude ? count : magnitude)) ? 1.0 : 0.0;
+    return d >= -(kFlatSpread * (sum < 0.0 ? -sum : sum)) ? 1.0 : 0.0;
   }
   if (method == Method::Chebyshev)
   {

@@ -6,18 +6,15 @@
 // No include guard: included once per namespace.
 
 /// isFlatVariance: true in the lanes whose box is flat.
-VAO_LANES Mask flatMask(D mean, D variance, D roundingVariance)
+VAO_LANES Mask flatMask(D variance, D roundingVariance)
 {
-  const D scale = max(mul(mean, mean), set1(1.0));
-  const D limit = max(roundingVariance, mul(set1(kFlatEpsilon), scale));
-  return lessEqual(variance, limit);
+  return lessEqual(variance, roundingVariance);
 }
 
-/// flatOpennessWithin: 1 where q >= mean - max(roundingSpread, kFlatSpread max(1, |mean|)).
+/// flatOpennessWithin: 1 where q >= mean - max(roundingSpread, kFlatSpread |mean|).
 VAO_LANES D flatOpenness(D q, D mean, D roundingSpread)
 {
-  const D magnitude = max(abs(mean), set1(1.0));
-  const D spread = max(roundingSpread, mul(set1(kFlatSpread), magnitude));
+  const D spread = max(roundingSpread, mul(set1(kFlatSpread), abs(mean)));
   return onlyWhere(greaterEqual(q, sub(mean, spread)), set1(1.0));
 }
 
@@ -28,7 +25,7 @@ VAO_LANES D chebyshevOpenness(D q, D mean, D variance, D roundingVariance, D rou
   const D d = sub(q, mean);
   const D share = div(variance, add(variance, mul(d, d)));
   const D bound = onlyWhere(greaterThan(d, zero()), min(max(sub(one, share), zero()), one));
-  return select(flatMask(mean, variance, roundingVariance), flatOpenness(q, mean, roundingSpread), bound);
+  return select(flatMask(variance, roundingVariance), flatOpenness(q, mean, roundingSpread), bound);
 }
 
 #if VAO_VECTOR_MATH
@@ -38,7 +35,7 @@ VAO_LANES D chebyshevOpenness(D q, D mean, D variance, D roundingVariance, D rou
 VAO_LANES D gaussianCdf(D q, D mean, D variance, D roundingVariance, D roundingSpread)
 {
   const D one = set1(1.0);
-  const Mask flat = flatMask(mean, variance, roundingVariance);
+  const Mask flat = flatMask(variance, roundingVariance);
   const D z = div(sub(q, mean), sqrt(mul(set1(2.0), select(flat, one, variance))));
   // Beyond |z| = 6 erf is +-1 in doubles (1 - erf(6) ~ 2e-17 is under half an ulp of 1), so
   // the openness is 1 or 0: groups of only such lanes and flat ones skip the erf (most of a
@@ -238,9 +235,8 @@ VAO_LANES_ENTRY void opennessFromExactSumsLanes(const S* sum, const std::int64_t
       const D positive = onlyWhere(greaterThan(numerator, zero()), numerator);
       const D q = query ? loadAsDoubles(query + i) : set1(isoValue);
       const D d = sub(mul(q, c), total);
-      const Mask flat = lessEqual(positive, mul(set1(kFlatEpsilon), max(mul(c, c), totalSquared)));
-      const D flatOpen =
-        onlyWhere(greaterEqual(d, sub(zero(), mul(set1(kFlatSpread), max(c, abs(total))))), one);
+      const Mask flat = lessEqual(positive, zero());
+      const D flatOpen = onlyWhere(greaterEqual(d, sub(zero(), mul(set1(kFlatSpread), abs(total)))), one);
       D open = zero();
       if constexpr (M == Method::Chebyshev)
       {
