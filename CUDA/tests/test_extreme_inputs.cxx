@@ -188,6 +188,46 @@ TEST(ExtremeInputs, MomentMethodsSeeTheSameSceneAtAnyOffsetAndScale)
   }
 }
 
+// The pyramid's levels hold means and variances as float32: a ball of 1e-30 in 0 (its
+// variances near 1e-61) built levels of zeros, every sample flat, and one of 1e20 levels of
+// infinities; Isosurface Ambient Occlusion then gave AO 0 or 1 everywhere. Such spans are
+// refused with a reason; inside the range the levels are the unit scene's, scaled.
+TEST(ExtremeInputs, PyramidRefusesSpansItsFloatLevelsCannotHold)
+{
+  const vao::Index3 dims = { 10, 10, 10 };
+  for (const double inside : { 1e-30, -3e-18, 1e20, -2e18 })
+  {
+    const std::vector<double> values = ballValues(dims, inside, 0.0);
+    std::vector<vao::MomentLevel> pyramid;
+    const vao::Status s = vao::buildMomentPyramid(viewOf(values, dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid);
+    EXPECT_FALSE(s.ok) << inside;
+    EXPECT_NE(s.message.find("rescale"), std::string::npos) << s.message;
+    EXPECT_TRUE(pyramid.empty());
+  }
+  // A constant volume has no variance to lose, whatever its value.
+  std::vector<vao::MomentLevel> constant;
+  EXPECT_TRUE(
+    vao::buildMomentPyramid(viewOf(ballValues(dims, 1e-30, 1e-30), dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, constant).ok);
+
+  const std::vector<double> unit = ballValues(dims, 1.0, 0.0);
+  std::vector<vao::MomentLevel> expected;
+  ASSERT_TRUE(vao::buildMomentPyramid(viewOf(unit, dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, expected).ok);
+  for (const int exponent : { -50, 55 })
+  {
+    const std::vector<double> scaled = ballValues(dims, std::ldexp(1.0, exponent), 0.0);
+    std::vector<vao::MomentLevel> pyramid;
+    const vao::Status s = vao::buildMomentPyramid(viewOf(scaled, dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid);
+    ASSERT_TRUE(s.ok) << s.message;
+    ASSERT_EQ(pyramid.size(), expected.size());
+    for (std::size_t l = 0; l < pyramid.size(); ++l)
+      for (std::size_t i = 0; i < pyramid[l].mean.size(); ++i)
+      {
+        ASSERT_NEAR(std::ldexp(pyramid[l].mean[i], -exponent), expected[l].mean[i], 1e-6) << l << " " << i;
+        ASSERT_NEAR(std::ldexp(pyramid[l].variance[i], -2 * exponent), expected[l].variance[i], 1e-6) << l << " " << i;
+      }
+  }
+}
+
 TEST(ExtremeInputs, ByteOfNanIsZeroNotUndefined)
 {
   EXPECT_EQ(vao::toByte(std::numeric_limits<double>::quiet_NaN()), 0);

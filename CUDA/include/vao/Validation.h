@@ -68,6 +68,17 @@ constexpr double kLargestMomentMagnitude = 1e140;
 /// A failure when the scanned values exceed kLargestMomentMagnitude in magnitude.
 Status checkMomentMagnitude(const ValueScan& scan);
 
+/// The spans of values whose variances the moment pyramid's float32 levels hold: beyond
+/// 1e18 the variance of a box of them can pass float's largest (3.4e38); below 1e-17 the
+/// variance of a box with a tenth of them changed falls under its smallest normal
+/// (1.2e-38), and flat and textured regions look alike.
+constexpr double kLargestPyramidSpan = 1e18;
+constexpr double kSmallestPyramidSpan = 1e-17;
+
+/// A failure when the scanned values span more than kLargestPyramidSpan, or less than
+/// kSmallestPyramidSpan without being constant.
+Status checkPyramidSpan(const ValueScan& scan);
+
 /// No NaN or infinite voxel; otherwise Status::nonFinite (count and first index). One
 /// parallel pass over the data (none for integer types).
 Status checkFiniteValues(const VolumeView& volume);

@@ -82,6 +82,8 @@ Status preparePyramid(const VolumeView& volume, const std::array<double, 3>& ori
     status = finiteStatus(scan);
   if (status.ok)
     status = checkMomentMagnitude(scan);
+  if (status.ok)
+    status = checkPyramidSpan(scan);
   if (!status.ok)
   {
     return status;

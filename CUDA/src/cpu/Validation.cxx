@@ -232,6 +232,22 @@ Status checkMomentMagnitude(const ValueScan& scan)
   return Status::failure(why.str());
 }
 
+Status checkPyramidSpan(const ValueScan& scan)
+{
+  const double span = scan.maximum - scan.minimum;
+  const bool tooWide = span > kLargestPyramidSpan;
+  if (!tooWide && !(span > 0.0 && span < kSmallestPyramidSpan))
+  {
+    return Status::success();
+  }
+  std::ostringstream why;
+  why << "the values span " << span << " (" << scan.minimum << " to " << scan.maximum << "); "
+      << (tooWide ? "above " : "below ") << (tooWide ? kLargestPyramidSpan : kSmallestPyramidSpan)
+      << " their variances " << (tooWide ? "overflow" : "underflow")
+      << " the pyramid's float32 levels: rescale the data (e.g. with the Calculator) first";
+  return Status::failure(why.str());
+}
+
 Status validateMomentRequest(const VolumeView& volume, const Region& region, const Radius& radius, ValueScan& scan)
 {
   Status status = validate(volume, region, radius);
