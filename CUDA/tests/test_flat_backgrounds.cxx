@@ -120,6 +120,20 @@ void expectFlatBoxesExact(const std::vector<T>& v, const std::string& label)
                           << " flat boxes wrong, the first at index " << first << " (got "
                           << (first >= 0 ? open[first] : 0.0f) << ")";
     }
+    // The Variance output: exactly 0 on every flat box (double sums leave rounding there,
+    // which the flat rule reads as flat), and the box's own elsewhere.
+    vao::AmbientOcclusionParameters p;
+    p.radius = { r, r, r };
+    std::vector<float> variance(v.size(), -1.0f);
+    ASSERT_TRUE(vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { nullptr, variance.data() }).ok);
+    std::int64_t nonzero = 0, zero = 0;
+    for (std::size_t i = 0; i < v.size(); ++i)
+    {
+      nonzero += flat[i] && variance[i] != 0.0f;
+      zero += !flat[i] && !(variance[i] > 0.0f);
+    }
+    EXPECT_EQ(nonzero, 0) << label << ", R = " << r << ": flat boxes with a variance";
+    EXPECT_EQ(zero, 0) << label << ", R = " << r << ": boxes of two values without one";
   }
 }
 

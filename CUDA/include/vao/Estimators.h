@@ -83,6 +83,14 @@ VAO_HD bool isFlatVariance(double variance, double roundingVariance = 0.0)
   return variance <= roundingVariance;
 }
 
+/// The variance a box reports (the Variance output): 0 where the flat rule calls the box
+/// flat, so that flat regions read exactly 0 whatever the data's type (double sums leave
+/// rounding there, 1e-13 on values near 7).
+VAO_HD double reportedVariance(double variance, double roundingVariance)
+{
+  return isFlatVariance(variance, roundingVariance) ? 0.0 : variance;
+}
+
 /// How far below its mean a flat neighbourhood's value can lie once the mean is rounded,
 /// relative to |mu|: float32 precision, which the moment pyramid's levels are stored in
 /// (a mean of sums is a few double ulps off). Relative to |mu| alone, so that it scales

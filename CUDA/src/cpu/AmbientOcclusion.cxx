@@ -59,7 +59,7 @@ Status separableOpenness(const VolumeView& view, const Region& region,
       if (output.variance)
       {
         for (std::int64_t i = 0; i < row.size; ++i)
-          output.variance[row.index + i] = static_cast<float>(row.variance[i]);
+          output.variance[row.index + i] = static_cast<float>(reportedVariance(row.variance[i], row.roundingVariance));
       }
       if (output.openness)
       {

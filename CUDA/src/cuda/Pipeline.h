@@ -153,7 +153,7 @@ struct StatisticsWriter
       out.openness[index] = static_cast<float>(opennessFromStats(estimator.method, q, s, estimator.erfMode));
     }
     if (out.variance)
-      out.variance[index] = static_cast<float>(s.variance);
+      out.variance[index] = static_cast<float>(reportedVariance(s.variance, s.roundingVariance));
     if (out.count)
       out.count[index] = static_cast<double>(n);
     if (out.mean)
