@@ -116,7 +116,7 @@ def reference(v, radii, method, iso, bins):
     return out.reshape(v.shape), variance.reshape(v.shape)
 
 
-def run(v, method, radius, world, spacing, extent0, iso, bins):
+def run(v, method, radius, world, spacing, extent0, iso, bins, smoothing=None):
     image = vtkImageData()
     nz, ny, nx = v.shape
     image.SetExtent(extent0[0], extent0[0] + nx - 1, extent0[1], extent0[1] + ny - 1, extent0[2], extent0[2] + nz - 1)
@@ -135,6 +135,9 @@ def run(v, method, radius, world, spacing, extent0, iso, bins):
     if iso is not None:
         f.SetQueryMode(F.ISO_VALUE)
         f.SetIsoValue(iso)
+    elif smoothing is not None:
+        f.SetQueryMode(F.SMOOTHED_VALUE)
+        f.SetQuerySmoothing(smoothing)
     f.Update()
     data = f.GetOutput().GetPointData()
     arrays = [data.GetArray(name) for name in ("AmbientOcclusion", "Variance")]
@@ -185,17 +188,18 @@ for k in range(cases):
 
 # Invariance: a soft-tissue-like field at offsets and in units far from 1.
 base = np.asarray(1000 + rng.integers(-20, 21, (9, 10, 11)), dtype=np.int16)
-for method in ("GAUSSIAN_CDF", "CHEBYSHEV", "CDF_RECONSTRUCTION"):
-    expected, _ = run(base, method, 2.0, False, (1.0, 1.0, 1.0), (0, 0, 0), None, 64)
+for method, smoothing in (("GAUSSIAN_CDF", None), ("CHEBYSHEV", None), ("CDF_RECONSTRUCTION", None),
+                          ("EXACT_BOX", 1.0), ("GAUSSIAN_CDF", 1.0)):
+    expected, _ = run(base, method, 2.0, False, (1.0, 1.0, 1.0), (0, 0, 0), None, 64, smoothing)
     for name, values in (("int32 + 1e9", base.astype(np.int32) + 1000000000),
                          ("int64 - 1e12", base.astype(np.int64) - 10 ** 12),
                          ("float64 * 1e-10", base * 1e-10),
                          ("float64 * 1e-25 + 1e-21", base * 1e-25 + 1e-21),
                          ("float32 * 2^-60", np.ldexp(base.astype(np.float32), -60))):
-        got, _ = run(values, method, 2.0, False, (1.0, 1.0, 1.0), (0, 0, 0), None, 64)
+        got, _ = run(values, method, 2.0, False, (1.0, 1.0, 1.0), (0, 0, 0), None, 64, smoothing)
         if got is None or np.abs(got - expected).max() > 1e-5:
-            failures.append("%s of %s differs from the int16 field's by %s" % (
-                method, name, "no output" if got is None else "%.3g" % np.abs(got - expected).max()))
+            failures.append("%s (smoothed query %s) of %s differs from the int16 field's by %s" % (
+                method, smoothing, name, "no output" if got is None else "%.3g" % np.abs(got - expected).max()))
 
 print("%d cases against the exact reference (seed %d), %d failures" % (compared_cases, seed, len(failures)))
 for failure in failures:

@@ -75,11 +75,14 @@ double centredAverage(double centre, const double* w, std::int64_t first, std::i
 }
 
 /// Integer data: a query within rounding of an integer is that integer, so that a flat or
-/// symmetric window counts its own value as <= q whatever the order of the sums.
+/// symmetric window counts its own value as <= q whatever the order of the sums. Within
+/// 1e-9 of it relative to its magnitude, but never more than 1e-6 away: at 1e9 the relative
+/// bound alone would take every query to an integer (the CT head with an offset of 1e9
+/// then gave Exact Box counts up to 0.24 off).
 double snapToInteger(double q)
 {
   const double r = std::nearbyint(q);
-  return std::abs(q - r) <= 1e-9 * std::max(1.0, std::abs(r)) ? r : q;
+  return std::abs(q - r) <= std::min(1e-9 * std::max(1.0, std::abs(r)), 1e-6) ? r : q;
 }
 
 template <class T>
