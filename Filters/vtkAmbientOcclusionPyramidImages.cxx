@@ -8,6 +8,7 @@
 #include "vtkPointData.h"
 
 #include <algorithm>
+#include <sstream>
 #include <utility>
 
 namespace vtkAmbientOcclusionPyramidImages
@@ -41,6 +42,20 @@ bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vt
     scalars.view, ExtentOrigin(input), { h[0], h[1], h[2] }, parameters, pyramid, execution);
   error = vtkAmbientOcclusionArrayInput::KernelError(status, scalars, "The variance occlusion map failed");
   return status.ok;
+}
+
+std::string PrecisionWarning(const std::vector<vao::MomentLevel>& levels)
+{
+  const double resolution = levels.empty() ? 0.0 : vao::meanResolution(levels.back());
+  if (!(resolution > vao::kCoarseMeanResolution))
+  {
+    return {};
+  }
+  std::ostringstream why;
+  why << "The values lie far from 0 against their spread: the pyramid's float32 means resolve "
+      << resolution << " of it (above " << vao::kCoarseMeanResolution
+      << "), so AO and shadows lose precision. Subtract an offset first (e.g. with the Calculator).";
+  return why.str();
 }
 
 vao::MomentLevel WholeLevelGeometry(vtkImageData* volume, const int whole[6], int step)

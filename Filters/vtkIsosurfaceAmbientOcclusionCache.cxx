@@ -139,6 +139,11 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
     }
     return false;
   }
+  const std::string warning = PyramidImages::PrecisionWarning(cache.surface.levels());
+  if (!warning.empty())
+  {
+    vtkWarningMacro(<< warning);
+  }
   cache.origin = PyramidImages::ExtentOrigin(volume);
   cache.spacing = { h[0], h[1], h[2] };
   std::copy(extent, extent + 6, cache.extent.begin());
@@ -181,6 +186,11 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
     vtkErrorMacro(<< (error.empty() ? std::string("The pyramid failed on another process (see its message).") : error));
     cache.levels.clear();
     return false;
+  }
+  const std::string warning = PyramidImages::PrecisionWarning(cache.levels);
+  if (!warning.empty())
+  {
+    vtkWarningMacro(<< warning);
   }
   this->ShareCoarsestLevel(volume, whole, expected, piece);
   if (empty)

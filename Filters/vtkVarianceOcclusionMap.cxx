@@ -130,6 +130,11 @@ int vtkVarianceOcclusionMap::RequestData(
       }
       return 1;
     }
+    const std::string warning = vtkAmbientOcclusionPyramidImages::PrecisionWarning(pyramid);
+    if (!warning.empty())
+    {
+      vtkWarningMacro(<< warning);
+    }
     // Level l keeps every step-th input voxel (from the input's first, aligned on it); the
     // piece's level voxels are those whose input voxel lies in the piece.
     output->SetNumberOfBlocks(static_cast<unsigned int>(pyramid.size()));

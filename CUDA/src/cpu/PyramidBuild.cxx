@@ -153,6 +153,18 @@ void setLevelGeometry(std::vector<MomentLevel>& levels, const std::array<double,
 
 } // namespace detail
 
+double meanResolution(const MomentLevel& level)
+{
+  if (level.mean.size() == 0)
+  {
+    return 0.0;
+  }
+  const auto range = std::minmax_element(level.mean.data(), level.mean.data() + level.mean.size());
+  const double lo = *range.first, hi = *range.second;
+  const double halfUlp = std::ldexp(std::max(std::abs(lo), std::abs(hi)), -24);
+  return hi > lo ? halfUlp / (hi - lo) : 0.0;
+}
+
 Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const PyramidParameters& parameters,
   std::vector<MomentLevel>& pyramid, const Execution& execution)
