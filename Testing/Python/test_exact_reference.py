@@ -196,6 +196,8 @@ for method, smoothing in (("GAUSSIAN_CDF", None), ("CHEBYSHEV", None), ("CDF_REC
                          ("float64 * 1e-10", base * 1e-10),
                          ("float64 * 1e-25 + 1e-21", base * 1e-25 + 1e-21),
                          ("float32 * 2^-60", np.ldexp(base.astype(np.float32), -60))):
+        if smoothing is not None and name == "int64 - 1e12":
+            continue  # a double query there resolves 1e-4: one near an integer may round to it
         got, _ = run(values, method, 2.0, False, (1.0, 1.0, 1.0), (0, 0, 0), None, 64, smoothing)
         if got is None or np.abs(got - expected).max() > 1e-5:
             failures.append("%s (smoothed query %s) of %s differs from the int16 field's by %s" % (
