@@ -5,10 +5,10 @@
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
+#include "vtkObject.h"
 #include "vtkPointData.h"
 
 #include <algorithm>
-#include <sstream>
 #include <utility>
 
 namespace vtkAmbientOcclusionPyramidImages
@@ -44,18 +44,17 @@ bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vt
   return status.ok;
 }
 
-std::string PrecisionWarning(const std::vector<vao::MomentLevel>& levels)
+void WarnOfCoarseMeans(vtkObject* owner, const std::vector<vao::MomentLevel>& levels)
 {
   const double resolution = levels.empty() ? 0.0 : vao::meanResolution(levels.back());
-  if (!(resolution > vao::kCoarseMeanResolution))
+  if (resolution > vao::kCoarseMeanResolution)
   {
-    return {};
+    vtkWarningWithObjectMacro(owner, << "The values lie far from 0 against their spread: the pyramid's float32 "
+                                        "means resolve "
+                                     << resolution << " of it (above " << vao::kCoarseMeanResolution
+                                     << "), so AO and shadows lose precision. Subtract an offset first (e.g. "
+                                        "with the Calculator).");
   }
-  std::ostringstream why;
-  why << "The values lie far from 0 against their spread: the pyramid's float32 means resolve "
-      << resolution << " of it (above " << vao::kCoarseMeanResolution
-      << "), so AO and shadows lose precision. Subtract an offset first (e.g. with the Calculator).";
-  return why.str();
 }
 
 vao::MomentLevel WholeLevelGeometry(vtkImageData* volume, const int whole[6], int step)

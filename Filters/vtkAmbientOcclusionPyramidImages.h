@@ -15,6 +15,7 @@
 #include <vector>
 
 class vtkImageData;
+class vtkObject;
 
 namespace vtkAmbientOcclusionPyramidImages
 {
@@ -35,10 +36,10 @@ bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vt
   const vao::PyramidParameters& parameters, const vao::Execution& execution, vao::SurfacePyramid& pyramid,
   std::string& error);
 
-/// A warning for the user when the levels' float32 means resolve the values coarsely
+/// Warns, as `owner`, when the levels' float32 means resolve the values coarsely
 /// (vao::meanResolution of the coarsest level past vao::kCoarseMeanResolution: values far
-/// from 0 against their spread); empty otherwise.
-std::string PrecisionWarning(const std::vector<vao::MomentLevel>& levels);
+/// from 0 against their spread).
+void WarnOfCoarseMeans(vtkObject* owner, const std::vector<vao::MomentLevel>& levels);
 
 /// The geometry (dims, origin, spacing) of the whole volume's level that keeps every
 /// step-th voxel of `volume`'s grid from the start of its whole extent; no values.

@@ -139,11 +139,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
     }
     return false;
   }
-  const std::string warning = PyramidImages::PrecisionWarning(cache.surface.levels());
-  if (!warning.empty())
-  {
-    vtkWarningMacro(<< warning);
-  }
+  PyramidImages::WarnOfCoarseMeans(this, cache.surface.levels());
   cache.origin = PyramidImages::ExtentOrigin(volume);
   cache.spacing = { h[0], h[1], h[2] };
   std::copy(extent, extent + 6, cache.extent.begin());
@@ -187,11 +183,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
     cache.levels.clear();
     return false;
   }
-  const std::string warning = PyramidImages::PrecisionWarning(cache.levels);
-  if (!warning.empty())
-  {
-    vtkWarningMacro(<< warning);
-  }
+  PyramidImages::WarnOfCoarseMeans(this, cache.levels);
   this->ShareCoarsestLevel(volume, whole, expected, piece);
   if (empty)
   {

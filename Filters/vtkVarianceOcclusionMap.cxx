@@ -130,11 +130,7 @@ int vtkVarianceOcclusionMap::RequestData(
       }
       return 1;
     }
-    const std::string warning = vtkAmbientOcclusionPyramidImages::PrecisionWarning(pyramid);
-    if (!warning.empty())
-    {
-      vtkWarningMacro(<< warning);
-    }
+    vtkAmbientOcclusionPyramidImages::WarnOfCoarseMeans(this, pyramid);
     // Level l keeps every step-th input voxel (from the input's first, aligned on it); the
     // piece's level voxels are those whose input voxel lies in the piece.
     output->SetNumberOfBlocks(static_cast<unsigned int>(pyramid.size()));

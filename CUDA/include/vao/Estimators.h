@@ -52,13 +52,6 @@ struct NeighbourhoodStats
   double roundingVariance = 0.0;
 };
 
-/// The flat-neighbourhood rule (METHODS.md: s2 <= eps max(1, mu^2)) with eps = 0 beyond
-/// rounding: a box is flat where its variance is at most what the rounding of its sums can
-/// give a flat box (roundingVariance: 0 for exact sums, sumRoundingVariance for double
-/// sums, which scales with the data's spread about the shift). A threshold relative to mu^2
-/// or to 1 would break the estimators' invariance to offset and scale: CT values stored
-/// with an offset of 1e9 (mu^2 ~ 1e18) or in units of 1e-10 (every variance below 1e-14)
-/// would make every box flat, and every openness 0 or 1.
 /// Ulps of deviation^2 that streamed double sums may be off by, in variance: the running
 /// sums of (v - shift) and (v - shift)^2 add and subtract every slice, row and voxel that
 /// enters or leaves a window, so their rounding grows with the largest |v - shift| of the
@@ -78,6 +71,13 @@ VAO_HD double sumRoundingVariance(double deviation)
   return kSumRoundingUlps * kDoubleUlp * deviation * deviation;
 }
 
+/// The flat-neighbourhood rule (METHODS.md: s2 <= eps max(1, mu^2)) with eps = 0 beyond
+/// rounding: a box is flat where its variance is at most what the rounding of its sums can
+/// give a flat box (roundingVariance: 0 for exact sums, sumRoundingVariance for double
+/// sums, which scales with the data's spread about the shift). A threshold relative to mu^2
+/// or to 1 would break the estimators' invariance to offset and scale: CT values stored
+/// with an offset of 1e9 (mu^2 ~ 1e18) or in units of 1e-10 (every variance below 1e-14)
+/// would make every box flat, and every openness 0 or 1.
 VAO_HD bool isFlatVariance(double variance, double roundingVariance = 0.0)
 {
   return variance <= roundingVariance;

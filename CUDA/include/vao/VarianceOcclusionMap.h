@@ -61,6 +61,10 @@ struct PyramidParameters
 /// per axis) and finite, the spacing finite and positive, 1 <= levels <= 16; on failure
 /// the pyramid is left empty. A pyramid passed in from an earlier build of the same size
 /// is rebuilt in its own storage (no reallocation).
+Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
+  std::vector<MomentLevel>& pyramid, const Execution& execution = {});
+
 /// How coarsely a level's float32 means resolve its values: half a float ulp of its largest
 /// |mean| over the spread (largest minus smallest) of its means; 0 for a constant level.
 /// Values far from 0 against their spread lose detail: the CT head at an offset of 1e6
@@ -68,10 +72,6 @@ struct PyramidParameters
 /// (within 7e-3). Past kCoarseMeanResolution the filters warn.
 double meanResolution(const MomentLevel& level);
 constexpr double kCoarseMeanResolution = 1e-4;
-
-Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
-  std::vector<MomentLevel>& pyramid, const Execution& execution = {});
 
 enum class SurfaceQuery : int
 {
