@@ -214,7 +214,7 @@ TEST(SimdTiers, RunningTotalsEqualTheSumsOneByOne)
   std::mt19937_64 rng(31);
   for (const SimdTier tier : kTiers)
   {
-    for (std::int64_t n = 0; n <= 41; ++n)
+    for (std::int64_t n = 0; n <= 70; ++n)
     {
       std::vector<std::int64_t> a(n), b(n), expectedA(n), expectedB(n);
       std::int64_t totalA = 0, totalB = 0;
@@ -228,20 +228,26 @@ TEST(SimdTiers, RunningTotalsEqualTheSumsOneByOne)
       // Capped like every loop here: a tier the processor lacks runs the best it has.
       const TierCap cap(tier);
       std::vector<std::int64_t> single = a; // one row alone (no second row)
-      std::vector<std::uint32_t> narrow(n), expectedNarrow(n);
-      std::uint32_t totalNarrow = 0;
+      std::vector<std::uint32_t> narrow(n), narrowB(n), expectedNarrow(n), expectedNarrowB(n);
+      std::uint32_t totalNarrow = 0, totalNarrowB = 0;
       for (std::int64_t i = 0; i < n; ++i)
       {
         narrow[i] = static_cast<std::uint32_t>(rng()); // the totals wrap modulo 2^32
+        narrowB[i] = static_cast<std::uint32_t>(rng() % 5);
         expectedNarrow[i] = totalNarrow += narrow[i];
+        expectedNarrowB[i] = totalNarrowB += narrowB[i];
       }
+      std::vector<std::uint32_t> narrowSingle = narrow;
       vao::detail::runningTotals(a.data(), b.data(), n, vao::detail::cpuSimdTier());
       vao::detail::runningTotals(single.data(), nullptr, n, vao::detail::cpuSimdTier());
-      vao::detail::runningTotals(narrow.data(), n, vao::detail::cpuSimdTier());
+      vao::detail::runningTotals(narrow.data(), narrowB.data(), n, vao::detail::cpuSimdTier());
+      vao::detail::runningTotals(narrowSingle.data(), nullptr, n, vao::detail::cpuSimdTier());
       ASSERT_EQ(a, expectedA) << "tier " << static_cast<int>(tier) << ", n " << n;
       ASSERT_EQ(b, expectedB) << "tier " << static_cast<int>(tier) << ", n " << n;
       ASSERT_EQ(single, expectedA) << "one row, tier " << static_cast<int>(tier) << ", n " << n;
       ASSERT_EQ(narrow, expectedNarrow) << "32 bits, tier " << static_cast<int>(tier) << ", n " << n;
+      ASSERT_EQ(narrowB, expectedNarrowB) << "32 bits, second row, tier " << static_cast<int>(tier) << ", n " << n;
+      ASSERT_EQ(narrowSingle, expectedNarrow) << "32 bits, one row, tier " << static_cast<int>(tier) << ", n " << n;
     }
   }
 }

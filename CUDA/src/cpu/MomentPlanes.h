@@ -304,9 +304,7 @@ private:
         q2[0] = 0;
         // No window (at most 2r + 1 values of the row) sums past int32's range.
         narrowSquares = double(std::min<std::int64_t>(2 * r + 1, span)) * largest < 2147483648.0;
-        if (narrowSquares)
-          runningTotals(q2, span + 1, this->Simd);
-        else // the 64-bit sums below, from the same differences
+        if (!narrowSquares) // the 64-bit sums below, from the same differences
           for (std::int64_t i = 0; i <= span; ++i)
             p2[i] = static_cast<std::int32_t>(q2[i]);
       }
@@ -323,7 +321,8 @@ private:
     }
     if constexpr (std::is_same<Lin, std::uint32_t>::value)
     {
-      runningTotals(p1, span + 1, this->Simd); // modulo 2^32, as every box sum below
+      // Modulo 2^32, as every box sum below; with the narrow squares' in the same loop.
+      runningTotals(p1, narrowSquares ? q2 : nullptr, span + 1, this->Simd);
       if (this->Squares && !narrowSquares)
         runningTotals(p2, nullptr, span + 1, this->Simd);
     }

@@ -107,6 +107,43 @@ VAO_AVX2_INLINE void runningTotalsAvx2(std::uint32_t* a, std::int64_t n)
   runningTotalsOfRow(a, i, n);
 }
 
+/// The running totals within sixteen 32-bit lanes: lane k gains lanes k - 1, k - 2, k - 4,
+/// k - 8 in turn.
+VAO_AVX512_TARGET inline __m512i scanLanes32(__m512i x)
+{
+  const __m512i zero = _mm512_setzero_si512();
+  x = _mm512_add_epi32(x, _mm512_alignr_epi32(x, zero, 15));
+  x = _mm512_add_epi32(x, _mm512_alignr_epi32(x, zero, 14));
+  x = _mm512_add_epi32(x, _mm512_alignr_epi32(x, zero, 12));
+  return _mm512_add_epi32(x, _mm512_alignr_epi32(x, zero, 8));
+}
+
+/// 32-bit running totals of a and, with Both, of b, sixteen at a time; as on AVX2, the
+/// chain from one sixteen to the next is the single addition of the carried total.
+template <bool Both>
+VAO_AVX512_TARGET void runningTotalsAvx512(std::uint32_t* a, std::uint32_t* b, std::int64_t n)
+{
+  const __m512i last = _mm512_set1_epi32(15);
+  __m512i carryA = _mm512_setzero_si512();
+  __m512i carryB = _mm512_setzero_si512();
+  std::int64_t i = 0;
+  for (; i + 16 <= n; i += 16)
+  {
+    const __m512i x = scanLanes32(_mm512_loadu_si512(a + i));
+    _mm512_storeu_si512(a + i, _mm512_add_epi32(x, carryA));
+    carryA = _mm512_add_epi32(carryA, _mm512_permutexvar_epi32(last, x));
+    if constexpr (Both)
+    {
+      const __m512i y = scanLanes32(_mm512_loadu_si512(b + i));
+      _mm512_storeu_si512(b + i, _mm512_add_epi32(y, carryB));
+      carryB = _mm512_add_epi32(carryB, _mm512_permutexvar_epi32(last, y));
+    }
+  }
+  runningTotalsOfRow(a, i, n);
+  if constexpr (Both)
+    runningTotalsOfRow(b, i, n);
+}
+
 /// Of a and, with Both, of b.
 template <bool Both>
 VAO_AVX512_TARGET void runningTotalsAvx512(std::int64_t* a, std::int64_t* b, std::int64_t n)
@@ -157,17 +194,29 @@ void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier ti
   runningTotalsPlain(a, b, 0, n);
 }
 
-void runningTotals(std::uint32_t* a, std::int64_t n, SimdTier tier)
+void runningTotals(std::uint32_t* a, std::uint32_t* b, std::int64_t n, SimdTier tier)
 {
 #if VAO_HAVE_AVX2_TARGET
-  if (tier >= SimdTier::Avx2)
+  if (tier >= SimdTier::Avx512)
+  {
+    if (b)
+      runningTotalsAvx512<true>(a, b, n);
+    else
+      runningTotalsAvx512<false>(a, nullptr, n);
+    return;
+  }
+  if (tier == SimdTier::Avx2)
   {
     runningTotalsAvx2(a, n);
+    if (b)
+      runningTotalsAvx2(b, n);
     return;
   }
 #endif
   (void)tier;
   runningTotalsOfRow(a, 0, n);
+  if (b)
+    runningTotalsOfRow(b, 0, n);
 }
 
 } // namespace detail
