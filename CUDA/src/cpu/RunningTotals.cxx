@@ -24,7 +24,8 @@ void runningTotalsOfRow(V* a, std::int64_t begin, std::int64_t n)
 /// From `begin` on, one value at a time; the running totals stay in registers (a and b may
 /// alias as far as the compiler knows, so a[i] += a[i - 1] would reload each value just
 /// stored).
-void runningTotalsPlain(std::int64_t* a, std::int64_t* b, std::int64_t begin, std::int64_t n)
+template <class V>
+void runningTotalsPlain(V* a, V* b, std::int64_t begin, std::int64_t n)
 {
   if (begin >= n)
     return;
@@ -33,8 +34,8 @@ void runningTotalsPlain(std::int64_t* a, std::int64_t* b, std::int64_t begin, st
     runningTotalsOfRow(a, begin, n);
     return;
   }
-  std::int64_t totalA = begin > 0 ? a[begin - 1] : 0;
-  std::int64_t totalB = begin > 0 ? b[begin - 1] : 0;
+  V totalA = begin > 0 ? a[begin - 1] : V(0);
+  V totalB = begin > 0 ? b[begin - 1] : V(0);
   for (std::int64_t i = begin; i < n; ++i)
   {
     totalA += a[i];
@@ -89,7 +90,7 @@ VAO_AVX2_INLINE void runningTotalsAvx2(std::int64_t* a, std::int64_t* b, std::in
 /// then the low half's total added to the high half. The carried total of the values
 /// before is added last; its next value sums the scan's own last lane, so the chain from
 /// one eight to the next is a single addition.
-VAO_AVX2_INLINE void runningTotalsAvx2(std::uint32_t* a, std::int64_t n)
+VAO_AVX2_INLINE void runningTotalsAvx2Row(std::uint32_t* a, std::int64_t n)
 {
   const __m256i last = _mm256_set1_epi32(7);
   __m256i carry = _mm256_setzero_si256();
@@ -105,6 +106,15 @@ VAO_AVX2_INLINE void runningTotalsAvx2(std::uint32_t* a, std::int64_t n)
     carry = _mm256_add_epi32(carry, _mm256_permutevar8x32_epi32(x, last));
   }
   runningTotalsOfRow(a, i, n);
+}
+
+/// Of a and, with Both, of b, one row after the other.
+template <bool Both>
+VAO_AVX2_INLINE void runningTotalsAvx2(std::uint32_t* a, std::uint32_t* b, std::int64_t n)
+{
+  runningTotalsAvx2Row(a, n);
+  if constexpr (Both)
+    runningTotalsAvx2Row(b, n);
 }
 
 /// The running totals within sixteen 32-bit lanes: lane k gains lanes k - 1, k - 2, k - 4,
@@ -139,9 +149,7 @@ VAO_AVX512_TARGET void runningTotalsAvx512(std::uint32_t* a, std::uint32_t* b, s
       carryB = _mm512_add_epi32(carryB, _mm512_permutexvar_epi32(last, y));
     }
   }
-  runningTotalsOfRow(a, i, n);
-  if constexpr (Both)
-    runningTotalsOfRow(b, i, n);
+  runningTotalsPlain(a, b, i, n);
 }
 
 /// Of a and, with Both, of b.
@@ -168,9 +176,9 @@ VAO_AVX512_TARGET void runningTotalsAvx512(std::int64_t* a, std::int64_t* b, std
 }
 #endif
 
-} // namespace
-
-void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier tier)
+/// The widest tier the processor has, for 64- or 32-bit rows alike.
+template <class V>
+void runningTotalsOnTier(V* a, V* b, std::int64_t n, SimdTier tier)
 {
 #if VAO_HAVE_AVX2_TARGET
   if (tier >= SimdTier::Avx512)
@@ -194,29 +202,16 @@ void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier ti
   runningTotalsPlain(a, b, 0, n);
 }
 
+} // namespace
+
+void runningTotals(std::int64_t* a, std::int64_t* b, std::int64_t n, SimdTier tier)
+{
+  runningTotalsOnTier(a, b, n, tier);
+}
+
 void runningTotals(std::uint32_t* a, std::uint32_t* b, std::int64_t n, SimdTier tier)
 {
-#if VAO_HAVE_AVX2_TARGET
-  if (tier >= SimdTier::Avx512)
-  {
-    if (b)
-      runningTotalsAvx512<true>(a, b, n);
-    else
-      runningTotalsAvx512<false>(a, nullptr, n);
-    return;
-  }
-  if (tier == SimdTier::Avx2)
-  {
-    runningTotalsAvx2(a, n);
-    if (b)
-      runningTotalsAvx2(b, n);
-    return;
-  }
-#endif
-  (void)tier;
-  runningTotalsOfRow(a, 0, n);
-  if (b)
-    runningTotalsOfRow(b, 0, n);
+  runningTotalsOnTier(a, b, n, tier);
 }
 
 } // namespace detail
