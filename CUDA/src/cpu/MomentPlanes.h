@@ -5,7 +5,8 @@
 // that enters the window and subtracts the one that leaves; both are done in one x/y pass
 // over the difference of the two slices (box sums are linear). Per voxel and slice this is
 // O(1) whatever the radius, and only the input is read from memory and the output written:
-// the x-box rows stay in cache (a ring of 2 r_y + 2 of them), and the plane is read and
+// the x-box rows stay in cache (a ring of 2 r_y + 2 of them; the sums of squares of 8-bit
+// and int16 rows in 32 bits where each fits, as on CT-like data), and the plane is read and
 // written once per slice.
 #pragma once
 
@@ -59,24 +60,25 @@ struct BoxGeometry
 
 /// One row of the y pass: plane += run (when plane is not null), then the running column
 /// sums move on: run = (run + entering) - leaving, in that order (the rounding of double
-/// sums is that of the scalar code it replaced), in one loop that loads run once.
-/// Compiled for AVX2 too (CpuDispatch.h).
-template <class Acc>
+/// sums is that of the scalar code it replaced), in one loop that loads run once. The
+/// x-box rows entering and leaving may be narrower integers (int32 sums of squares,
+/// widened here). Compiled for AVX2 too (CpuDispatch.h).
+template <class Acc, class In = Acc, class Out = Acc>
 struct SlideColumns
 {
-  static VAO_ALWAYS_INLINE void run(Acc* __restrict plane, Acc* __restrict run, const Acc* __restrict entering,
-    const Acc* __restrict leaving, std::int64_t n)
+  static VAO_ALWAYS_INLINE void run(Acc* __restrict plane, Acc* __restrict run, const In* __restrict entering,
+    const Out* __restrict leaving, std::int64_t n)
   {
     if (plane)
       for (std::int64_t i = 0; i < n; ++i)
       {
         const Acc r = run[i];
         plane[i] += r;
-        run[i] = (r + entering[i]) - leaving[i];
+        run[i] = (r + static_cast<Acc>(entering[i])) - static_cast<Acc>(leaving[i]);
       }
     else
       for (std::int64_t i = 0; i < n; ++i)
-        run[i] = (run[i] + entering[i]) - leaving[i];
+        run[i] = (run[i] + static_cast<Acc>(entering[i])) - static_cast<Acc>(leaving[i]);
   }
 };
 
@@ -197,10 +199,13 @@ public:
     , RingRows(std::min<std::int64_t>(2 * std::int64_t(geometry.radius.y) + 2, geometry.ys.size()))
     , XBox1(RingRows * geometry.region.size[0])
     , XBox2(squares ? RingRows * geometry.region.size[0] : 0)
+    , XBox2Narrow(squares && kNarrowSquares ? RingRows * geometry.region.size[0] : 0)
+    , SlotNarrow(static_cast<std::size_t>(RingRows), 0)
     , Run1(geometry.region.size[0])
     , Run2(squares ? geometry.region.size[0] : 0)
     , Zeros(geometry.region.size[0], Acc(0))
     , ZerosLin(geometry.region.size[0], Lin(0))
+    , ZerosNarrow(geometry.region.size[0], 0)
   {
   }
 
@@ -255,8 +260,7 @@ private:
       runRows<SlideColumns<Lin>>(this->Simd, plane1, this->Run1.data(), in < 0 ? zerosLin : this->xbox1(in),
         out < 0 ? zerosLin : this->xbox1(out), nx);
       if (this->Squares)
-        runRows<SlideColumns<Acc>>(this->Simd, plane2, this->Run2.data(), in < 0 ? zeros : this->xbox2(in),
-          out < 0 ? zeros : this->xbox2(out), nx);
+        this->slideSquares(plane2, in, out);
     };
     for (std::int64_t y = std::max<std::int64_t>(0, y0 - r); y <= std::min(ny - 1, y0 + r); ++y)
     {
@@ -276,8 +280,35 @@ private:
     }
   }
 
-  Lin* xbox1(std::int64_t y) { return this->XBox1.data() + (y - this->Geo.ys.lo) % this->RingRows * this->Geo.region.size[0]; }
-  Acc* xbox2(std::int64_t y) { return this->XBox2.data() + (y - this->Geo.ys.lo) % this->RingRows * this->Geo.region.size[0]; }
+  std::int64_t slot(std::int64_t y) const { return (y - this->Geo.ys.lo) % this->RingRows; }
+  Lin* xbox1(std::int64_t y) { return this->XBox1.data() + this->slot(y) * this->Geo.region.size[0]; }
+  Acc* xbox2(std::int64_t y) { return this->XBox2.data() + this->slot(y) * this->Geo.region.size[0]; }
+  /// Row y's x-box sums of squares where each fits in int32 (narrow: half the bytes in
+  /// the ring, so that on CT-like data the ring stays in the first-level cache).
+  std::int32_t* xbox2Narrow(std::int64_t y) { return this->XBox2Narrow.data() + this->slot(y) * this->Geo.region.size[0]; }
+
+  /// The y pass of the squares: Run2 moves on by row `in` and `out` (-1: none), each read
+  /// from whichever ring holds it, after plane2 (when not null) has taken it.
+  void slideSquares(Acc* plane2, std::int64_t in, std::int64_t out)
+  {
+    const std::int64_t nx = this->Geo.region.size[0];
+    const bool narrowIn = in < 0 || this->SlotNarrow[this->slot(in)];
+    const bool narrowOut = out < 0 || this->SlotNarrow[this->slot(out)];
+    const std::int32_t* in32 = in < 0 ? this->ZerosNarrow.data() : (narrowIn ? this->xbox2Narrow(in) : nullptr);
+    const std::int32_t* out32 = out < 0 ? this->ZerosNarrow.data() : (narrowOut ? this->xbox2Narrow(out) : nullptr);
+    Acc* run = this->Run2.data();
+    if constexpr (kNarrowSquares)
+    {
+      if (narrowIn && narrowOut)
+        return runRows<SlideColumns<Acc, std::int32_t, std::int32_t>>(this->Simd, plane2, run, in32, out32, nx);
+      if (narrowIn)
+        return runRows<SlideColumns<Acc, std::int32_t, Acc>>(this->Simd, plane2, run, in32, this->xbox2(out), nx);
+      if (narrowOut)
+        return runRows<SlideColumns<Acc, Acc, std::int32_t>>(this->Simd, plane2, run, this->xbox2(in), out32, nx);
+    }
+    const Acc* zeros = this->Zeros.data();
+    runRows<SlideColumns<Acc>>(this->Simd, plane2, run, in < 0 ? zeros : this->xbox2(in), out < 0 ? zeros : this->xbox2(out), nx);
+  }
 
   /// x box sums of one row of (entering - leaving), stored in the ring at xbox1(y), xbox2(y).
   void boxRowDifference(std::int64_t y, std::int64_t entering, std::int64_t leaving)
@@ -351,7 +382,18 @@ private:
     const std::int64_t r = this->Geo.radius.x;
     const std::int64_t x0 = this->Geo.region.begin[0] - this->Geo.xs.lo; // first output in span
     Lin* box1 = this->xbox1(y);
-    Acc* box2 = p2 ? this->xbox2(y) : nullptr;
+    // Sums of squares from 32-bit prefix sums (Sq = std::uint32_t) fit in int32: the narrow ring.
+    constexpr bool narrow = std::is_same<Sq, std::uint32_t>::value && !std::is_same<Acc, std::uint32_t>::value;
+    using Box = typename std::conditional<narrow, std::int32_t, Acc>::type;
+    Box* box2 = nullptr;
+    if (p2)
+    {
+      if constexpr (narrow)
+        box2 = this->xbox2Narrow(y);
+      else
+        box2 = this->xbox2(y);
+      this->SlotNarrow[this->slot(y)] = narrow;
+    }
     // Outputs whose window lies inside the span (a vector loop) and the clamped ends.
     const std::int64_t first = std::min(nx, std::max<std::int64_t>(0, r - x0));
     const std::int64_t end = std::max(first, std::min(nx, span - r - x0));
@@ -360,14 +402,14 @@ private:
       const std::int64_t hi = std::min<std::int64_t>(span, x0 + i + r + 1);
       box1[i] = p1[hi] - p1[lo];
       if (box2)
-        box2[i] = squaresWindow<Acc>(p2[hi] - p2[lo]);
+        box2[i] = squaresWindow<Box>(p2[hi] - p2[lo]);
     };
     for (std::int64_t i = 0; i < first; ++i)
       clamped(i);
     if (box2)
-      runRows<WindowDifferences<Acc, true, Lin, Sq>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+      runRows<WindowDifferences<Box, true, Lin, Sq>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
     else
-      runRows<WindowDifferences<Acc, false, Lin, Sq>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+      runRows<WindowDifferences<Box, false, Lin, Sq>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
     for (std::int64_t i = end; i < nx; ++i)
       clamped(i);
   }
@@ -384,10 +426,13 @@ private:
   std::int64_t RingRows; // x-box rows kept: a window's and the next entering one
   std::vector<Lin> XBox1;
   std::vector<Acc> XBox2;
+  std::vector<std::int32_t> XBox2Narrow; // kNarrowSquares: the rows whose sums fit in int32
+  std::vector<char> SlotNarrow; // per ring slot: its squares are in XBox2Narrow
   std::vector<Lin> Run1;
   std::vector<Acc> Run2;
   std::vector<Acc> Zeros; // a row outside the volume
   std::vector<Lin> ZerosLin; // the same for the sums of v
+  std::vector<std::int32_t> ZerosNarrow; // and for the narrow squares
   SimdTier Simd = cpuSimdTier();
 };
 
