@@ -12,7 +12,9 @@ output after
   2e-5 (one pass of the paper's eight ordered sweeps is not symmetric, by design).
 Isosurface AO (the contour's points, their AO and Shadow) is checked against threads and
 extents (to 1e-5 there: the points' float coordinates round differently at other
-indices); the pyramid's halvings are not symmetric on odd sizes, so not against flips.
+indices), and with one pyramid level against flips of the volume and the light (points
+matched to the nearest, 1e-5). Coarser levels sit on every 2^l-th voxel from the first,
+so with more levels a flip moves their grids and the answer (README, precision).
 
 usage: python3 test_metamorphic.py PACKAGE_DIR [SEED] [CASES]
 """
@@ -22,6 +24,7 @@ sys.path.insert(0, sys.argv[1])
 import numpy as np  # noqa: E402
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy  # noqa: E402
 from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
+from scipy.spatial import cKDTree  # noqa: E402
 from vtkmodules.vtkFiltersCore import vtkFlyingEdges3D  # noqa: E402
 from volumetricao import VolumetricAOFilters as V  # noqa: E402
 
@@ -69,7 +72,10 @@ def volume_run(make, values, threads=1, first=(0, 0, 0)):
     return out
 
 
-def surface_run(values, iso, shadows, threads=1, first=(0, 0, 0)):
+LIGHT = (0.3, -0.5, 0.8)
+
+
+def surface_run(values, iso, shadows, threads=1, first=(0, 0, 0), levels=4, light=LIGHT):
     volume = image(values, first)
     contour = vtkFlyingEdges3D()
     contour.SetInputData(volume)
@@ -81,7 +87,8 @@ def surface_run(values, iso, shadows, threads=1, first=(0, 0, 0)):
     f.SetVolumeData(volume)
     f.SetIsoValue(iso)
     f.SetComputeShadows(shadows)
-    f.SetLightDirection(0.3, -0.5, 0.8)
+    f.SetLightDirection(*light)
+    f.SetNumberOfLevels(levels)
     f.Update()
     o = f.GetOutput()
     if o.GetNumberOfPoints() == 0:
@@ -202,6 +209,20 @@ for case in range(cases):
             check("%s, %d threads" % (what, threads), differs(base, surface_run(values, iso, shadows, threads), 0.0))
         check("%s, extent from (5, -3, 7)" % what,
               differs(base, surface_run(values, iso, shadows, first=(5, -3, 7)), 1e-5))
+        one = surface_run(values, iso, True, levels=1)
+        extent = (np.array(values.shape[::-1]) - 1) * np.array([0.5, 1.0, 1.5])
+        for axis in range(3):
+            light = list(LIGHT)
+            light[axis] = -light[axis]
+            flipped = surface_run(np.flip(values, 2 - axis).copy(), iso, True, levels=1, light=light)
+            points = flipped.pop("points")
+            points[:, axis] = extent[axis] - points[:, axis]
+            distance, nearest = cKDTree(points).query(one["points"])
+            flipped = {k: a[nearest] for k, a in flipped.items()}
+            if "Normals" in flipped:
+                flipped["Normals"] = flipped["Normals"] * np.where(np.arange(3) == axis, -1.0, 1.0)
+            flipped["points"] = one["points"] if distance.max() < 1e-5 else points[nearest]
+            check("%s, one level, flipped along axis %d" % (what, axis), differs(one, flipped, 1e-5))
 print("%d cases, %d failures" % (cases, len(failures)))
 print("FAILED" if failures else "every filter gave the same answer where it must")
 sys.exit(1 if failures else 0)
