@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -164,19 +165,27 @@ double refShadow(const Scene& s, int i, const Vec3& light, const vao::SurfaceOcc
   const Vec3 start = along(x, n, r0);
   const int levels = static_cast<int>(s.pyramid.size());
   double occlusion = 0.0;
-  for (double t = 0.0;;)
+  // The distance in units of r0: the steps, half a level's radius (r_l = 2^l r0), add
+  // exactly, so the levels change exactly where t / r0 + 1 reaches a power of two.
+  for (double u = 0.0;;)
   {
+    const double t = u * r0;
     const Vec3 at = along(start, l, t);
     bool inside = true;
     for (int a = 0; a < 3; ++a)
-      inside = inside && at[a] >= base.origin[a] && at[a] <= base.origin[a] + (base.dims[a] - 1) * base.spacing[a];
+    {
+      // The volume's box, faces included to two float32 ulps (surface points are floats).
+      const double lo = base.origin[a], hi = base.origin[a] + (base.dims[a] - 1) * base.spacing[a];
+      const double slack = 2.0 * std::numeric_limits<float>::epsilon() * std::max(std::abs(lo), std::abs(hi));
+      inside = inside && at[a] >= lo - slack && at[a] <= hi + slack;
+    }
     if (!inside)
       break;
     const int level = std::clamp(static_cast<int>(std::floor(std::log2(1.0 + t / r0))), 0, levels - 1);
     occlusion = std::max(occlusion, refOcclusion(s.pyramid[level], at, q, p.estimator));
     if (occlusion >= 0.999)
       break;
-    t += s.pyramid[level].kernelRadius / 2;
+    u += std::ldexp(0.5, level);
   }
   return 1.0 - std::clamp(occlusion, 0.0, 1.0);
 }

@@ -12,7 +12,9 @@ output after
   2e-5 (one pass of the paper's eight ordered sweeps is not symmetric, by design).
 Isosurface AO (the contour's points, their AO and Shadow) is checked against threads and
 extents (to 1e-5 there: the points' float coordinates round differently at other
-indices), and with one pyramid level against flips of the volume and the light (points
+indices), against the spacing and origin in other units (x 3.7 and x 1e-3; and on 40
+smooth random fields at spacings and origins that binary fractions do not hold, x 1e-3,
+3.7 or 1e4), and with one pyramid level against flips of the volume and the light (points
 matched to the nearest, 1e-5). Coarser levels sit on every 2^l-th voxel from the first,
 so with more levels a flip moves their grids and the answer (README, precision).
 
@@ -34,11 +36,15 @@ rng = np.random.default_rng(seed)
 failures = []
 
 
-def image(values, first=(0, 0, 0)):
+SPACING = np.array([0.5, 1.0, 1.5])
+
+
+def image(values, first=(0, 0, 0), unit=1.0):
     result = vtkImageData()
     nz, ny, nx = values.shape
     result.SetExtent(first[0], first[0] + nx - 1, first[1], first[1] + ny - 1, first[2], first[2] + nz - 1)
-    result.SetSpacing(0.5, 1.0, 1.5)
+    result.SetSpacing(*(SPACING * unit))
+    result.SetOrigin(*(np.array([-2.0, 1.0, 3.0]) * unit))
     scalars = numpy_to_vtk(np.ascontiguousarray(values).reshape(-1), deep=1)
     scalars.SetName("v")
     result.GetPointData().SetScalars(scalars)
@@ -75,8 +81,8 @@ def volume_run(make, values, threads=1, first=(0, 0, 0)):
 LIGHT = (0.3, -0.5, 0.8)
 
 
-def surface_run(values, iso, shadows, threads=1, first=(0, 0, 0), levels=4, light=LIGHT):
-    volume = image(values, first)
+def surface_run(values, iso, shadows, threads=1, first=(0, 0, 0), levels=4, light=LIGHT, unit=1.0):
+    volume = image(values, first, unit)
     contour = vtkFlyingEdges3D()
     contour.SetInputData(volume)
     contour.SetValue(0, iso)
@@ -93,8 +99,8 @@ def surface_run(values, iso, shadows, threads=1, first=(0, 0, 0), levels=4, ligh
     o = f.GetOutput()
     if o.GetNumberOfPoints() == 0:
         return {}
-    shift = np.array(first) * np.array([0.5, 1.0, 1.5])
-    points = vtk_to_numpy(o.GetPoints().GetData()) - shift
+    shift = (np.array(first) * SPACING + np.array([-2.0, 1.0, 3.0])) * unit
+    points = (vtk_to_numpy(o.GetPoints().GetData()) - shift) / unit
     order = np.lexsort(np.round(points, 5).T[::-1])
     out = {k: a[order] for k, a in arrays(o, None).items()}
     out["points"] = points[order]
@@ -209,8 +215,11 @@ for case in range(cases):
             check("%s, %d threads" % (what, threads), differs(base, surface_run(values, iso, shadows, threads), 0.0))
         check("%s, extent from (5, -3, 7)" % what,
               differs(base, surface_run(values, iso, shadows, first=(5, -3, 7)), 1e-5))
+        for unit in (3.7, 1e-3):  # spacing and origin in other units: the same scene
+            check("%s, spacing and origin x %g" % (what, unit),
+                  differs(base, surface_run(values, iso, shadows, unit=unit), 1e-5))
         one = surface_run(values, iso, True, levels=1)
-        extent = (np.array(values.shape[::-1]) - 1) * np.array([0.5, 1.0, 1.5])
+        extent = (np.array(values.shape[::-1]) - 1) * SPACING
         for axis in range(3):
             light = list(LIGHT)
             light[axis] = -light[axis]
@@ -223,6 +232,36 @@ for case in range(cases):
                 flipped["Normals"] = flipped["Normals"] * np.where(np.arange(3) == axis, -1.0, 1.0)
             flipped["points"] = one["points"] if distance.max() < 1e-5 else points[nearest]
             check("%s, one level, flipped along axis %d" % (what, axis), differs(one, flipped, 1e-5))
+# Isosurface AO and shadows of smooth random fields (whose surfaces the coarse levels and
+# the long marches see) at a spacing and origin that binary fractions do not hold, then
+# the same scene in other units: the march's levels change at t / r0 + 1 = 2^l whatever
+# the unit's rounding.
+for case in range(40):
+    shape = tuple(int(n) for n in rng.integers(10, 21, 3))
+    field = rng.normal(0.0, 1.0, shape)
+    for _ in range(2):
+        field = (field + np.roll(field, 1, 0) + np.roll(field, 1, 1) + np.roll(field, 1, 2)) / 2
+    spacing, origin = rng.uniform(0.3, 2.0, 3), rng.uniform(-5.0, 5.0, 3)
+    results = []
+    for unit in (1.0, float(rng.choice([1e-3, 3.7, 1e4]))):
+        volume = image(field.astype(np.float32))
+        volume.SetSpacing(*(spacing * unit))
+        volume.SetOrigin(*(origin * unit))
+        contour = vtkFlyingEdges3D()
+        contour.SetInputData(volume)
+        contour.SetValue(0, 0.2)
+        contour.Update()
+        f = V.vtkIsosurfaceAmbientOcclusion()
+        f.SetInputData(contour.GetOutput())
+        f.SetVolumeData(volume)
+        f.SetIsoValue(0.2)
+        f.SetComputeShadows(True)
+        f.Update()
+        results.append((unit, arrays(f.GetOutput(), None)))
+    (_, one), (unit, other) = results
+    check("smooth field %d %s, isosurface AO + shadows, spacing and origin x %g" % (case, shape, unit),
+          differs({k: one[k] for k in ("AmbientOcclusion", "Shadow")},
+                  {k: other[k] for k in ("AmbientOcclusion", "Shadow")}, 1e-5))
 print("%d cases, %d failures" % (cases, len(failures)))
 print("FAILED" if failures else "every filter gave the same answer where it must")
 sys.exit(1 if failures else 0)

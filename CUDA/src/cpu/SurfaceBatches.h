@@ -102,8 +102,16 @@ bool forEachBatch(const P* points, const P* normals, const PointRange& range, co
     });
 }
 
+/// Float32 rounding of a coordinate, relative to its magnitude, that the march's box
+/// allows beyond its faces (kFaceSlack x FLT_EPSILON: two float ulps at least).
+constexpr double kFaceSlack = 2.0 * 1.1920928955078125e-07;
+
 /// The box the shadow march stays in: level 0's bounds, or the whole volume's when the
-/// level is a distributed piece's window.
+/// level is a distributed piece's window, widened by kFaceSlack of its coordinates'
+/// magnitude. Surface points come as float32 (VTK's points): one on a face whose
+/// coordinate float32 does not hold (an origin of -7.4, a spacing of 0.7) rounds up to an
+/// ulp outside it, and its march, starting there, would stop at once (Shadow 1 where the
+/// same scene in other units was in shadow). Samples so close outside clamp to the face.
 struct MarchBounds
 {
   double lo[3], hi[3];
@@ -115,6 +123,9 @@ struct MarchBounds
     {
       this->lo[a] = window ? level.wholeBounds[2 * a] : level.origin[a];
       this->hi[a] = window ? level.wholeBounds[2 * a + 1] : level.origin[a] + (level.dims[a] - 1) * level.spacing[a];
+      const double slack = kFaceSlack * std::max(std::abs(this->lo[a]), std::abs(this->hi[a]));
+      this->lo[a] -= slack;
+      this->hi[a] += slack;
     }
   }
 

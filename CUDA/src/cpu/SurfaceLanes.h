@@ -38,15 +38,22 @@ struct MarchStep
 
 /// Every march's steps: they depend on the distance alone, so every point takes the same.
 /// The list ends at kMarchMaxSteps, or past `reach` (twice the box's diagonal: a march
-/// that starts in the box has left it, so its lanes have stopped there).
+/// that starts in the box has left it, so its lanes have stopped there). The distance is
+/// counted in units of r_0, whose steps (halves of r_l / r_0 = 2^l) add exactly: summed in
+/// world units, a step meant to land on a level's first distance (t = 3 r_0, 7 r_0, ...)
+/// could round below it wherever r_0 is not a short binary fraction, and march on the
+/// finer level, so that the shadows changed with the unit of the spacing.
 inline std::vector<MarchStep> marchSchedule(const double* kernelRadius, int levels, double reach)
 {
   std::vector<MarchStep> steps;
-  for (double t = 0.0; steps.size() < static_cast<std::size_t>(kMarchMaxSteps) && !(t > reach);)
+  for (double u = 0.0; steps.size() < static_cast<std::size_t>(kMarchMaxSteps);)
   {
-    const int l = marchLevel(t, kernelRadius[0], levels);
+    const double t = u * kernelRadius[0];
+    if (t > reach)
+      break;
+    const int l = marchLevel(u, 1.0, levels);
     steps.push_back({ t, l });
-    t += kMarchStepFraction * kernelRadius[l];
+    u += kMarchStepFraction * (kernelRadius[l] / kernelRadius[0]);
   }
   return steps;
 }
