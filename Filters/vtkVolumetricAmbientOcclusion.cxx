@@ -110,7 +110,10 @@ void vtkVolumetricAmbientOcclusion::ComputeVoxelRadius(const double spacing[3], 
     }
     // Bounded so an absurd radius cannot overflow; CheckParameters reports it.
     voxels = std::isfinite(voxels) ? std::min(std::max(voxels, 0.0), 1e9) : 0.0;
-    radius[a] = static_cast<int>(std::lround(voxels));
+    // Half-integers round up, and so do ratios a rounding error below one (5.5 x 1.3 mm over
+    // 1.3 mm is 5.5, the same in metres 5.499999999999999): the same radius and spacing in
+    // other units give the same voxels.
+    radius[a] = static_cast<int>(std::floor(voxels + 0.5 + 1e-12 * voxels));
   }
 }
 
