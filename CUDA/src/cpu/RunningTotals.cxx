@@ -1,5 +1,7 @@
 #include "RunningTotals.h"
 
+#include <type_traits>
+
 #if VAO_HAVE_AVX2_TARGET
 #include <immintrin.h>
 #endif
@@ -128,52 +130,51 @@ VAO_AVX512_TARGET inline __m512i scanLanes32(__m512i x)
   return _mm512_add_epi32(x, _mm512_alignr_epi32(x, zero, 8));
 }
 
-/// 32-bit running totals of a and, with Both, of b, sixteen at a time; as on AVX2, the
-/// chain from one sixteen to the next is the single addition of the carried total.
-template <bool Both>
-VAO_AVX512_TARGET void runningTotalsAvx512(std::uint32_t* a, std::uint32_t* b, std::int64_t n)
+/// The AVX-512 lanes of 32- and 64-bit totals: how many a vector holds, the scan within
+/// it, the addition, and the last lane's total in every lane.
+struct Lanes32
 {
-  const __m512i last = _mm512_set1_epi32(15);
+  static constexpr int kCount = 16;
+  static VAO_AVX512_TARGET __m512i scan(__m512i x) { return scanLanes32(x); }
+  static VAO_AVX512_TARGET __m512i add(__m512i x, __m512i y) { return _mm512_add_epi32(x, y); }
+  static VAO_AVX512_TARGET __m512i last(__m512i x) { return _mm512_permutexvar_epi32(_mm512_set1_epi32(15), x); }
+};
+
+struct Lanes64
+{
+  static constexpr int kCount = 8;
+  static VAO_AVX512_TARGET __m512i scan(__m512i x) { return scanLanes(x); }
+  static VAO_AVX512_TARGET __m512i add(__m512i x, __m512i y) { return _mm512_add_epi64(x, y); }
+  static VAO_AVX512_TARGET __m512i last(__m512i x) { return _mm512_permutexvar_epi64(_mm512_set1_epi64(7), x); }
+};
+
+/// Running totals of a and, with Both, of b, a vector at a time: the scan within the vector
+/// plus the total carried from the one before. The carried total's next value sums the
+/// scan's own last lane, so the chain from one vector to the next is a single addition.
+template <class L, bool Both, class V>
+VAO_AVX512_TARGET void runningTotalsAvx512(V* a, V* b, std::int64_t n)
+{
   __m512i carryA = _mm512_setzero_si512();
   __m512i carryB = _mm512_setzero_si512();
   std::int64_t i = 0;
-  for (; i + 16 <= n; i += 16)
+  for (; i + L::kCount <= n; i += L::kCount)
   {
-    const __m512i x = scanLanes32(_mm512_loadu_si512(a + i));
-    _mm512_storeu_si512(a + i, _mm512_add_epi32(x, carryA));
-    carryA = _mm512_add_epi32(carryA, _mm512_permutexvar_epi32(last, x));
+    const __m512i x = L::scan(_mm512_loadu_si512(a + i));
+    _mm512_storeu_si512(a + i, L::add(x, carryA));
+    carryA = L::add(carryA, L::last(x));
     if constexpr (Both)
     {
-      const __m512i y = scanLanes32(_mm512_loadu_si512(b + i));
-      _mm512_storeu_si512(b + i, _mm512_add_epi32(y, carryB));
-      carryB = _mm512_add_epi32(carryB, _mm512_permutexvar_epi32(last, y));
+      const __m512i y = L::scan(_mm512_loadu_si512(b + i));
+      _mm512_storeu_si512(b + i, L::add(y, carryB));
+      carryB = L::add(carryB, L::last(y));
     }
   }
   runningTotalsPlain(a, b, i, n);
 }
 
-/// Of a and, with Both, of b.
-template <bool Both>
-VAO_AVX512_TARGET void runningTotalsAvx512(std::int64_t* a, std::int64_t* b, std::int64_t n)
-{
-  const __m512i last = _mm512_set1_epi64(7);
-  __m512i carryA = _mm512_setzero_si512();
-  __m512i carryB = _mm512_setzero_si512();
-  std::int64_t i = 0;
-  for (; i + 8 <= n; i += 8)
-  {
-    const __m512i x = _mm512_add_epi64(scanLanes(_mm512_loadu_si512(a + i)), carryA);
-    _mm512_storeu_si512(a + i, x);
-    carryA = _mm512_permutexvar_epi64(last, x);
-    if constexpr (Both)
-    {
-      const __m512i y = _mm512_add_epi64(scanLanes(_mm512_loadu_si512(b + i)), carryB);
-      _mm512_storeu_si512(b + i, y);
-      carryB = _mm512_permutexvar_epi64(last, y);
-    }
-  }
-  runningTotalsPlain(a, b, i, n);
-}
+/// The lanes of a row's width.
+template <class V>
+using LanesOf = typename std::conditional<sizeof(V) == 4, Lanes32, Lanes64>::type;
 #endif
 
 /// The widest tier the processor has, for 64- or 32-bit rows alike.
@@ -184,9 +185,9 @@ void runningTotalsOnTier(V* a, V* b, std::int64_t n, SimdTier tier)
   if (tier >= SimdTier::Avx512)
   {
     if (b)
-      runningTotalsAvx512<true>(a, b, n);
+      runningTotalsAvx512<LanesOf<V>, true>(a, b, n);
     else
-      runningTotalsAvx512<false>(a, nullptr, n);
+      runningTotalsAvx512<LanesOf<V>, false>(a, static_cast<V*>(nullptr), n);
     return;
   }
   if (tier == SimdTier::Avx2)
