@@ -205,7 +205,7 @@ public:
     , Run2(squares ? geometry.region.size[0] : 0)
     , Zeros(geometry.region.size[0], Acc(0))
     , ZerosLin(geometry.region.size[0], Lin(0))
-    , ZerosNarrow(geometry.region.size[0], 0)
+    , ZerosNarrow(kNarrowSquares ? geometry.region.size[0] : 0, 0)
   {
   }
 
@@ -292,13 +292,14 @@ private:
   void slideSquares(Acc* plane2, std::int64_t in, std::int64_t out)
   {
     const std::int64_t nx = this->Geo.region.size[0];
-    const bool narrowIn = in < 0 || this->SlotNarrow[this->slot(in)];
-    const bool narrowOut = out < 0 || this->SlotNarrow[this->slot(out)];
-    const std::int32_t* in32 = in < 0 ? this->ZerosNarrow.data() : (narrowIn ? this->xbox2Narrow(in) : nullptr);
-    const std::int32_t* out32 = out < 0 ? this->ZerosNarrow.data() : (narrowOut ? this->xbox2Narrow(out) : nullptr);
     Acc* run = this->Run2.data();
     if constexpr (kNarrowSquares)
     {
+      // A missing row reads as a narrow row of zeros.
+      const bool narrowIn = in < 0 || this->SlotNarrow[this->slot(in)];
+      const bool narrowOut = out < 0 || this->SlotNarrow[this->slot(out)];
+      const std::int32_t* in32 = in < 0 ? this->ZerosNarrow.data() : this->xbox2Narrow(in);
+      const std::int32_t* out32 = out < 0 ? this->ZerosNarrow.data() : this->xbox2Narrow(out);
       if (narrowIn && narrowOut)
         return runRows<SlideColumns<Acc, std::int32_t, std::int32_t>>(this->Simd, plane2, run, in32, out32, nx);
       if (narrowIn)
