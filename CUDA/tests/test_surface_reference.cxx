@@ -181,7 +181,7 @@ double refShadow(const Scene& s, int i, const Vec3& light, const vao::SurfaceOcc
     }
     if (!inside)
       break;
-    const int level = std::clamp(static_cast<int>(std::floor(std::log2(1.0 + t / r0))), 0, levels - 1);
+    const int level = std::clamp(static_cast<int>(std::floor(std::log2(1.0 + u))), 0, levels - 1); // u = t / r0
     occlusion = std::max(occlusion, refOcclusion(s.pyramid[level], at, q, p.estimator));
     if (occlusion >= 0.999)
       break;

@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 namespace vao
 {
@@ -103,8 +104,8 @@ bool forEachBatch(const P* points, const P* normals, const PointRange& range, co
 }
 
 /// Float32 rounding of a coordinate, relative to its magnitude, that the march's box
-/// allows beyond its faces (kFaceSlack x FLT_EPSILON: two float ulps at least).
-constexpr double kFaceSlack = 2.0 * 1.1920928955078125e-07;
+/// allows beyond its faces: two float ulps at least.
+constexpr double kFaceSlack = 2.0 * std::numeric_limits<float>::epsilon();
 
 /// The box the shadow march stays in: level 0's bounds, or the whole volume's when the
 /// level is a distributed piece's window, widened by kFaceSlack of its coordinates'
