@@ -38,14 +38,15 @@ failures = []
 
 
 SPACING = np.array([0.5, 1.0, 1.5])
+ORIGIN = np.array([-2.0, 1.0, 3.0])
 
 
-def image(values, first=(0, 0, 0), unit=1.0):
+def image(values, first=(0, 0, 0), unit=1.0, spacing=SPACING, origin=ORIGIN):
     result = vtkImageData()
     nz, ny, nx = values.shape
     result.SetExtent(first[0], first[0] + nx - 1, first[1], first[1] + ny - 1, first[2], first[2] + nz - 1)
-    result.SetSpacing(*(SPACING * unit))
-    result.SetOrigin(*(np.array([-2.0, 1.0, 3.0]) * unit))
+    result.SetSpacing(*(np.asarray(spacing) * unit))
+    result.SetOrigin(*(np.asarray(origin) * unit))
     scalars = numpy_to_vtk(np.ascontiguousarray(values).reshape(-1), deep=1)
     scalars.SetName("v")
     result.GetPointData().SetScalars(scalars)
@@ -82,8 +83,8 @@ def volume_run(make, values, threads=1, first=(0, 0, 0)):
 LIGHT = (0.3, -0.5, 0.8)
 
 
-def surface_run(values, iso, shadows, threads=1, first=(0, 0, 0), levels=4, light=LIGHT, unit=1.0):
-    volume = image(values, first, unit)
+def isosurface(volume, iso, shadows, threads=1, levels=4, light=None):
+    """Isosurface AO of the volume's own contour at iso (the filter's light unless given)."""
     contour = vtkFlyingEdges3D()
     contour.SetInputData(volume)
     contour.SetValue(0, iso)
@@ -94,13 +95,20 @@ def surface_run(values, iso, shadows, threads=1, first=(0, 0, 0), levels=4, ligh
     f.SetVolumeData(volume)
     f.SetIsoValue(iso)
     f.SetComputeShadows(shadows)
-    f.SetLightDirection(*light)
+    if light is not None:
+        f.SetLightDirection(*light)
     f.SetNumberOfLevels(levels)
     f.Update()
-    o = f.GetOutput()
+    return f.GetOutput()
+
+
+def surface_run(values, iso, shadows, threads=1, first=(0, 0, 0), levels=4, light=LIGHT, unit=1.0):
+    """isosurface() on the values, its arrays and points (at unit 1, extent from 0) in the
+    points' order."""
+    o = isosurface(image(values, first, unit), iso, shadows, threads, levels, light)
     if o.GetNumberOfPoints() == 0:
         return {}
-    shift = (np.array(first) * SPACING + np.array([-2.0, 1.0, 3.0])) * unit
+    shift = (np.array(first) * SPACING + ORIGIN) * unit
     points = (vtk_to_numpy(o.GetPoints().GetData()) - shift) / unit
     order = np.lexsort(np.round(points, 5).T[::-1])
     out = {k: a[order] for k, a in arrays(o, None).items()}
@@ -243,23 +251,9 @@ for case in range(40):
     for _ in range(2):
         field = (field + np.roll(field, 1, 0) + np.roll(field, 1, 1) + np.roll(field, 1, 2)) / 2
     spacing, origin = rng.uniform(0.3, 2.0, 3), rng.uniform(-5.0, 5.0, 3)
-    results = []
-    for unit in (1.0, float(rng.choice([1e-3, 3.7, 1e4]))):
-        volume = image(field.astype(np.float32))
-        volume.SetSpacing(*(spacing * unit))
-        volume.SetOrigin(*(origin * unit))
-        contour = vtkFlyingEdges3D()
-        contour.SetInputData(volume)
-        contour.SetValue(0, 0.2)
-        contour.Update()
-        f = V.vtkIsosurfaceAmbientOcclusion()
-        f.SetInputData(contour.GetOutput())
-        f.SetVolumeData(volume)
-        f.SetIsoValue(0.2)
-        f.SetComputeShadows(True)
-        f.Update()
-        results.append((unit, arrays(f.GetOutput(), None)))
-    (_, one), (unit, other) = results
+    unit = float(rng.choice([1e-3, 3.7, 1e4]))
+    one, other = (arrays(isosurface(image(field.astype(np.float32), unit=u, spacing=spacing, origin=origin), 0.2, True),
+                         None) for u in (1.0, unit))
     check("smooth field %d %s, isosurface AO + shadows, spacing and origin x %g" % (case, shape, unit),
           differs({k: one[k] for k in ("AmbientOcclusion", "Shadow")},
                   {k: other[k] for k in ("AmbientOcclusion", "Shadow")}, 1e-5))
@@ -269,8 +263,7 @@ values = (rng.integers(0, 5, (14, 15, 16)) * 10).astype(np.int16)
 for h, ratio, unit in [(1.3, 5.5, 1e-3), (0.15, 1.5, 25.4), (0.15, 4.5, 10.0), (0.8, 3.5, 1e-3)]:
     outputs = []
     for u in (1.0, unit):
-        volume = image(values)
-        volume.SetSpacing(h * u, h * u, h * u)
+        volume = image(values, unit=u, spacing=(h, h, h))
         f = V.vtkVolumetricAmbientOcclusion()
         f.SetRadiusUnits(F.WORLD)
         f.SetRadius(ratio * h * u)
