@@ -116,6 +116,9 @@ bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData*
     error = "Array '" + volume.name + "' is not a point-data array; the filter works on points (voxels).";
     return false;
   }
+  error = PointCountError(scalars, input->GetNumberOfPoints());
+  if (!error.empty())
+    return false;
   const int components = scalars->GetNumberOfComponents();
   const int picked = component < 0 && components == 1 ? 0 : component;
   if (picked < 0 || picked >= components)
@@ -137,6 +140,16 @@ bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData*
   volume.firstVoxel = { extent[0], extent[2], extent[4] };
   ViewComponent(scalars, picked, volume);
   return true;
+}
+
+std::string PointCountError(vtkDataArray* array, vtkIdType points)
+{
+  if (!array || array->GetNumberOfTuples() == points)
+    return std::string();
+  std::ostringstream why;
+  why << "Array '" << (array->GetName() ? array->GetName() : "") << "' has " << array->GetNumberOfTuples()
+      << " tuples for the input's " << points << " points: a point array needs one tuple a point.";
+  return why.str();
 }
 
 vtkDataArray* GivenNormals(vtkPolyData* surface)

@@ -6,6 +6,8 @@
 
 #include "vao/AmbientOcclusion.h"
 
+#include "vtkType.h"
+
 #include <array>
 #include <string>
 #include <vector>
@@ -52,6 +54,11 @@ bool SurfaceNormals(vtkPolyData* surface, const ScalarVolume& volume, const std:
 /// The kernels' execution hooks for an algorithm: its progress, its abort flag, and
 /// `threads` (the filter's NumberOfThreads; 0: the kernels' default).
 vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads);
+
+/// The error for a point array without one tuple for each of the data set's `points`
+/// (VTK does not keep the two equal: a script or a reader can attach any array, and a
+/// filter reading a short one would read past its end); empty when they match.
+std::string PointCountError(vtkDataArray* array, vtkIdType points);
 
 /// The error for a NumberOfThreads below 0; empty for a valid one.
 std::string NumberOfThreadsError(int threads);

@@ -98,7 +98,8 @@ vtkMTimeType vtkAmbientOcclusionShading::GetMTime()
 }
 
 //------------------------------------------------------------------------------
-std::string vtkAmbientOcclusionShading::CheckInput(vtkPointData* pd, vtkDataArray* scalars, bool volume) const
+std::string vtkAmbientOcclusionShading::CheckInput(
+  vtkPointData* pd, vtkIdType points, vtkDataArray* scalars, bool volume) const
 {
   std::ostringstream why;
   vtkDataArray* ao = pd->GetArray(this->AmbientOcclusionArrayName.c_str());
@@ -129,13 +130,16 @@ std::string vtkAmbientOcclusionShading::CheckInput(vtkPointData* pd, vtkDataArra
         << "); an empty ramp such as (1, 0) means the upper half of the range.";
   if (!why.str().empty())
     return why.str();
-  // The arrays the colours come from: one non-finite value would turn the automatic range,
-  // and with it every colour, into garbage.
+  // The arrays the colours come from, read a value a point: one short of the points would
+  // be read past its end, and one non-finite value would turn the automatic range, and
+  // with it every colour, into garbage.
   const bool shadowUsed = !volume;
   for (vtkDataArray* array : { scalars, ao, shadowUsed ? pd->GetArray("Shadow") : nullptr,
          volume && this->ModulateOpacity ? pd->GetArray("Variance") : nullptr })
   {
-    const std::string error = vtkAmbientOcclusionArrayInput::NonFiniteError(array);
+    std::string error = vtkAmbientOcclusionArrayInput::PointCountError(array, points);
+    if (error.empty())
+      error = vtkAmbientOcclusionArrayInput::NonFiniteError(array);
     if (!error.empty())
       return error;
   }
@@ -242,7 +246,7 @@ int vtkAmbientOcclusionShading::RequestData(
     vtkDataArray* scalars =
       this->ScalarsArrayName.empty() ? pd->GetScalars() : pd->GetArray(this->ScalarsArrayName.c_str());
     const bool volume = vtkImageData::SafeDownCast(input) != nullptr;
-    const std::string error = this->CheckInput(pd, scalars, volume);
+    const std::string error = this->CheckInput(pd, input->GetNumberOfPoints(), scalars, volume);
     // The range is reduced before any error return: every process must take part.
     double range[2];
     this->ColourRange(scalars, range);

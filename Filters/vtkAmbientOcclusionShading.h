@@ -137,7 +137,7 @@ private:
   void operator=(const vtkAmbientOcclusionShading&) = delete;
 
   /// Why the parameters or the input's arrays cannot be shaded; empty when they can.
-  std::string CheckInput(vtkPointData* pd, vtkDataArray* scalars, bool volume) const;
+  std::string CheckInput(vtkPointData* pd, vtkIdType points, vtkDataArray* scalars, bool volume) const;
   /// ScalarRange, or when it is empty the scalars' range over every process. Collective.
   void ColourRange(vtkDataArray* scalars, double range[2]);
   /// Fills `shaded` (3 components a point, 4 on a volume); false when the user aborted.

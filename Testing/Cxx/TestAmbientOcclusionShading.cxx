@@ -150,6 +150,13 @@ TEST(AmbientOcclusionShadingFilter, RejectsBadInputWithAClearError)
   nanVariance->GetPointData()->GetArray("Variance")->SetComponent(2, 0, nan);
   check(nanVariance, [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); }, "Array 'Variance' has 1 NaN");
   check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetNumberOfThreads(-2); }, "NumberOfThreads");
+  // Arrays with fewer or more values than the points (read past their end before).
+  const vtkIdType points = SmallVolume()->GetNumberOfPoints();
+  for (const char* name : { "Density", "AmbientOcclusion", "Variance" })
+    for (vtkIdType tuples : { vtkIdType(3), points - 1, points + 1 })
+      check(WithPointArrayResized(SmallVolume(), name, tuples), [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); },
+        std::string("Array '") + name + "' has " + std::to_string(tuples) + " tuples for the input's " +
+          std::to_string(points) + " points");
 }
 
 TEST(AmbientOcclusionShadingFilter, AnyNumberOfThreadsGivesTheSameColours)

@@ -2,6 +2,9 @@
 
 #include "vtkMetaImageReader.h"
 #include "vtkNew.h"
+#include "vtkPointData.h"
+
+#include <algorithm>
 
 #include <gtest/gtest.h>
 
@@ -24,6 +27,24 @@ std::vector<double> Values(vtkDataArray* array)
   for (vtkIdType i = 0; i < array->GetNumberOfTuples(); ++i)
     values[i] = array->GetComponent(i, 0);
   return values;
+}
+
+vtkSmartPointer<vtkDataSet> WithPointArrayResized(vtkDataSet* data, const char* name, vtkIdType tuples)
+{
+  vtkSmartPointer<vtkDataSet> copy = vtk::TakeSmartPointer(data->NewInstance());
+  copy->DeepCopy(data);
+  vtkDataArray* array = copy->GetPointData()->GetArray(name);
+  EXPECT_NE(array, nullptr) << name;
+  if (array)
+  {
+    const vtkIdType kept = std::min(tuples, array->GetNumberOfTuples());
+    array->Resize(tuples); // keeps the first tuples; its pointer and length follow the new size
+    array->SetNumberOfTuples(tuples);
+    for (vtkIdType i = kept; i < tuples; ++i)
+      for (int c = 0; c < array->GetNumberOfComponents(); ++c)
+        array->SetComponent(i, c, 0.0);
+  }
+  return copy;
 }
 
 } // namespace vaotest

@@ -3,6 +3,7 @@
 
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
+#include "vtkDataSet.h"
 #include "vtkImageData.h"
 #include "vtkObject.h"
 #include "vtkSmartPointer.h"
@@ -50,5 +51,9 @@ vtkSmartPointer<vtkImageData> ReadMetaImage(const std::string& path);
 
 /// Values of a one-component array as doubles.
 std::vector<double> Values(vtkDataArray* array);
+
+/// A copy of `data` whose point array `name` holds `tuples` tuples (its first ones, then
+/// zeros): a point array that does not fit the points, which VTK lets a script attach.
+vtkSmartPointer<vtkDataSet> WithPointArrayResized(vtkDataSet* data, const char* name, vtkIdType tuples);
 
 } // namespace vaotest

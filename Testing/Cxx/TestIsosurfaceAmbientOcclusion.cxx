@@ -88,6 +88,12 @@ TEST(VarianceOcclusionMapFilter, RejectsBadInputWithAClearError)
   };
   auto volume = Slab(12, 4, 6);
   EXPECT_NE(run(volume, -1).find("NumberOfThreads"), std::string::npos);
+  for (vtkIdType tuples : { 11, 1727, 1729 })
+  {
+    const std::string error = run(vtkImageData::SafeDownCast(WithPointArrayResized(volume, "Density", tuples)), 0);
+    EXPECT_NE(error.find("Array 'Density' has " + std::to_string(tuples) + " tuples for the input's 1728 points"),
+      std::string::npos) << error;
+  }
   vtkNew<vtkImageData> shifted;
   shifted->DeepCopy(WithNaN(volume, 2, 9, 4));
   shifted->SetExtent(10, 21, -3, 8, 0, 11);
@@ -364,6 +370,9 @@ TEST(IsosurfaceAmbientOcclusionFilter, RejectsBadInputWithAClearError)
   ExpectRejected(surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetOffsetFactor(-1); }, "OffsetFactor");
   ExpectRejected(surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetNumberOfThreads(-1); }, "NumberOfThreads");
   ExpectRejected(surface, WithNaN(volume, 7, 5, 3), none, "NaN or infinite values (the first at voxel 7, 5, 3)");
+  for (vtkIdType tuples : { 13, 13823, 13825 })
+    ExpectRejected(surface, vtkImageData::SafeDownCast(WithPointArrayResized(volume, "Density", tuples)), none,
+      "Array 'Density' has " + std::to_string(tuples) + " tuples for the input's 13824 points");
   vtkNew<vtkImageData> twoD;
   twoD->DeepCopy(Slab(24, 8, 12));
   twoD->SetDimensions(24, 576, 1);

@@ -149,6 +149,9 @@ TEST(OcclusionSweepingFilter, RejectsBadInputWithAClearError)
   flat->DeepCopy(Ball(9, 3));
   flat->SetDimensions(9, 81, 1);
   ExpectRejected(flat, none, "needs a 3-D volume");
+  for (vtkIdType tuples : { 7, 728, 730 })
+    ExpectRejected(vtkImageData::SafeDownCast(WithPointArrayResized(Ball(9, 3), "Density", tuples)), none,
+      "Array 'Density' has " + std::to_string(tuples) + " tuples for the input's 729 points");
   auto nan = Ball(9, 3);
   vtkNew<vtkFloatArray> values;
   values->DeepCopy(nan->GetPointData()->GetScalars());

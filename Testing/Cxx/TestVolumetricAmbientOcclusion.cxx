@@ -311,6 +311,14 @@ TEST(VolumetricAmbientOcclusion, RejectsBadInputWithAClearError)
     f->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_CELLS, "CellValues");
   }, "not a point-data array");
 
+  // Scalars with fewer or more values than the image has points (read past their end
+  // before), one and three components.
+  for (vtkIdType tuples : { 5, 215, 217 })
+    for (int components : { 1, 3 })
+      ExpectRejected(WithPointArrayResized(RandomImage(6, 6, 6, 1, components), "Density", tuples),
+        [](vtkVolumetricAmbientOcclusion* f) { f->SetComponent(0); },
+        "Array 'Density' has " + std::to_string(tuples) + " tuples for the input's 216 points");
+
   ExpectRejected(RandomImage(6, 6, 6, 1, 3), radius(2), "set Component");
   ExpectRejected(RandomImage(6, 6, 6, 1, 3), [](vtkVolumetricAmbientOcclusion* f) { f->SetComponent(3); }, "set Component");
 
