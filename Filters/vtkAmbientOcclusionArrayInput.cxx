@@ -117,7 +117,10 @@ bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData*
     return false;
   }
   error = PointCountError(scalars, input->GetNumberOfPoints());
-  if (!error.empty())
+  // Spacings, radii and distances are taken along the image's axes: they must be
+  // orthogonal unit vectors in the physical frame.
+  vtkAmbientOcclusionFrame::Frame frame;
+  if (!error.empty() || !vtkAmbientOcclusionFrame::FrameOf(input, frame, error))
     return false;
   const int components = scalars->GetNumberOfComponents();
   const int picked = component < 0 && components == 1 ? 0 : component;
@@ -162,8 +165,9 @@ vtkDataArray* GivenNormals(vtkPolyData* surface)
   return given && given->GetNumberOfComponents() == 3 ? given : nullptr;
 }
 
-bool SurfaceNormals(vtkPolyData* surface, const ScalarVolume& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, std::vector<double>& normals, std::string& error)
+bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points, const vtkAmbientOcclusionFrame::Frame& frame,
+  const ScalarVolume& volume, const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
+  std::vector<double>& normals, std::string& error)
 {
   const vtkIdType n = surface->GetNumberOfPoints();
   normals.resize(static_cast<size_t>(3 * n));
@@ -172,13 +176,18 @@ bool SurfaceNormals(vtkPolyData* surface, const ScalarVolume& volume, const std:
     for (vtkIdType i = 0; i < n; ++i)
     {
       given->GetTuple(i, &normals[3 * i]);
+      if (!frame.identity)
+      {
+        const std::array<double, 3> turned = frame.VectorToImage(&normals[3 * i]);
+        std::copy(turned.begin(), turned.end(), normals.begin() + 3 * i);
+      }
     }
     return true;
   }
   for (vtkIdType i = 0; i < n; ++i)
   {
-    double p[3], g[3];
-    surface->GetPoint(i, p);
+    const double* p = &points[3 * i];
+    double g[3];
     for (int a = 0; a < 3; ++a)
     {
       std::array<double, 3> forward = { p[0], p[1], p[2] }, backward = forward;

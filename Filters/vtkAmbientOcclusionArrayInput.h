@@ -4,6 +4,8 @@
 #ifndef vtkAmbientOcclusionArrayInput_h
 #define vtkAmbientOcclusionArrayInput_h
 
+#include "vtkAmbientOcclusionFrame.h"
+
 #include "vao/AmbientOcclusion.h"
 
 #include "vtkType.h"
@@ -34,7 +36,8 @@ struct ScalarVolume
 
 /// Takes the array the algorithm chose to process (`chosen`, from GetInputArrayToProcess;
 /// the active point scalars when no array was named at all), checks it (numeric, point
-/// data, a valid component) and fills volume. On failure returns false and says why in
+/// data, a valid component, one tuple a point, an image whose direction matrix is a
+/// rotation) and fills volume. On failure returns false and says why in
 /// `error`. NaN and infinite values are not looked for here: the kernels find them in
 /// their first pass over the data, and KernelError names them.
 bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input, int component,
@@ -45,11 +48,13 @@ bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData*
 vtkDataArray* GivenNormals(vtkPolyData* surface);
 
 /// The unit normals of the surface's points as the surface kernels read them (3 doubles
-/// a point): its point normals, or without them the gradient of `volume` (voxel 0 at
-/// `origin`) at each point, pointing towards lower values. On failure (no normals and a
-/// zero gradient) returns false and says why in `error`.
-bool SurfaceNormals(vtkPolyData* surface, const ScalarVolume& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, std::vector<double>& normals, std::string& error);
+/// a point, in the image's frame): its point normals turned into that frame, or without
+/// them the gradient of `volume` (voxel 0 at `origin`) at `points` (3 doubles a point,
+/// already in the image's frame), pointing towards lower values. On failure (no normals
+/// and a zero gradient) returns false and says why in `error`.
+bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points, const vtkAmbientOcclusionFrame::Frame& frame,
+  const ScalarVolume& volume, const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
+  std::vector<double>& normals, std::string& error);
 
 /// The kernels' execution hooks for an algorithm: its progress, its abort flag, and
 /// `threads` (the filter's NumberOfThreads; 0: the kernels' default).

@@ -6,6 +6,7 @@
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionCollectives.h"
 #include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionFrame.h"
 #include "vtkAmbientOcclusionMemory.h"
 #include "vtkAmbientOcclusionPyramidImages.h"
 
@@ -14,6 +15,7 @@
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
+#include "vtkMatrix3x3.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
@@ -23,6 +25,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -90,6 +93,8 @@ struct vtkIsosurfaceAmbientOcclusion::Cache
   vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
   std::array<double, 3> origin{};
   std::array<double, 3> spacing{};
+  // The volume's frame: the surface's points, normals and the light are turned into it.
+  vtkAmbientOcclusionFrame::Frame frame;
   // The last AmbientOcclusion, which does not depend on the light: a light move reuses it
   // while the surface, the query and the pyramid stay (SurfaceKey).
   vtkSmartPointer<vtkFloatArray> occlusion;
@@ -114,8 +119,10 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
   Cache& cache = *this->Pyramid;
   const int* extent = volume->GetExtent();
   const double* h = volume->GetSpacing();
+  const double* d = volume->GetDirectionMatrix()->GetData();
   const bool sameGrid = std::equal(extent, extent + 6, cache.extent.begin()) &&
-    cache.origin == PyramidImages::ExtentOrigin(volume) && cache.spacing == std::array<double, 3>{ h[0], h[1], h[2] };
+    cache.origin == PyramidImages::ExtentOrigin(volume) && cache.spacing == std::array<double, 3>{ h[0], h[1], h[2] } &&
+    std::equal(d, d + 9, cache.frame.direction.begin());
   const bool fresh = chosen && cache.array == chosen && cache.arrayTime == chosen->GetMTime() && sameGrid &&
     cache.component == this->Component &&
     cache.numberOfLevels == this->NumberOfLevels && cache.halfResolution == (this->StartAtHalfResolution != 0) &&
@@ -127,7 +134,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
   cache.levels.clear();
   cache.surface.clear();
   std::string error;
-  if (!Extents::CheckWholeExtent(volume->GetExtent(), error) ||
+  if (!Extents::CheckWholeExtent(volume->GetExtent(), error) || !vtkAmbientOcclusionFrame::FrameOf(volume, cache.frame, error) ||
     !PrepareScalars(this, chosen, volume, this->Component, cache.scalars, error) ||
     !PyramidImages::BuildPyramid(cache.scalars, volume, this->PyramidRequest(),
       ExecutionOf(this, this->NumberOfThreads), cache.surface, error))
@@ -164,7 +171,10 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
   int expected[6];
   this->VolumeExtentOf(whole, volume->GetSpacing(), piece, expected);
   const bool empty = Extents::EmptyExtent(piece);
-  if (!empty && !std::equal(expected, expected + 6, volume->GetExtent()))
+  if (!vtkAmbientOcclusionFrame::FrameOf(volume, cache.frame, error))
+  {
+  }
+  else if (!empty && !std::equal(expected, expected + 6, volume->GetExtent()))
   {
     error = "The volume input delivered another extent than this process's piece and its reach: under MPI, "
             "feed the Volume input from its own reader.";
@@ -236,6 +246,31 @@ void vtkIsosurfaceAmbientOcclusion::ShareCoarsestLevel(
 }
 
 //------------------------------------------------------------------------------
+void vtkIsosurfaceAmbientOcclusion::SurfaceBoundsInVolumeFrame(vtkPolyData* surface, double bounds[6]) const
+{
+  const vtkAmbientOcclusionFrame::Frame& frame = this->Pyramid->frame;
+  if (frame.identity)
+  {
+    surface->GetBounds(bounds);
+    return;
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    bounds[2 * a] = std::numeric_limits<double>::infinity();
+    bounds[2 * a + 1] = -bounds[2 * a];
+  }
+  for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i)
+  {
+    const std::array<double, 3> p = frame.PointToImage(surface->GetPoint(i));
+    for (int a = 0; a < 3; ++a)
+    {
+      bounds[2 * a] = std::min(bounds[2 * a], p[a]);
+      bounds[2 * a + 1] = std::max(bounds[2 * a + 1], p[a]);
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
 bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* output)
 {
   Cache& cache = *this->Pyramid;
@@ -257,7 +292,8 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
   }
   vtkFloatArray* floatPoints = vtkFloatArray::SafeDownCast(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr);
   vtkFloatArray* floatNormals = vtkFloatArray::SafeDownCast(givenNormals);
-  const bool inPlace = floatPoints && floatNormals;
+  const vtkAmbientOcclusionFrame::Frame& frame = cache.frame;
+  const bool inPlace = floatPoints && floatNormals && frame.identity;
   std::vector<double> points, normals;
   std::string error;
   if (!inPlace && (newOcclusion || this->ComputeShadows))
@@ -266,9 +302,14 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
     for (vtkIdType i = 0; i < n; ++i)
     {
       surface->GetPoint(i, &points[3 * i]);
+      if (!frame.identity)
+      {
+        const std::array<double, 3> p = frame.PointToImage(&points[3 * i]);
+        std::copy(p.begin(), p.end(), points.begin() + 3 * i);
+      }
     }
     if (!vtkAmbientOcclusionArrayInput::SurfaceNormals(
-          surface, cache.scalars, cache.origin, cache.spacing, normals, error))
+          surface, points, frame, cache.scalars, cache.origin, cache.spacing, normals, error))
     {
       vtkErrorMacro(<< error);
       return false;
@@ -305,7 +346,9 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
   {
     shadow->SetName("Shadow");
     vtkAmbientOcclusionMemory::Allocate(shadow, n, "the Shadow output");
-    const double* l = this->LightDirection;
+    const std::array<double, 3> l = frame.identity
+      ? std::array<double, 3>{ this->LightDirection[0], this->LightDirection[1], this->LightDirection[2] }
+      : frame.VectorToImage(this->LightDirection);
     status = run([&](auto p, auto nn) {
       return cache.surface.empty()
         ? vao::surfaceShadow(cache.levels, p, nn, n, { l[0], l[1], l[2] }, parameters, shadow->GetPointer(0), execution)

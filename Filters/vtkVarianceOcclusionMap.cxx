@@ -4,6 +4,7 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionFrame.h"
 #include "vtkAmbientOcclusionPyramidImages.h"
 
 #include "vao/VarianceOcclusionMap.h"
@@ -118,7 +119,8 @@ int vtkVarianceOcclusionMap::RequestData(
     }
     std::vector<vao::MomentLevel> pyramid;
     vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
-    if (!input || !Extents::CheckWholeExtent(whole, error) ||
+    vtkAmbientOcclusionFrame::Frame frame;
+    if (!input || !Extents::CheckWholeExtent(whole, error) || !vtkAmbientOcclusionFrame::FrameOf(input, frame, error) ||
       !vtkAmbientOcclusionArrayInput::PrepareScalars(
         this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error) ||
       !vtkAmbientOcclusionPyramidImages::BuildPyramid(scalars, input, this->Parameters(),
@@ -138,6 +140,7 @@ int vtkVarianceOcclusionMap::RequestData(
     for (size_t l = 0; l < pyramid.size(); ++l, step *= 2)
     {
       auto part = vtkAmbientOcclusionPyramidImages::LevelPiece(pyramid[l], whole, expected, piece, step);
+      vtkAmbientOcclusionFrame::PlaceInWorld(frame, part); // where the input's own voxels lie
       output->SetBlock(static_cast<unsigned int>(l), part);
       output->GetMetaData(static_cast<unsigned int>(l))
         ->Set(vtkCompositeDataSet::NAME(), ("Level " + std::to_string(l)).c_str());

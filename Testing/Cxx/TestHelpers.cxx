@@ -29,6 +29,20 @@ std::vector<double> Values(vtkDataArray* array)
   return values;
 }
 
+void SetDensity(vtkImageData* image, vtkDataArray* values, const std::function<double(int, int, int)>& f)
+{
+  const int* d = image->GetDimensions();
+  values->SetName("Density");
+  values->SetNumberOfComponents(1);
+  values->SetNumberOfTuples(image->GetNumberOfPoints());
+  vtkIdType id = 0;
+  for (int k = 0; k < d[2]; ++k)
+    for (int j = 0; j < d[1]; ++j)
+      for (int i = 0; i < d[0]; ++i, ++id)
+        values->SetComponent(id, 0, f(i, j, k));
+  image->GetPointData()->SetScalars(values);
+}
+
 vtkSmartPointer<vtkDataSet> WithPointArrayResized(vtkDataSet* data, const char* name, vtkIdType tuples)
 {
   vtkSmartPointer<vtkDataSet> copy = vtk::TakeSmartPointer(data->NewInstance());

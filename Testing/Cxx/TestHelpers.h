@@ -8,6 +8,7 @@
 #include "vtkObject.h"
 #include "vtkSmartPointer.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,10 @@ vtkSmartPointer<vtkImageData> ReadMetaImage(const std::string& path);
 
 /// Values of a one-component array as doubles.
 std::vector<double> Values(vtkDataArray* array);
+
+/// Fills `values` (any numeric array) with f(i, j, k) over the image's dimensions, x
+/// fastest, names it "Density" and makes it the image's point scalars.
+void SetDensity(vtkImageData* image, vtkDataArray* values, const std::function<double(int, int, int)>& f);
 
 /// A copy of `data` whose point array `name` holds `tuples` tuples (its first ones, then
 /// zeros): a point array that does not fit the points, which VTK lets a script attach.

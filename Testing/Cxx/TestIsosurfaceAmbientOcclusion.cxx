@@ -38,15 +38,7 @@ vtkSmartPointer<vtkImageData> Slab(int n, int zLo, int zHi)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetDimensions(n, n, n);
-  vtkNew<vtkShortArray> values;
-  values->SetName("Density");
-  values->SetNumberOfTuples(image->GetNumberOfPoints());
-  vtkIdType id = 0;
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i, ++id)
-        values->SetValue(id, k >= zLo && k <= zHi ? 1000 : 0);
-  image->GetPointData()->SetScalars(values);
+  SetDensity(image, vtkNew<vtkShortArray>(), [&](int, int, int k) { return k >= zLo && k <= zHi ? 1000 : 0; });
   return image;
 }
 
