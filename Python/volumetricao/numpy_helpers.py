@@ -1,8 +1,10 @@
 """numpy in, numpy out: the filters run on an array without building a VTK pipeline.
 
 Arrays are indexed ``[z, y, x]`` (C order, x fastest: how VTK stores image data and how
-numpy arrays from ``vtk_to_numpy(...).reshape(nz, ny, nx)`` come). Any numeric dtype is
-accepted without conversion; the results are float32 arrays of the same shape.
+numpy arrays from ``vtk_to_numpy(...).reshape(nz, ny, nx)`` come). Integer and float
+arrays in the machine's byte order are read in place; other byte orders (``>i2`` from a
+big-endian raw file, say) and float16 are converted, bool is read as 0 and 1. Complex
+and non-numeric arrays are refused. The results are float32 arrays of the same shape.
 """
 import numpy as np
 
@@ -22,8 +24,24 @@ _METHODS = {
 }
 
 
-def _image(array, spacing, origin):
+def _readable(array):
+    """The array as VTK can read it: C order, native byte order, a type VTK has."""
     values = np.ascontiguousarray(array)
+    kind = values.dtype.kind
+    if kind == "c":
+        raise ValueError("complex values have no order to rank: pass the real part or the magnitude")
+    if kind not in "biuf":
+        raise ValueError("expected a numeric array, got dtype %s" % values.dtype)
+    if kind == "b":
+        return values.view(np.uint8)
+    if values.dtype == np.float16:
+        return values.astype(np.float32)
+    # VTK reads the bytes in the machine's order: another order would be silently wrong.
+    return values.astype(values.dtype.newbyteorder("="), copy=False)
+
+
+def _image(array, spacing, origin):
+    values = _readable(array)
     if values.ndim != 3:
         raise ValueError("expected a 3-D array indexed [z, y, x], got shape %s" % (values.shape,))
     image = vtkImageData()

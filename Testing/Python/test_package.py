@@ -84,15 +84,31 @@ expected = filter_result(volumes["float32"], s, ["AmbientOcclusion", "SignedDist
 check(np.array_equal(sweep_ao, expected[0]) and np.array_equal(distance, expected[1]),
       "occlusion_sweeping equals vtkOcclusionSweeping")
 
-for what, call, error in [
-        ("radius 0", lambda: ambient_occlusion(volumes["int16"], radius=0), RuntimeError),
-        ("an unknown method", lambda: ambient_occlusion(volumes["int16"], method="Fast"), ValueError),
-        ("a 2-D array", lambda: ambient_occlusion(np.zeros((4, 4))), ValueError),
-        ("NaN values", lambda: ambient_occlusion(np.full((5, 5, 5), np.nan, np.float32)), RuntimeError)]:
+# Other byte orders, float16 and bool are converted: the result is the native array's.
+native = volumes["int16"]
+for what, other, same, iso in [(">i2 (big-endian)", native.astype(">i2"), native, 50),
+                               (">f8 (big-endian)", native.astype(">f8"), native.astype(np.float64), 50),
+                               ("float16", native.astype(np.float16), native.astype(np.float16).astype(np.float32), 50),
+                               ("bool", native > 100, (native > 100).astype(np.uint8), 0.5)]:
+    check(np.array_equal(ambient_occlusion(other, radius=2, method="Gaussian CDF"),
+                         ambient_occlusion(same, radius=2, method="Gaussian CDF")),
+          "%s: ambient_occlusion equals that of the native array" % what)
+    distance = occlusion_sweeping(other, iso)[1]
+    check(np.array_equal(distance, occlusion_sweeping(same, iso)[1]) and (distance < 0).any() and (distance > 0).any(),
+          "%s: occlusion_sweeping equals that of the native array (a surface crosses it)" % what)
+
+for what, call, error, word in [
+        ("complex values", lambda: ambient_occlusion(volumes["int16"].astype(np.complex64)), ValueError, "complex"),
+        ("an object array", lambda: ambient_occlusion(volumes["int16"].astype(object)), ValueError, "numeric"),
+        ("radius 0", lambda: ambient_occlusion(volumes["int16"], radius=0), RuntimeError, "rounds to 0 voxels"),
+        ("an unknown method", lambda: ambient_occlusion(volumes["int16"], method="Fast"), ValueError, "unknown method"),
+        ("a 2-D array", lambda: ambient_occlusion(np.zeros((4, 4))), ValueError, "3-D array"),
+        ("NaN values", lambda: ambient_occlusion(np.full((5, 5, 5), np.nan, np.float32), radius=1), RuntimeError,
+         "NaN")]:
     try:
         call()
         check(False, "%s raises %s" % (what, error.__name__))
     except error as e:
-        check(len(str(e)) > 10, "%s raises %s: %s" % (what, error.__name__, str(e).splitlines()[-1][:100]))
+        check(word in str(e), "%s raises %s naming it (%r): %s" % (what, error.__name__, word, str(e).splitlines()[-1][:100]))
 print("FAILED" if failures else "all package checks passed")
 sys.exit(1 if failures else 0)
