@@ -193,7 +193,7 @@ bool vtkIsosurfaceAmbientOcclusion::CheckSurfaceInVolume(
   {
     bounds[a] = origin[a / 2] + reached[a] * h[a / 2];
   }
-  this->SurfaceBoundsInVolumeFrame(surface, surfaceBounds);
+  this->PlaceSurface(surface, surfaceBounds);
   for (int a = 0; a < 3; ++a)
   {
     if (surfaceBounds[2 * a] < bounds[2 * a] - 0.5 * h[a] || surfaceBounds[2 * a + 1] > bounds[2 * a + 1] + 0.5 * h[a])

@@ -25,6 +25,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <string>
 #include <tuple>
@@ -70,6 +71,17 @@ struct SurfaceKey
       std::tie(o.points, o.pointsTime, o.normals, o.normalsTime, o.count, o.query, o.pyramidBuilds);
   }
 };
+/// The median distance of the values from their median: near 0 when nearly all agree.
+double MedianDeviation(std::vector<double> values)
+{
+  const auto middle = values.begin() + values.size() / 2;
+  std::nth_element(values.begin(), middle, values.end());
+  const double median = *middle;
+  for (double& v : values)
+    v = std::abs(v - median);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
 } // namespace
 
 /// The pyramid of the last volume, and what it was built from: the array (and its MTime,
@@ -93,8 +105,10 @@ struct vtkIsosurfaceAmbientOcclusion::Cache
   vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
   std::array<double, 3> origin{};
   std::array<double, 3> spacing{};
-  // The volume's frame: the surface's points, normals and the light are turned into it.
+  // The volume's frame, and the one the current surface's points are in (PlaceSurface):
+  // its points, normals and the light are turned from it into the volume's.
   vtkAmbientOcclusionFrame::Frame frame;
+  vtkAmbientOcclusionFrame::Frame surfaceFrame;
   // The last AmbientOcclusion, which does not depend on the light: a light move reuses it
   // while the surface, the query and the pyramid stay (SurfaceKey).
   vtkSmartPointer<vtkFloatArray> occlusion;
@@ -246,9 +260,34 @@ void vtkIsosurfaceAmbientOcclusion::ShareCoarsestLevel(
 }
 
 //------------------------------------------------------------------------------
-void vtkIsosurfaceAmbientOcclusion::SurfaceBoundsInVolumeFrame(vtkPolyData* surface, double bounds[6]) const
+void vtkIsosurfaceAmbientOcclusion::PlaceSurface(vtkPolyData* surface, double bounds[6])
 {
-  const vtkAmbientOcclusionFrame::Frame& frame = this->Pyramid->frame;
+  // VTK places an oriented image's voxels at origin + D (spacing index); vtkFlyingEdges3D
+  // and vtkMarchingCubes put a contour there, while vtkContourFilter and
+  // vtkSynchronizedTemplates3D of VTK 9.2 (ParaView 5.11's Contour) leave it along the
+  // image's axes. A contour's points lie on grid edges, where the trilinear volume takes
+  // the iso value: the frame in which the sampled values agree is the surface's.
+  Cache& cache = *this->Pyramid;
+  cache.surfaceFrame = cache.frame;
+  const vtkIdType n = surface->GetNumberOfPoints();
+  if (!cache.frame.identity && n > 0)
+  {
+    std::vector<double> inFrame, alongAxes;
+    for (vtkIdType i = 0; i < n; i += std::max<vtkIdType>(1, n / 512))
+    {
+      const double* p = surface->GetPoint(i);
+      inFrame.push_back(vao::sampleVolume(cache.scalars.view, cache.origin, cache.spacing, cache.frame.PointToImage(p)));
+      alongAxes.push_back(vao::sampleVolume(cache.scalars.view, cache.origin, cache.spacing, { p[0], p[1], p[2] }));
+    }
+    if (MedianDeviation(alongAxes) < 1e-3 * MedianDeviation(inFrame))
+    {
+      cache.surfaceFrame = vtkAmbientOcclusionFrame::Frame{};
+      vtkWarningMacro(<< "The surface lies on the volume's iso-surface only with the volume's direction matrix "
+                         "ignored, as vtkContourFilter and ParaView 5.11's Contour extract it: its points, normals "
+                         "and LightDirection are taken along the image's axes.");
+    }
+  }
+  const vtkAmbientOcclusionFrame::Frame& frame = cache.surfaceFrame;
   if (frame.identity)
   {
     surface->GetBounds(bounds);
@@ -259,7 +298,7 @@ void vtkIsosurfaceAmbientOcclusion::SurfaceBoundsInVolumeFrame(vtkPolyData* surf
     bounds[2 * a] = std::numeric_limits<double>::infinity();
     bounds[2 * a + 1] = -bounds[2 * a];
   }
-  for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i)
+  for (vtkIdType i = 0; i < n; ++i)
   {
     const std::array<double, 3> p = frame.PointToImage(surface->GetPoint(i));
     for (int a = 0; a < 3; ++a)
@@ -292,7 +331,7 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
   }
   vtkFloatArray* floatPoints = vtkFloatArray::SafeDownCast(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr);
   vtkFloatArray* floatNormals = vtkFloatArray::SafeDownCast(givenNormals);
-  const vtkAmbientOcclusionFrame::Frame& frame = cache.frame;
+  const vtkAmbientOcclusionFrame::Frame& frame = cache.surfaceFrame; // PlaceSurface's
   const bool inPlace = floatPoints && floatNormals && frame.identity;
   std::vector<double> points, normals;
   std::string error;
