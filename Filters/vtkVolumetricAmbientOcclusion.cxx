@@ -179,6 +179,9 @@ bool vtkVolumetricAmbientOcclusion::CheckParameters()
     why << vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
   else if (this->OutputArrayName.empty())
     why << "OutputArrayName must not be empty.";
+  else if (this->ComputeVariance && this->OutputArrayName == "Variance")
+    why << "OutputArrayName 'Variance' is the name of the variance output (ComputeVariance), which would replace "
+           "it: choose another name.";
   if (why.tellp() == 0)
   {
     return true;

@@ -363,6 +363,11 @@ TEST(VolumetricAmbientOcclusion, RejectsBadInputWithAClearError)
   ExpectRejected(RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) { f->SetNumberOfThreads(-1); }, "NumberOfThreads");
   ExpectRejected(RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) { f->SetDevice(-2); }, "Device must be -1");
   ExpectRejected(RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) { f->SetOutputArrayName(""); }, "OutputArrayName");
+  // The openness and the variance under one name: one would replace the other.
+  ExpectRejected(RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) {
+    f->SetOutputArrayName("Variance");
+    f->ComputeVarianceOn();
+  }, "OutputArrayName 'Variance' is the name of the variance output");
 }
 
 TEST(VolumetricAmbientOcclusion, ARadiusLargerThanTheVolumeOnSomeAxesIsClipped)
