@@ -266,7 +266,9 @@ void vtkIsosurfaceAmbientOcclusion::PlaceSurface(vtkPolyData* surface, double bo
   // and vtkMarchingCubes put a contour there, while vtkContourFilter and
   // vtkSynchronizedTemplates3D of VTK 9.2 (ParaView 5.11's Contour) leave it along the
   // image's axes. A contour's points lie on grid edges, where the trilinear volume takes
-  // the iso value: the frame in which the sampled values agree is the surface's.
+  // the iso value: the frame in which the sampled values agree is the surface's. The
+  // axes win only where the physical frame's values clearly disagree: the points of a
+  // physical surface read along the axes may all fall in flat air, and agree there too.
   Cache& cache = *this->Pyramid;
   cache.surfaceFrame = cache.frame;
   const vtkIdType n = surface->GetNumberOfPoints();
@@ -279,7 +281,11 @@ void vtkIsosurfaceAmbientOcclusion::PlaceSurface(vtkPolyData* surface, double bo
       inFrame.push_back(vao::sampleVolume(cache.scalars.view, cache.origin, cache.spacing, cache.frame.PointToImage(p)));
       alongAxes.push_back(vao::sampleVolume(cache.scalars.view, cache.origin, cache.spacing, { p[0], p[1], p[2] }));
     }
-    if (MedianDeviation(alongAxes) < 1e-3 * MedianDeviation(inFrame))
+    const auto [low, high] = std::minmax_element(inFrame.begin(), inFrame.end());
+    const auto [lowAxes, highAxes] = std::minmax_element(alongAxes.begin(), alongAxes.end());
+    const double spread = std::max(*high, *highAxes) - std::min(*low, *lowAxes);
+    const double disagreement = MedianDeviation(inFrame);
+    if (disagreement > 1e-4 * spread && MedianDeviation(alongAxes) < 1e-3 * disagreement)
     {
       cache.surfaceFrame = vtkAmbientOcclusionFrame::Frame{};
       vtkWarningMacro(<< "The surface lies on the volume's iso-surface only with the volume's direction matrix "

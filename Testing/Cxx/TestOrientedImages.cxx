@@ -51,8 +51,9 @@ std::array<double, 3> Times(const Matrix& m, const double v[3])
     m[6] * v[0] + m[7] * v[1] + m[8] * v[2] };
 }
 
-/// A ball beside a wall in air, n^3 float voxels of anisotropic spacing.
-vtkSmartPointer<vtkImageData> Scene(int n, const Matrix* direction, const double origin[3])
+/// A ball beside a wall in air, n^3 float voxels of anisotropic spacing; `flat`: the ball
+/// alone, in air of exactly 0.
+vtkSmartPointer<vtkImageData> Scene(int n, const Matrix* direction, const double origin[3], bool flat = false)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetDimensions(n, n, n);
@@ -60,8 +61,10 @@ vtkSmartPointer<vtkImageData> Scene(int n, const Matrix* direction, const double
   image->SetOrigin(origin[0], origin[1], origin[2]);
   if (direction)
     image->SetDirectionMatrix(direction->data());
-  SetDensity(image, vtkNew<vtkFloatArray>(), [n](int i, int j, int k) {
+  SetDensity(image, vtkNew<vtkFloatArray>(), [n, flat](int i, int j, int k) {
     const double ball = std::hypot(i - 0.4 * n, j - 0.5 * n, k - 0.5 * n) < 0.2 * n ? 1000.0 : 0.0;
+    if (flat)
+      return static_cast<float>(std::hypot(i - 0.7 * n, j - 0.7 * n, k - 0.5 * n) < 0.2 * n ? 1000.0 : 0.0);
     const double wall = i >= 3 * n / 4 && i < 3 * n / 4 + 3 ? 1000.0 : 0.0;
     return static_cast<float>(std::max(ball, wall) + (i * 7 + j * 3 + k) % 5);
   });
@@ -110,24 +113,25 @@ TEST(OrientedImages, IsosurfaceAmbientOcclusionOfARotatedSceneIsTheScenesOwn)
     Matrix direction;
     const double* origin;
     double tolerance; // a quarter turn about z at the origin 0 moves every float exactly
+    bool flat = false; // a ball in exact air, where the points read along the axes agree too
   };
   for (const Case& c : { Case{ Rotation({ 0, 0, 1 }, 0.5 * M_PI), zero, 0.0 },
          Case{ Rotation({ 1, 2, 3 }, 0.7), origin, 2e-5 }, Case{ Rotation({ -2, 1, 0.5 }, 2.5), origin, 2e-5 },
-         Case{ Rotation({ 0.3, -1, 0.2 }, 0.02), origin, 2e-5 } })
+         Case{ Rotation({ 0.3, -1, 0.2 }, 0.02), origin, 2e-5 }, Case{ Rotation({ 0, 0, 1 }, 0.7), origin, 2e-5, true } })
   {
     Matrix exact = c.direction;
     if (c.tolerance == 0.0)
       for (double& m : exact)
         m = std::round(m); // cos(pi / 2) is 6e-17, not 0
-    auto plain = Scene(24, nullptr, c.origin);
-    auto turned = Scene(24, &exact, c.origin);
+    auto plain = Scene(24, nullptr, c.origin, c.flat);
+    auto turned = Scene(24, &exact, c.origin, c.flat);
     const Shaded a = ShadeContour(plain, light);
     const std::array<double, 3> turnedLight = Times(exact, light);
     std::vector<std::string> warnings;
     const Shaded b = ShadeContour(turned, turnedLight.data(), nullptr, &warnings);
     EXPECT_TRUE(warnings.empty()) << (warnings.empty() ? "" : warnings.front());
     const vtkIdType n = a.surface->GetNumberOfPoints();
-    ASSERT_GT(n, 1000);
+    ASSERT_GT(n, 300);
     ASSERT_EQ(b.surface->GetNumberOfPoints(), n);
     ASSERT_EQ(b.output->GetNumberOfPoints(), n) << "the rotated scene was refused";
     // The contours are the same points, rotated about the origin.
