@@ -119,8 +119,7 @@ bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData*
   error = PointCountError(scalars, input->GetNumberOfPoints());
   // Spacings, radii and distances are taken along the image's axes: they must be
   // orthogonal unit vectors in the physical frame.
-  vtkAmbientOcclusionFrame::Frame frame;
-  if (!error.empty() || !vtkAmbientOcclusionFrame::FrameOf(input, frame, error))
+  if (!error.empty() || !vtkAmbientOcclusionFrame::FrameOf(input, volume.frame, error))
     return false;
   const int components = scalars->GetNumberOfComponents();
   const int picked = component < 0 && components == 1 ? 0 : component;

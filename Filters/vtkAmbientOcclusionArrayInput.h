@@ -32,12 +32,15 @@ struct ScalarVolume
   /// Structured coordinates of the view's first voxel (the lower corner of the input's
   /// extent): a voxel index of the kernels becomes a voxel the user can find.
   std::array<int, 3> firstVoxel = { 0, 0, 0 };
+  /// The image's frame (its direction matrix, a rotation): where the kernels' axis-aligned
+  /// coordinates lie in the physical frame.
+  vtkAmbientOcclusionFrame::Frame frame;
 };
 
 /// Takes the array the algorithm chose to process (`chosen`, from GetInputArrayToProcess;
 /// the active point scalars when no array was named at all), checks it (numeric, point
 /// data, a valid component, one tuple a point, an image whose direction matrix is a
-/// rotation) and fills volume. On failure returns false and says why in
+/// rotation) and fills volume, its frame included. On failure returns false and says why in
 /// `error`. NaN and infinite values are not looked for here: the kernels find them in
 /// their first pass over the data, and KernelError names them.
 bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input, int component,

@@ -105,9 +105,9 @@ struct vtkIsosurfaceAmbientOcclusion::Cache
   vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
   std::array<double, 3> origin{};
   std::array<double, 3> spacing{};
-  // The volume's frame, and the one the current surface's points are in (PlaceSurface):
-  // its points, normals and the light are turned from it into the volume's.
-  vtkAmbientOcclusionFrame::Frame frame;
+  // The frame the current surface's points are in (PlaceSurface: the volume's,
+  // scalars.frame, or the image's axes): its points, normals and the light are turned
+  // from it into the volume's axis-aligned one.
   vtkAmbientOcclusionFrame::Frame surfaceFrame;
   // The last AmbientOcclusion, which does not depend on the light: a light move reuses it
   // while the surface, the query and the pyramid stay (SurfaceKey).
@@ -136,7 +136,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
   const double* d = volume->GetDirectionMatrix()->GetData();
   const bool sameGrid = std::equal(extent, extent + 6, cache.extent.begin()) &&
     cache.origin == PyramidImages::ExtentOrigin(volume) && cache.spacing == std::array<double, 3>{ h[0], h[1], h[2] } &&
-    std::equal(d, d + 9, cache.frame.direction.begin());
+    std::equal(d, d + 9, cache.scalars.frame.direction.begin());
   const bool fresh = chosen && cache.array == chosen && cache.arrayTime == chosen->GetMTime() && sameGrid &&
     cache.component == this->Component &&
     cache.numberOfLevels == this->NumberOfLevels && cache.halfResolution == (this->StartAtHalfResolution != 0) &&
@@ -148,7 +148,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
   cache.levels.clear();
   cache.surface.clear();
   std::string error;
-  if (!Extents::CheckWholeExtent(volume->GetExtent(), error) || !vtkAmbientOcclusionFrame::FrameOf(volume, cache.frame, error) ||
+  if (!Extents::CheckWholeExtent(volume->GetExtent(), error) ||
     !PrepareScalars(this, chosen, volume, this->Component, cache.scalars, error) ||
     !PyramidImages::BuildPyramid(cache.scalars, volume, this->PyramidRequest(),
       ExecutionOf(this, this->NumberOfThreads), cache.surface, error))
@@ -185,10 +185,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
   int expected[6];
   this->VolumeExtentOf(whole, volume->GetSpacing(), piece, expected);
   const bool empty = Extents::EmptyExtent(piece);
-  if (!vtkAmbientOcclusionFrame::FrameOf(volume, cache.frame, error))
-  {
-  }
-  else if (!empty && !std::equal(expected, expected + 6, volume->GetExtent()))
+  if (!empty && !std::equal(expected, expected + 6, volume->GetExtent()))
   {
     error = "The volume input delivered another extent than this process's piece and its reach: under MPI, "
             "feed the Volume input from its own reader.";
@@ -270,15 +267,16 @@ void vtkIsosurfaceAmbientOcclusion::PlaceSurface(vtkPolyData* surface, double bo
   // axes win only where the physical frame's values clearly disagree: the points of a
   // physical surface read along the axes may all fall in flat air, and agree there too.
   Cache& cache = *this->Pyramid;
-  cache.surfaceFrame = cache.frame;
+  const vtkAmbientOcclusionFrame::Frame& volumeFrame = cache.scalars.frame;
+  cache.surfaceFrame = volumeFrame;
   const vtkIdType n = surface->GetNumberOfPoints();
-  if (!cache.frame.identity && n > 0)
+  if (!volumeFrame.identity && n > 0)
   {
     std::vector<double> inFrame, alongAxes;
     for (vtkIdType i = 0; i < n; i += std::max<vtkIdType>(1, n / 512))
     {
       const double* p = surface->GetPoint(i);
-      inFrame.push_back(vao::sampleVolume(cache.scalars.view, cache.origin, cache.spacing, cache.frame.PointToImage(p)));
+      inFrame.push_back(vao::sampleVolume(cache.scalars.view, cache.origin, cache.spacing, volumeFrame.PointToImage(p)));
       alongAxes.push_back(vao::sampleVolume(cache.scalars.view, cache.origin, cache.spacing, { p[0], p[1], p[2] }));
     }
     const auto [low, high] = std::minmax_element(inFrame.begin(), inFrame.end());

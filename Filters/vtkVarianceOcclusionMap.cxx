@@ -119,8 +119,7 @@ int vtkVarianceOcclusionMap::RequestData(
     }
     std::vector<vao::MomentLevel> pyramid;
     vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
-    vtkAmbientOcclusionFrame::Frame frame;
-    if (!input || !Extents::CheckWholeExtent(whole, error) || !vtkAmbientOcclusionFrame::FrameOf(input, frame, error) ||
+    if (!input || !Extents::CheckWholeExtent(whole, error) ||
       !vtkAmbientOcclusionArrayInput::PrepareScalars(
         this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error) ||
       !vtkAmbientOcclusionPyramidImages::BuildPyramid(scalars, input, this->Parameters(),
@@ -140,7 +139,7 @@ int vtkVarianceOcclusionMap::RequestData(
     for (size_t l = 0; l < pyramid.size(); ++l, step *= 2)
     {
       auto part = vtkAmbientOcclusionPyramidImages::LevelPiece(pyramid[l], whole, expected, piece, step);
-      vtkAmbientOcclusionFrame::PlaceInWorld(frame, part); // where the input's own voxels lie
+      vtkAmbientOcclusionFrame::PlaceInWorld(scalars.frame, part); // where the input's own voxels lie
       output->SetBlock(static_cast<unsigned int>(l), part);
       output->GetMetaData(static_cast<unsigned int>(l))
         ->Set(vtkCompositeDataSet::NAME(), ("Level " + std::to_string(l)).c_str());
