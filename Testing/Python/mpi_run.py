@@ -11,7 +11,7 @@ import sys
 from paraview.simple import *  # noqa: F401,F403
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from vao_test_utils import RAW_XML, extent_logger  # noqa: E402
+from vao_test_utils import XML_OPTIONS, extent_logger  # noqa: E402
 
 plugin, source, target = sys.argv[1:4]
 LoadPlugin(plugin, remote=True, ns=globals())
@@ -36,14 +36,14 @@ current = OcclusionSweeping(Input=extent_logger(current, target + ".sweeping"), 
 current.Scalars = ["POINTS", "MetaImage"]
 current = AmbientOcclusionShading(Input=current, AmbientOcclusionArray="GaussianCDF")
 current.Scalars = ["POINTS", "MetaImage"]
-SaveData(target, proxy=current, **RAW_XML)
+SaveData(target, proxy=current, **XML_OPTIONS)
 
 # A local filter asked directly for the writer's pieces (ParaView's decomposition of the
 # output, with ghost levels grown by the radius): each rank needs its piece + 10 voxels.
 direct = VolumetricAmbientOcclusion(Input=extent_logger(reader, target + ".piece"), Method="Gaussian CDF", Radius=10,
                                     OutputArrayName="Direct")
 direct.Scalars = ["POINTS", "MetaImage"]
-SaveData(target[:-len(".pvti")] + "_direct.pvti", proxy=direct, **RAW_XML)
+SaveData(target[:-len(".pvti")] + "_direct.pvti", proxy=direct, **XML_OPTIONS)
 
 # Histogram CDF takes its thresholds from the whole data set: the ranks reduce the value
 # histograms of their pieces, so each still needs only its piece grown by the radii
@@ -55,4 +55,4 @@ smoothed = VolumetricAmbientOcclusion(Input=histogram, Method="Histogram CDF", R
                                       QueryMode="Smoothed Voxel Value", QuerySmoothing=2.0,
                                       OutputArrayName="HistogramSmoothed")
 smoothed.Scalars = ["POINTS", "MetaImage"]
-SaveData(target[:-len(".pvti")] + "_histogram.pvti", proxy=smoothed, **RAW_XML)
+SaveData(target[:-len(".pvti")] + "_histogram.pvti", proxy=smoothed, **XML_OPTIONS)

@@ -10,7 +10,7 @@ import sys
 from paraview.simple import *  # noqa: F401,F403
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from vao_test_utils import RAW_XML, extent_logger  # noqa: E402
+from vao_test_utils import XML_OPTIONS, extent_logger  # noqa: E402
 
 plugin, source_path, target = sys.argv[1:4]
 LoadPlugin(plugin, remote=True, ns=globals())
@@ -22,7 +22,7 @@ volume = extent_logger(XMLImageDataReader(FileName=[source_path]), target + ".vo
 bone = Contour(Input=pieces, ContourBy=["POINTS", "MetaImage"], Isosurfaces=[400.0], ComputeNormals=0)
 shaded = IsosurfaceAmbientOcclusion(Input=bone, Volume=volume, ComputeShadows=1, LightDirection=[0.0, -1.0, 1.0])
 shaded.Scalars = ["POINTS", "MetaImage"]
-SaveData(target, proxy=shaded, **RAW_XML)
+SaveData(target, proxy=shaded, **XML_OPTIONS)
 
 # The pyramid (Variance Occlusion Map), distributed: each rank computes the level voxels
 # of its piece from its piece grown by the pyramid's reach. A pass-through writes, per
