@@ -3,9 +3,9 @@
 # Debian packages that are missing, configure and build (build/), then run one job:
 #
 #   bash .ci/setup.sh demo [vao-demo arguments]   the main job (AO of the generated phantom
-#                                                 or of a file you name; see README)
+#                                                 or of a file you name; see README.md)
 #   bash .ci/setup.sh test                        the whole test suite (ctest)
-#   bash .ci/setup.sh benchmark                   the benchmark table (README "Benchmark")
+#   bash .ci/setup.sh benchmark                   the benchmark table (docs/performance.md)
 #   bash .ci/setup.sh build                       set-up only
 #   bash .ci/setup.sh sanitize [--filters]        the tests under ASan + UBSan and TSan
 #   bash .ci/setup.sh fuzz [seconds]              libFuzzer on the kernel library (600 s)
@@ -14,9 +14,10 @@ cd "$(dirname "$0")/.."
 job="${1:-demo}"
 shift || true
 
-# Verified from a bare Debian 12 (see ../shared/ARCHITECTURE.md), plus scipy for the
-# benchmark's peer, python3-dev for the Python package and qemu-user for the kernel tests
-# on an emulated processor without AVX2.
+# Verified from a bare (minbase) Debian 12: ParaView's development files and what its CMake
+# files ask for, plus scipy for the benchmark's peer, python3-dev for the Python package and
+# qemu-user for the kernel tests on an emulated processor without AVX2. docs/development.md
+# says which of them a plain CMake build needs.
 qt_packages=(qtbase5-dev qttools5-dev libqt5svg5-dev libqt5opengl5-dev qtxmlpatterns5-dev-tools
   libqt5x11extras5-dev)
 # Debian 13's ParaView 5.13 is built with Qt 6 (Testing/compat/debian13.sh runs this there).
@@ -57,9 +58,8 @@ case "$job" in
   demo)
     build/bin/vao-demo "$@"
     # The figures of the papers (volume rendering, isosurfaces) with every filter, on the
-    # generated phantom and, when ../shared is beside the checkout, the CT head phantom.
-    ct=../shared/data/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha
-    [ -f "$ct" ] || ct=""
+    # CT head phantom the repository ships (Data/).
+    ct=Data/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha
     exec bash .ci/with-xvfb.sh /usr/bin/pvpython --force-offscreen-rendering \
       Examples/figures.py "$(cat build/VolumetricAOPluginPath.txt)" vao-output/figures $ct ;;
   test)

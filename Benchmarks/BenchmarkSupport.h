@@ -4,11 +4,15 @@
 
 #include <algorithm>
 #include <chrono>
+#include <fstream>
 #include <string>
 #include <thread>
 
-#ifndef VAO_DEFAULT_SHARED_DATA_DIR
-#define VAO_DEFAULT_SHARED_DATA_DIR "../shared/data"
+#ifndef VAO_DATA_DIR
+#define VAO_DATA_DIR "Data"
+#endif
+#ifndef VAO_EXTRA_DATA_DIR
+#define VAO_EXTRA_DATA_DIR ""
 #endif
 #ifndef VAO_DEFAULT_SCIPY_PEER
 #define VAO_DEFAULT_SCIPY_PEER "scipy_peer.py"
@@ -25,7 +29,7 @@ namespace vaobench
 
 struct Options
 {
-  std::string shared = VAO_DEFAULT_SHARED_DATA_DIR;
+  std::string data = VAO_EXTRA_DATA_DIR; // --data: scans the repository does not ship
   std::string scipy = VAO_DEFAULT_SCIPY_PEER;
   std::string scipyEdt = VAO_DEFAULT_SCIPY_EDT_PEER;
   std::string scipyBlur = VAO_DEFAULT_SCIPY_BLUR_PEER;
@@ -37,6 +41,16 @@ struct Options
   bool exact = false;
   int threads = 0;
 };
+
+/// Where a scan is: under Data/ (shipped), else under `extra` (--data), else the Data/ path,
+/// so that the reader's message names the file that is missing.
+inline std::string ScanPath(const std::string& extra, const std::string& relative)
+{
+  const std::string shipped = std::string(VAO_DATA_DIR) + "/" + relative;
+  if (std::ifstream(shipped).good() || extra.empty())
+    return shipped;
+  return extra + "/" + relative;
+}
 
 inline int ResolvedThreads(int requested)
 {

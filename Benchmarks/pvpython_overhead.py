@@ -17,7 +17,9 @@ import time
 from paraview.simple import *  # noqa: F401,F403
 
 LoadPlugin(sys.argv[1], ns=globals())
-data = sys.argv[2] if len(sys.argv) > 2 else os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data")
+# The 512x512x209 CT head is not shipped in Data/: DATA_DIR is a folder laid out like Data/
+# that holds it (ct_head_phantom/ct_head_phantom_512x512x209_int16.mha).
+data = sys.argv[2] if len(sys.argv) > 2 else os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Data")
 
 
 def seconds(update):

@@ -6,7 +6,7 @@
 // generated scenes of Singh et al.'s Table 2 sizes and the CT head phantom's skin, against
 // scipy.ndimage.distance_transform_edt in the same run.
 //
-// Usage: vao_benchmark [--shared DIR] [--scipy PATH/TO/scipy_peer.py] [--repeat N]
+// Usage: vao_benchmark [--data DIR] [--scipy PATH/TO/scipy_peer.py] [--repeat N]
 //                      [--exact] [--threads N] [--volumetric | --sweeping | --penner | --relight | --bytes]
 //                      (one table only; --relight: the surface query rates alone; --bytes: the
 //                      bytes per voxel each kernel moves, under valgrind, BytesPerVoxel.cxx)
@@ -223,7 +223,7 @@ void Benchmark(const std::string& label, vtkImageData* image, const std::string&
   }
 }
 
-/// A MetaImage scan from ../shared/data; exits with a message when it cannot be read.
+/// A MetaImage scan (ScanPath); exits with a message when it cannot be read.
 vtkSmartPointer<vtkImageData> ReadScanOrExit(const std::string& path)
 {
   vtkNew<vtkMetaImageReader> reader;
@@ -231,7 +231,10 @@ vtkSmartPointer<vtkImageData> ReadScanOrExit(const std::string& path)
   reader->Update();
   if (reader->GetOutput()->GetNumberOfPoints() == 0)
   {
-    std::fprintf(stderr, "cannot read %s\n", path.c_str());
+    std::fprintf(stderr,
+      "cannot read %s (a scan not shipped in Data/: pass --data DIR, or configure with "
+      "-DVAO_EXTRA_DATA_DIR=DIR)\n",
+      path.c_str());
     std::exit(1);
   }
   return reader->GetOutput();
@@ -354,8 +357,8 @@ int main(int argc, char* argv[])
   for (int i = 1; i < argc; ++i)
   {
     const std::string arg = argv[i];
-    if (arg == "--shared" && i + 1 < argc)
-      options.shared = argv[++i];
+    if (arg == "--data" && i + 1 < argc)
+      options.data = argv[++i];
     else if (arg == "--scipy" && i + 1 < argc)
       options.scipy = argv[++i];
     else if (arg == "--repeat" && i + 1 < argc)
@@ -381,7 +384,7 @@ int main(int argc, char* argv[])
       return RunBytesWorkload(argv[i + 1]);
     else
     {
-      std::fprintf(stderr, "usage: %s [--shared DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--volumetric | --sweeping | --penner | --relight | --bytes]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--data DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--volumetric | --sweeping | --penner | --relight | --bytes]\n", argv[0]);
       return 2;
     }
   }
@@ -401,14 +404,14 @@ int main(int argc, char* argv[])
     Benchmark("generated phantom", phantom->GetOutput(), raw, options);
     std::remove(raw.c_str());
 
-    const std::string ct = options.shared + "/ct_head_phantom/ct_head_phantom_512x512x209_int16.mha";
+    const std::string ct = ScanPath(options.data, "ct_head_phantom/ct_head_phantom_512x512x209_int16.mha");
     Benchmark("ct_head_phantom_512x512x209_int16.mha", ReadScanOrExit(ct), ct, options);
   }
   if (options.volumetricOnly)
   {
     return 0;
   }
-  const auto head = ReadScanOrExit(options.shared + "/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha");
+  const auto head = ReadScanOrExit(ScanPath(options.data, "ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));
   if (!options.pennerOnly)
   {
     BenchmarkSweeping(options, head);
@@ -421,7 +424,7 @@ int main(int argc, char* argv[])
       options.repeat);
     BenchmarkRelighting(options, "CT head 128x128x136", head);
     BenchmarkRelighting(options, "CT head 512x512x209",
-      ReadScanOrExit(options.shared + "/ct_head_phantom/ct_head_phantom_512x512x209_int16.mha"));
+      ReadScanOrExit(ScanPath(options.data, "ct_head_phantom/ct_head_phantom_512x512x209_int16.mha")));
   }
   return 0;
 }

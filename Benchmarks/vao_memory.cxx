@@ -10,6 +10,7 @@
 // so one method's freed memory does not hide the next one's peak. The child reads the
 // volume, resets the kernel's high-water mark (/proc/self/clear_refs, "5"), runs the filter
 // and reads VmHWM from /proc/self/status.
+#include "BenchmarkSupport.h"
 #include "ProcessMemory.h"
 #include "vtkAmbientOcclusionShading.h"
 #include "vtkIsosurfaceAmbientOcclusion.h"
@@ -219,8 +220,7 @@ std::string Mb(long long bytes)
 
 int main(int argc, char* argv[])
 {
-  std::string path = std::string(VAO_DEFAULT_SHARED_DATA_DIR) +
-    "/ct_head_phantom/ct_head_phantom_512x512x209_int16.mha";
+  std::string path = vaobench::ScanPath(VAO_EXTRA_DATA_DIR, "ct_head_phantom/ct_head_phantom_512x512x209_int16.mha");
   double radius = 10.0;
   int threads = 0;
   int child = -1;

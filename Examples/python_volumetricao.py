@@ -1,7 +1,7 @@
 """VolumetricAO from VTK Python: a VTK pipeline and the numpy helper on the CT head phantom.
 
     PYTHONPATH=build/lib/python3.11/site-packages python3 Examples/python_volumetricao.py \
-        ../shared/data/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha
+        Data/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha
 
 (or pvpython; after `cmake --install build --prefix PREFIX`, PYTHONPATH=PREFIX/lib/python3.11/site-packages).
 """
@@ -14,7 +14,7 @@ from vtkmodules.vtkIOImage import vtkMetaImageReader
 import volumetricao
 from volumetricao import vtkVolumetricAmbientOcclusion
 
-path = sys.argv[1] if len(sys.argv) > 1 else "../shared/data/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"
+path = sys.argv[1] if len(sys.argv) > 1 else "Data/ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"
 reader = vtkMetaImageReader()
 reader.SetFileName(path)
 

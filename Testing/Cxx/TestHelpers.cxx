@@ -5,11 +5,40 @@
 #include "vtkPointData.h"
 
 #include <algorithm>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
 namespace vaotest
 {
+
+namespace
+{
+bool Readable(const std::string& path)
+{
+  return std::ifstream(path).good();
+}
+}
+
+std::string DataFile(const std::string& relative)
+{
+  const std::string shipped = std::string(VAO_DATA_DIR) + "/" + relative;
+  const std::string extra = std::string(VAO_EXTRA_DATA_DIR);
+  if (!Readable(shipped) && !extra.empty() && Readable(extra + "/" + relative))
+    return extra + "/" + relative;
+  return shipped;
+}
+
+bool HaveDataFile(const std::string& relative)
+{
+  return Readable(DataFile(relative));
+}
+
+std::string MissingDataMessage(const std::string& relative)
+{
+  return relative + " is not shipped in Data/: configure with -DVAO_EXTRA_DATA_DIR=DIR, DIR holding " +
+    relative + " (VAO_EXTRA_DATA_DIR is now '" + VAO_EXTRA_DATA_DIR + "')";
+}
 
 vtkSmartPointer<vtkImageData> ReadMetaImage(const std::string& path)
 {

@@ -41,11 +41,15 @@ public:
   std::vector<std::string> Warnings;
 };
 
-/// Path of a file under ../shared/data (the real scans beside the checkout).
-inline std::string SharedData(const std::string& relative)
-{
-  return std::string(VAO_SHARED_DATA_DIR) + "/" + relative;
-}
+/// Path of a real scan: under Data/ (shipped with the repository) or, for the larger ones,
+/// under VAO_EXTRA_DATA_DIR (a folder laid out the same way). The Data/ path when neither
+/// has it, so that the reader's error names the file.
+std::string DataFile(const std::string& relative);
+
+/// Whether DataFile(relative) exists; tests of a scan that is not shipped skip without it:
+/// `if (!HaveDataFile(f)) GTEST_SKIP() << MissingDataMessage(f);`
+bool HaveDataFile(const std::string& relative);
+std::string MissingDataMessage(const std::string& relative);
 
 /// Reads a MetaImage volume; fails the calling test when it cannot.
 vtkSmartPointer<vtkImageData> ReadMetaImage(const std::string& path);

@@ -440,7 +440,7 @@ double MonteCarloAO(vtkImageData* volume, double iso, const double p[3], const d
 
 TEST(IsosurfaceAmbientOcclusionFilter, FollowsMonteCarloAmbientOcclusionOnTheCtBoneSurface)
 {
-  auto ct = ReadMetaImage(SharedData("ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));
+  auto ct = ReadMetaImage(DataFile("ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));
   const double iso = 400.0;
   auto bone = Contour(ct, iso);
   const ShadeRun run = Shade(bone, ct, [](vtkIsosurfaceAmbientOcclusion*) {});

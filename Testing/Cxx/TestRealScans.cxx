@@ -55,7 +55,7 @@ ErrorStats Compare(const std::vector<double>& estimate, const std::vector<double
 /// METHODS.md: RMSE against Exact Box on the 128x128x136 CT head phantom, to +-0.005.
 void ExpectPublishedRmse(double radius, double gaussian, double cdf, double chebyshev)
 {
-  auto ct = ReadMetaImage(SharedData("ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));
+  auto ct = ReadMetaImage(DataFile("ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));
   ASSERT_EQ(ct->GetNumberOfPoints(), 128 * 128 * 136);
   const auto exact = AmbientOcclusion(ct, vtkVolumetricAmbientOcclusion::EXACT_BOX, radius);
   const ErrorStats g = Compare(AmbientOcclusion(ct, vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, radius), exact);

@@ -4,7 +4,7 @@ and to a .pvti written in 4 pieces, runs mpi_run.py serially and under
 reader), reads the .pvti pieces back and compares every array; checks from the logged
 extents that no rank received the whole volume (the local filters: at most its piece
 grown by the radii; occlusion sweeping: its slab and one ghost layer). Then the surface
-filters. Usage: pvpython test_mpi.py PLUGIN SHARED OUT PVBATCH MPIEXEC N..."""
+filters. Usage: pvpython test_mpi.py PLUGIN DATA_DIR OUT PVBATCH MPIEXEC N..."""
 import os
 import subprocess
 import sys
@@ -18,11 +18,11 @@ from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
 from vtkmodules.vtkIOXML import vtkXMLImageDataWriter  # noqa: E402
 from vtkmodules.vtkIOParallelXML import vtkXMLPImageDataWriter  # noqa: E402
 
-plugin, shared, out_dir, pvbatch, mpiexec = sys.argv[1:6]
+plugin, data_dir, out_dir, pvbatch, mpiexec = sys.argv[1:6]
 rank_counts = [int(n) for n in sys.argv[6:]]
 here = os.path.dirname(os.path.abspath(__file__))
 
-ct = read_image(os.path.join(shared, "ct_head_phantom", "ct_head_phantom_128x128x136_int16.mha"))
+ct = read_image(os.path.join(data_dir, "ct_head_phantom", "ct_head_phantom_128x128x136_int16.mha"))
 WHOLE = ct.GetExtent()
 source = os.path.join(out_dir, "mpi_ct.vti")
 writer = vtkXMLImageDataWriter()
