@@ -5,11 +5,12 @@ import sys
 # In the order the Method menu lists them (the default first).
 METHODS = ["Histogram CDF", "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box", "Exact Sphere"]
 
-# SaveData's options for every XML file the tests write: appended data encoded as base64,
-# uncompressed. Raw appended data is what ParaView writes by default, and VTK 9.2's XML
-# reader cannot parse it with the libexpat1 of a current Debian 12 (2.5.0-1+deb12u2 and
-# later defer reparsing and reject the binary bytes as "not well-formed").
-XML_OPTIONS = dict(DataMode="Appended", EncodeAppendedData=1, CompressorType="None")
+# SaveData's options for every XML file the tests write: inline binary (base64) data.
+# Appended data, raw or base64, is what ParaView writes by default, and VTK 9.2's XML reader
+# cannot parse it with the libexpat1 of a current Debian 12 (2.5.0-1+deb12u2 and later
+# defer reparsing, and the reader's early stop at <AppendedData> then fails as "not
+# well-formed (invalid token)").
+XML_OPTIONS = dict(DataMode="Binary")
 
 
 def fail(message):
