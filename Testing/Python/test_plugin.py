@@ -1,7 +1,7 @@
 """pvpython: load the plugin, check the proxy's properties, run every method on Wavelet
 and on the CT head phantom, check arrays and ranges, write the result and read it back.
 
-Usage: pvpython test_plugin.py PLUGIN SHARED_DATA_DIR OUTPUT_DIR"""
+Usage: pvpython test_plugin.py PLUGIN DATA_DIR OUTPUT_DIR"""
 import os
 import sys
 
@@ -12,7 +12,7 @@ from paraview.simple import *  # noqa: E402,F401,F403
 from paraview import servermanager  # noqa: E402
 import numpy as np  # noqa: E402
 
-plugin, shared, out_dir = sys.argv[1:4]
+plugin, data_dir, out_dir = sys.argv[1:4]
 LoadPlugin(plugin, ns=globals())
 check("VolumetricAmbientOcclusion" in globals(), "the plugin defines VolumetricAmbientOcclusion")
 
@@ -85,7 +85,7 @@ wavelet_points = 25 * 21 * 17
 results = {m: check_result(run(wavelet, "RTData", m, 3), "Wavelet/" + m, wavelet_points) for m in METHODS}
 check(np.all(results["Chebyshev"] <= results["Exact Box"] + 1e-6), "Wavelet: Chebyshev <= Exact Box")
 
-ct_path = os.path.join(shared, "ct_head_phantom", "ct_head_phantom_128x128x136_int16.mha")
+ct_path = os.path.join(data_dir, "ct_head_phantom", "ct_head_phantom_128x128x136_int16.mha")
 ct = OpenDataFile(ct_path)
 ct_points = 128 * 128 * 136
 for method in METHODS:
@@ -154,6 +154,18 @@ skin = Contour(Input=sweep, ContourBy=["POINTS", "MetaImage"], Isosurfaces=[-300
 surface = servermanager.Fetch(skin)
 surface_ao = surface.GetPointData().GetArray("AmbientOcclusion")
 check(surface.GetNumberOfPoints() > 10000 and surface_ao is not None, "the skin contour carries AmbientOcclusion")
+# The skin coloured in one step: Probe Outside Surface samples the sweeping's field a voxel
+# and a half outside the skin, so the inside voxels (dark by definition) do not darken it.
+lit_skin = ProbeOutsideSurface(Input=skin, Volume=sweep)
+check(lit_skin.Distance == 1.5 and lit_skin.Orientation == "Auto", "Probe Outside Surface defaults")
+lit = servermanager.Fetch(lit_skin)
+lit_ao = array_of(lit, "AmbientOcclusion")
+check(lit.GetNumberOfPoints() == surface.GetNumberOfPoints() and lit.GetPointData().GetArray("OctantVisibility"),
+      "Probe Outside Surface: every point of the skin, every array of the sweeping")
+on_skin = array_of(surface, "AmbientOcclusion")
+check(lit_ao.mean() > on_skin.mean() + 0.1 and 0.0 <= lit_ao.min() and lit_ao.max() <= 1.0,
+      "the probed skin is lit (mean AO %.3f) where the contour's own is dark (%.3f)" % (lit_ao.mean(), on_skin.mean()))
+Delete(lit_skin)
 Delete(skin)
 Delete(sweep)
 
