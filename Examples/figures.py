@@ -1,6 +1,7 @@
 """Figures of the three papers' uses of ambient occlusion, rendered with the plugin in pvpython.
 
-Usage (rendering needs a display: run it under Xvfb):
+Usage (Debian's ParaView renders through X even offscreen: without a display, run it
+under Xvfb, package xvfb):
 
     xvfb-run -a pvpython --force-offscreen-rendering Examples/figures.py PLUGIN OUTDIR [CT.mha] [--quick]
 
@@ -50,6 +51,12 @@ plugin, out_dir = args[0], args[1]
 ct_path = args[2] if len(args) > 2 else None
 os.makedirs(out_dir, exist_ok=True)
 LoadPlugin(plugin, ns=globals())
+
+# A ParaView built for X (Debian's) aborts without a display; say how to run instead.
+import vtkmodules.vtkRenderingOpenGL2 as _gl  # noqa: E402
+if not os.environ.get("DISPLAY") and not any(hasattr(_gl, w) for w in ("vtkEGLRenderWindow", "vtkOSOpenGLRenderWindow")):
+    sys.exit("no X display, and this ParaView renders through X: run\n"
+             "    xvfb-run -a pvpython --force-offscreen-rendering " + " ".join(sys.argv))
 
 view = CreateView("RenderView")
 view.ViewSize = [PANEL, PANEL]
@@ -245,11 +252,9 @@ def singh(source, array, tag, spacing):
         sweep.Scalars = ["POINTS", array]
         skin = Contour(Input=source, ContourBy=["POINTS", array], Isosurfaces=[SKIN_HU], ComputeNormals=1,
                        ComputeScalars=0)
-        # The normals point outwards (towards lower values): sample the field 1.5 voxels out
-        # away from the inside voxels, which are dark by definition; then move back.
-        out = WarpByVector(Input=skin, Vectors=["POINTS", "Normals"], ScaleFactor=1.5 * spacing)
-        probe = ResampleWithDataset(SourceDataArrays=sweep, DestinationMesh=out)
-        shade = AppendAttributes(Input=[skin, probe])  # the skin's points, the probed AO
+        # The field 1.5 voxels outside the skin, away from the inside voxels (dark by
+        # definition), on the skin's points.
+        shade = ProbeOutsideSurface(Input=skin, Volume=sweep, Distance=1.5)
         hide_all()
         display = Show(shade, view)
         ColorBy(display, ("POINTS", "AmbientOcclusion"))
