@@ -24,6 +24,14 @@ shaded = IsosurfaceAmbientOcclusion(Input=bone, Volume=volume, ComputeShadows=1,
 shaded.Scalars = ["POINTS", "MetaImage"]
 SaveData(target, proxy=shaded, **XML_OPTIONS)
 
+# Probe Outside Surface: a Volumetric AO field (bit for bit the serial one on any piece)
+# sampled 1.5 voxels outside the bone, from its own reader (<OUT>_probe.pvtp).
+field = VolumetricAmbientOcclusion(Input=XMLImageDataReader(FileName=[source_path]), Method="Gaussian CDF", Radius=3)
+field.Scalars = ["POINTS", "MetaImage"]
+normals_bone = Contour(Input=pieces, ContourBy=["POINTS", "MetaImage"], Isosurfaces=[400.0], ComputeNormals=1)
+probed = ProbeOutsideSurface(Input=normals_bone, Volume=field, Orientation="Normals")
+SaveData(target[:-len(".pvtp")] + "_probe.pvtp", proxy=probed, **XML_OPTIONS)
+
 # The pyramid (Variance Occlusion Map), distributed: each rank computes the level voxels
 # of its piece from its piece grown by the pyramid's reach. A pass-through writes, per
 # rank, every level's extent and arrays (<OUT>.pyramid.<rank>.npz) and the extent the
