@@ -4,7 +4,7 @@
  *
  * The project's own default volume, for demos and for tests that must run anywhere:
  * air (-1000 HU) around a head of soft tissue (skin, brain ~ 20-45 HU) inside a skull of
- * bone (700-1300 HU) with eye sockets, a nasal cavity of air, ventricles of CSF (~5 HU),
+ * bone (750-1300 HU) with eye sockets, a nasal cavity of air, ventricles of CSF (~5 HU),
  * teeth (~1500 HU), a neck and a headrest plate under it. Deterministic noise of
  * NoiseAmplitude HU, correlated over 4 voxels like acquired CT noise (a hash of the
  * voxel index and Seed, smoothly interpolated), makes the tissue look acquired; air stays
@@ -34,7 +34,8 @@ public:
   ///@}
 
   ///@{
-  /// Amplitude of the uniform noise in HU (default 20; 0 for a noiseless phantom).
+  /// Amplitude of the smooth noise (correlated over about 4 voxels) added to tissue and
+  /// bone, in HU (default 20; 0 for a noiseless phantom).
   vtkSetMacro(NoiseAmplitude, double);
   vtkGetMacro(NoiseAmplitude, double);
   vtkSetMacro(Seed, int);

@@ -2,9 +2,9 @@
 // output, computed in parallel (vao/ValueRanges.h) and stored where vtkDataArray caches
 // them (COMPONENT_RANGE in PER_COMPONENT and PER_FINITE_COMPONENT, L2_NORM_RANGE and
 // L2_NORM_FINITE_RANGE), so that GetRange and GetFiniteRange, which ParaView calls for
-// every array after every update, answer at once instead of scanning on one thread
-// (2 s for an 8-component array of 250^3 tuples). vtkAbstractArray::Modified() drops the
-// cache, so an array changed later gets VTK's own ranges again.
+// every array after every update, answer at once instead of scanning on one thread.
+// vtkAbstractArray::Modified() drops the cache, so an array changed later gets VTK's own
+// ranges again.
 #ifndef vtkAmbientOcclusionRanges_h
 #define vtkAmbientOcclusionRanges_h
 

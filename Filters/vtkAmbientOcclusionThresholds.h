@@ -1,5 +1,5 @@
 // Private helper of vtkVolumetricAmbientOcclusion: Histogram CDF's thresholds from the
-// value distribution of the whole data set (../shared/METHODS.md 8), never of one piece.
+// value distribution of the whole data set (docs/methods.md section 8), never of one piece.
 // Not part of the module's public interface.
 #ifndef vtkAmbientOcclusionThresholds_h
 #define vtkAmbientOcclusionThresholds_h

@@ -22,8 +22,8 @@
  * On one process the pyramid's two finest levels (nearly all of its bytes) are kept only
  * where the surface samples them: each update builds the tiles of 8^3 voxels that its
  * points, their AO offsets and their shadow rays reach and keeps them for the next (a new
- * light reaches few more). The values are those of the whole pyramid; the CT head's bone
- * surface with shadows needs 70% of the volume's size instead of 476%. The volume's array
+ * light reaches few more). The values are those of the whole pyramid, in a fraction of
+ * its memory (build/bin/vao_memory; docs/performance.md). The volume's array
  * is read again when tiles are built. Under MPI each process keeps the whole levels of
  * its piece.
  */

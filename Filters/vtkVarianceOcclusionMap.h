@@ -36,8 +36,8 @@ public:
   ///@}
 
   ///@{
-  /// Start the pyramid at half resolution (default off): a quarter of the memory of
-  /// level 0 for large volumes.
+  /// Start the pyramid at half resolution (default off): level 0 has an eighth of the
+  /// voxels, for large volumes.
   vtkSetMacro(StartAtHalfResolution, vtkTypeBool);
   vtkGetMacro(StartAtHalfResolution, vtkTypeBool);
   vtkBooleanMacro(StartAtHalfResolution, vtkTypeBool);

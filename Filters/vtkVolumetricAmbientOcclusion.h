@@ -10,7 +10,7 @@
  * turning even the exact AO into salt and pepper. The estimators:
  *  - Histogram CDF (default): the box's cumulative distribution at NumberOfBins thresholds
  *    taken from the whole data set's values, interpolated at q; O(1) per voxel and bin
- *    whatever the radius, within 0.015-0.025 RMS of Exact Box on the CT scans at 64 bins,
+ *    whatever the radius, within 0.001-0.014 RMS of Exact Box on the CT scans at 64 bins,
  *    and exact for data with at most NumberOfBins distinct values (uint8 with 256);
  *  - CDF Reconstruction, Gaussian CDF, Chebyshev: the papers' estimators from separable
  *    box statistics (mean, variance, minimum, maximum), O(1) per voxel;
