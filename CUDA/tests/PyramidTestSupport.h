@@ -1,5 +1,5 @@
 // Helpers of the variance occlusion map tests: a brute-force pyramid written from
-// METHODS.md (not from the kernel's code), test fields, and surface points.
+// docs/methods.md (not from the kernel's code), test fields, and surface points.
 #pragma once
 
 #include "TestVolumes.h"

@@ -1,4 +1,4 @@
-// The estimators of METHODS.md written out again for the tests, from the text, not from
+// The estimators of docs/methods.md written out again for the tests, from the text, not from
 // Estimators.h: a reference that called the library's own formulas would share its bugs.
 #pragma once
 
@@ -17,9 +17,9 @@ struct Statistics
   double roundingVariance = 0.0; // what rounded sums can give a flat box (0: exact sums)
 };
 
-/// METHODS.md: flat when s2 <= eps max(1, mu^2) or vmax == vmin; then O = (q >= mu). Here
-/// eps = 0 beyond the sums' rounding (README: a threshold relative to mu^2 or 1 would make
-/// data stored with a large offset or in small units flat everywhere).
+/// docs/methods.md (Notation, flat boxes): flat when s2 is at most the sums' rounding
+/// variance, or vmax == vmin; then O = (q >= mu). No threshold relative to mu^2 or 1: that
+/// would make data stored with a large offset or in small units flat everywhere.
 inline bool flat(const Statistics& s)
 {
   return s.maximum == s.minimum || s.variance <= s.roundingVariance;
@@ -74,7 +74,7 @@ inline double chebyshev(double q, const Statistics& s)
   return 1.0 - s.variance / (s.variance + (q - s.mean) * (q - s.mean));
 }
 
-/// METHODS.md 8, Histogram CDF: with F(t) = P(v <= t) over the box, O = 0 when q is below
+/// docs/methods.md section 8, Histogram CDF: with F(t) = P(v <= t) over the box, O = 0 when q is below
 /// the lowest threshold, 1 at or above the highest, F(t_k) at q = t_k, and between the two
 /// enclosing thresholds the straight line through (t_k, F(t_k)) and (t_k+1, F(t_k+1)).
 template <class Fraction>

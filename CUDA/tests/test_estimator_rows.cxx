@@ -1,6 +1,6 @@
 // The estimators over rows of neighbourhoods (EstimatorRows.h, four voxels at a time on
 // AVX2 and eight on AVX-512, with glibc's vector erf, exp and log and AVX-512's piecewise erf;
-// each tier the processor has) against the formulas of METHODS.md written out again
+// each tier the processor has) against the formulas of docs/methods.md written out again
 // (ReferenceFormulas.h): rows of every length around the vector width, queries per voxel
 // and one iso value, flat boxes among noisy ones, small and large magnitudes.
 #include "../src/cpu/CpuDispatch.h"

@@ -35,7 +35,7 @@ TEST(Estimators, WinitzkiIsCloseToErfAndOdd)
     ASSERT_DOUBLE_EQ(vao::erfWinitzki(-x), -vao::erfWinitzki(x));
   }
   EXPECT_LT(worst, 3.3e-4); // the documented bound of a = 8(pi - 3) / (3 pi (4 - pi))
-  EXPECT_GT(worst, 3.2e-4) << "a different constant than METHODS.md's";
+  EXPECT_GT(worst, 3.2e-4) << "a different constant than docs/methods.md's";
   EXPECT_GT(worst, 1e-6); // it is an approximation, not erf itself
 }
 

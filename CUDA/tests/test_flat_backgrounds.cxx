@@ -4,7 +4,7 @@
 // double sums grows with the largest |v - shift| of the data, so a box of zeros next to
 // values of 1e12 shows a spurious variance; the estimators must see through it.
 //
-// The reference is written here from METHODS.md: the openness of a box is the fraction of
+// The reference is written here from docs/methods.md: the openness of a box is the fraction of
 // its (clipped) voxels with v <= q; for a box of one value b and q = b that is 1.
 #include "TestVolumes.h"
 #include "vao/AmbientOcclusion.h"

@@ -1,4 +1,4 @@
-// Histogram CDF (METHODS.md 8): the thresholds' properties, and the openness against a
+// Histogram CDF (docs/methods.md section 8): the thresholds' properties, and the openness against a
 // brute force of the definition (ReferenceFormulas.h) on random volumes of every kind.
 #include "ReferenceFormulas.h"
 #include "TestVolumes.h"

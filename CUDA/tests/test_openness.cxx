@@ -1,6 +1,6 @@
 // computeAmbientOcclusion end to end on random volumes: the exact references against an
-// independent brute force, the separable estimators against METHODS.md's formulas written
-// again in ReferenceFormulas.h, applied to brute-force statistics, the properties of METHODS.md, and decomposition invariance.
+// independent brute force, the separable estimators against docs/methods.md's formulas written
+// again in ReferenceFormulas.h, applied to brute-force statistics, the properties of docs/methods.md, and decomposition invariance.
 #include "ReferenceFormulas.h"
 #include "TestVolumes.h"
 

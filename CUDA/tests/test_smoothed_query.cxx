@@ -1,4 +1,4 @@
-// The smoothed query (METHODS.md 9) against a brute force of its definition: a 3-D sum of
+// The smoothed query (docs/methods.md section 9) against a brute force of its definition: a 3-D sum of
 // Gaussian weights over the clipped window, renormalised, fed to every method.
 #include "ReferenceFormulas.h"
 #include "TestVolumes.h"

@@ -1,5 +1,5 @@
-// Surface ambient occlusion and soft shadows against a reference written from the Penner
-// & Mitchell section of METHODS.md (and the query's documented rules in
+// Surface ambient occlusion and soft shadows against a reference written from docs/methods.md,
+// Penner and Mitchell (and the query's documented rules in
 // vao/VarianceOcclusionMap.h): its own trilinear weights, estimators and march, on a noisy
 // volume (no flat neighbourhood, so the flat rule never decides), anisotropic spacing, an
 // origin off zero, unnormalised normals, and point counts around the lane width of the

@@ -65,7 +65,7 @@ inline const MethodInfo& MethodWithId(int id, int query = vtkVolumetricAmbientOc
     Methods.begin(), Methods.end(), [id, query](const MethodInfo& m) { return m.id == id && m.query == query; });
 }
 
-/// The oracle a row is compared with (METHODS.md): Exact Box with the same query.
+/// The oracle a row is compared with (docs/methods.md): Exact Box with the same query.
 inline const MethodInfo& ReferenceOf(const MethodInfo& method)
 {
   return MethodWithId(vtkVolumetricAmbientOcclusion::EXACT_BOX, method.query);

@@ -1,4 +1,4 @@
-// Every method against Exact Box on the real scans: the README's accuracy table (printed
+// Every method against Exact Box on the real scans: docs/accuracy.md's table (printed
 // as its rows) and the bars of Histogram CDF at its default bins.
 //
 // "Visible" voxels are those an opacity ramp starting at 10% of the data range would

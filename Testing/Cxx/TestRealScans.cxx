@@ -1,4 +1,5 @@
-// The filter on real scans: the RMSE figures of METHODS.md and a regression image.
+// The filter on real scans: the reference errors of docs/methods.md (Ruiz et al.) and a
+// regression image.
 #include "TestHelpers.h"
 
 #include "vtkAmbientOcclusionPhantom.h"
@@ -52,7 +53,8 @@ ErrorStats Compare(const std::vector<double>& estimate, const std::vector<double
   return { std::sqrt(sq / exact.size()), sum / exact.size() };
 }
 
-/// METHODS.md: RMSE against Exact Box on the 128x128x136 CT head phantom, to +-0.005.
+/// docs/methods.md (Ruiz et al., reference errors): RMSE against Exact Box on the
+/// 128x128x136 CT head phantom, to +-0.005.
 void ExpectPublishedRmse(double radius, double gaussian, double cdf, double chebyshev)
 {
   auto ct = ReadMetaImage(DataFile("ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));

@@ -61,7 +61,7 @@ double ReferenceOpenness(vtkImageData* image, int method, const int r[3], int i,
     for (int y = std::max(e[2], j - r[1]); y <= std::min(e[3], j + r[1]); ++y)
       for (int x = std::max(e[0], i - r[0]); x <= std::min(e[1], i + r[0]); ++x)
         m2 += (value(x, y, z) - mean) * (value(x, y, z) - mean);
-  // METHODS.md's formulas as the tests write them (CUDA/tests/ReferenceFormulas.h).
+  // docs/methods.md's formulas as the tests write them (CUDA/tests/ReferenceFormulas.h).
   const vaotest::reference::Statistics s{ double(mean), double(m2 / n), double(lo), double(hi) };
   const double q = value(i, j, k);
   switch (method)

@@ -1,11 +1,11 @@
-"""vtkVolumetricAmbientOcclusion against METHODS.md computed exactly, on random small volumes.
+"""vtkVolumetricAmbientOcclusion against docs/methods.md computed exactly, on random small volumes.
 
 Each case draws a dtype, a shape, values (small integers, a type's whole range, a CT-like
 offset, flat regions with spikes, the type's two extremes, tiny or huge floats), a method,
 a radius in voxels or in world units over anisotropic spacing, a query (the voxel's value
 or an iso value), a bin count and an extent that does not start at 0. The reference sums
 the box in Python integers or Fractions (so its statistics are exact, never the library's
-helpers) and applies the definitions of METHODS.md; the filter's float32 must agree to
+helpers) and applies the definitions of docs/methods.md; the filter's float32 must agree to
 a few float ulps. A second part checks that an offset or a change of unit leaves every
 moment method's openness as it was (the estimators depend on (q - mu) / sigma alone).
 
@@ -58,11 +58,11 @@ def exact(x):
 
 
 def reference(v, radii, method, iso, bins):
-    """METHODS.md 1-5 and 8 with exact statistics; NaN where a case is not decided here."""
+    """docs/methods.md section 1-5 and section 8 with exact statistics; NaN where a case is not decided here."""
     nz, ny, nx = v.shape
     flat_values = v.reshape(-1)
     values = [exact(x) for x in flat_values]
-    # 64-bit integers compare as doubles (METHODS.md counts double(v) <= q, as VTK does).
+    # 64-bit integers compare as doubles (docs/methods.md counts double(v) <= q, as VTK does).
     compared = [float(x) for x in flat_values] if v.dtype.itemsize == 8 and v.dtype.kind in "iu" else values
     distinct = sorted(set(values))
     rx, ry, rz = radii

@@ -17,7 +17,8 @@ smooth random fields at spacings and origins that binary fractions do not hold, 
 3.7 or 1e4), and with one pyramid level against flips of the volume and the light (points
 matched to the nearest, 1e-5). Volumetric AO with a world radius whose ratio to the
 spacing is a half-integer gives the same voxels, and floats, in other units. Coarser levels sit on every 2^l-th voxel from the first,
-so with more levels a flip moves their grids and the answer (README, precision).
+so with more levels a flip moves their grids and the answer (docs/methods.md, Penner and
+Mitchell).
 
 usage: python3 test_metamorphic.py PACKAGE_DIR [SEED] [CASES]
 """

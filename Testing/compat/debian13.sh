@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # The project against Debian 13 (trixie): ParaView 5.13, VTK 9.3/9.4. Builds a Debian 13
 # root with debootstrap from Debian's own mirror (once; reused afterwards), copies this
-# checkout and ../shared into it, and runs the two set-up commands of the README there:
+# checkout into it (with the extra scans of ../shared/data when that folder exists), and runs the two set-up commands of the README there:
 # `bash .ci/setup.sh test` (which installs the packages, builds and runs every test).
-# Needs root. Takes about half an hour the first time (downloads), minutes afterwards.
+# Needs root. The first run downloads the Debian 13 root and its packages; later runs
+# reuse them.
 #
 #   bash Testing/compat/debian13.sh [ROOT_DIR]      (default /var/tmp/vao-debian13)
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/../.." && pwd)"
-shared="$(cd "$repo/../shared" && pwd)"
+shared=""
+[ -d "$repo/../shared/data" ] && shared="$(cd "$repo/../shared" && pwd)"
 root="${1:-/var/tmp/vao-debian13}"
 mirror="http://deb.debian.org/debian"
 
@@ -37,10 +39,13 @@ for fs in proc sys dev dev/pts; do
 done
 cp /etc/resolv.conf "$root/etc/resolv.conf"
 
-echo "== copying the checkout and ../shared (build trees left out)"
-mkdir -p "$root/work/main" "$root/work/shared"
+echo "== copying the checkout${shared:+ and $shared} (build trees left out)"
+mkdir -p "$root/work/main"
 tar -C "$repo" --exclude='./build*' --exclude='./vao-output' -cf - . | tar -C "$root/work/main" -xf -
-tar -C "$shared" -cf - . | tar -C "$root/work/shared" -xf -
+if [ -n "$shared" ]; then
+  mkdir -p "$root/work/shared"
+  tar -C "$shared" -cf - . | tar -C "$root/work/shared" -xf -
+fi
 
 echo "== inside Debian 13: bash .ci/setup.sh test"
 # Debian 13's ParaView CMake files (VTKPython-targets.cmake, ParaViewPython-targets.cmake)

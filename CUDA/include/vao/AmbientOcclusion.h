@@ -75,7 +75,7 @@ enum class QueryMode : int
 {
   VoxelValue = 0,
   IsoValue = 1,
-  SmoothedValue = 2, // METHODS.md 9: a normalised Gaussian average of v around the voxel
+  SmoothedValue = 2, // docs/methods.md section 9: a normalised Gaussian average of v around the voxel
 };
 
 /// The accepted QuerySmoothing (sigma in voxels): the window of ceil(3 sigma) voxels each

@@ -20,7 +20,7 @@
 // recursions as the serial sweeps of the whole volume, so the results agree with a
 // converged serial run (iterations large, tolerance > 0) to about the tolerance. V crosses
 // one block per round, so the rounds are about the blocks along the longest upwind chain
-// plus one or two. Definitions: the Singh et al. section of METHODS.md.
+// plus one or two. Definitions: docs/methods.md, Singh et al.
 #pragma once
 
 #include "vao/OcclusionSweeping.h"

@@ -1,4 +1,4 @@
-// The openness estimators of ../shared/METHODS.md, written once for host and device.
+// The openness estimators of docs/methods.md, written once for host and device.
 //
 // Every function here is a pure formula on the statistics of one neighbourhood, so the
 // CPU path and the CUDA kernels (src/cuda/Pipeline.h) include this header and call the same code.
@@ -71,7 +71,7 @@ VAO_HD double sumRoundingVariance(double deviation)
   return kSumRoundingUlps * kDoubleUlp * deviation * deviation;
 }
 
-/// The flat-neighbourhood rule (METHODS.md: s2 <= eps max(1, mu^2)) with eps = 0 beyond
+/// The flat-neighbourhood rule (docs/methods.md, flat boxes), with no allowance beyond
 /// rounding: a box is flat where its variance is at most what the rounding of its sums can
 /// give a flat box (roundingVariance: 0 for exact sums, sumRoundingVariance for double
 /// sums, which scales with the data's spread about the shift). A threshold relative to mu^2
@@ -193,8 +193,8 @@ VAO_HD double opennessChebyshevWithin(double query, double mean, double variance
   return isFlatVariance(variance, roundingVariance) ? flatOpennessWithin(query, mean, roundingSpread) : bound;
 }
 
-/// Cantelli's one-tailed bound on the occluder fraction P(v >= q), as METHODS.md fixes it:
-/// p_max = 1 if q <= mu, else s2 / (s2 + (q - mu)^2); O = 1 - p_max <= P(v <= q).
+/// Cantelli's one-tailed bound on the occluder fraction P(v >= q), as docs/methods.md section 5
+/// fixes it: p_max = 1 if q <= mu, else s2 / (s2 + (q - mu)^2); O = 1 - p_max <= P(v <= q).
 VAO_HD double opennessChebyshev(double query, const NeighbourhoodStats& s)
 {
   return opennessChebyshevWithin(
@@ -217,7 +217,7 @@ VAO_HD int thresholdIndex(double q, const double* thresholds, int n)
   return lo;
 }
 
-/// Histogram CDF (METHODS.md 8): O = F at q, where F_k = P(v <= t_k) over the box is known
+/// Histogram CDF (docs/methods.md section 8): O = F at q, where F_k = P(v <= t_k) over the box is known
 /// at the n ascending thresholds; linear between the two that enclose q, F_k itself at
 /// q = t_k, 0 below t_0 and 1 at or above t_(n-1). The thresholds start at the data set's
 /// lowest value and end at its highest, so both ends are exact. The box holds `count`

@@ -1,4 +1,4 @@
-// Histogram CDF (../shared/METHODS.md 8): the thresholds, fixed from the value
+// Histogram CDF (docs/methods.md section 8): the thresholds, fixed from the value
 // distribution of the whole data set.
 //
 // A ValueHistogram summarises the values of any part of a data set on a grid of cells
@@ -17,9 +17,10 @@
 // cell's largest value. The weight sits between equal counts (quantiles, which spend most
 // thresholds on the bulk of the data: air and soft tissue in CT) and equal numbers of
 // distinct values (which spend them on sparse outliers); on the CT head phantom at R = 5
-// and 64 thresholds it gives RMSE 0.014 against Exact Box where quantiles give 0.022, and
-// 0.015 where they give 0.032 on the visible voxels. A tie (air clamped at -1024 or 0) is
-// one cell, so it costs one threshold however many voxels share it.
+// and 64 thresholds it gives RMSE 0.014 against Exact Box where quantiles give 0.023, and
+// 0.015 where they give 0.033 on the visible voxels (Testing/Python/histogram_cdf_bins.py
+// prints both). A tie (air clamped at -1024 or 0) is one cell, so it costs one threshold
+// however many voxels share it.
 #pragma once
 
 #include "vao/AmbientOcclusion.h"

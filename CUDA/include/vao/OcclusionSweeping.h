@@ -1,6 +1,6 @@
 // Occlusion sweeping (Singh, Yuksel & House 2009), host code: the signed distance field
 // of an isosurface by fast sweeping, with the visibility of the eight octants of the sky
-// propagated in the same sweeps. Definitions: the Singh et al. section of METHODS.md.
+// propagated in the same sweeps. Definitions: docs/methods.md, Singh et al.
 #pragma once
 
 #include "vao/AmbientOcclusion.h"

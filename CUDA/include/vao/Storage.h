@@ -1,9 +1,8 @@
 // Storage of the large arrays (pyramid levels, sweep fields, box extrema, the filters'
 // outputs): blocks of 2 MiB and more are aligned to 2 MiB and, on Linux, advised to use
 // transparent huge pages, as NumPy does for its large arrays. The first touch of 4 KiB
-// pages costs a page fault each, which on some virtual machines is slower than the
-// filter's own work: there, writing a fresh 109 MB block took 380 ms in 4 KiB pages and
-// 15-190 ms in huge pages.
+// pages costs a page fault each, which on some virtual machines costs more than the
+// filter's own work; a huge page takes one fault for 2 MiB instead of 512.
 #pragma once
 
 #include <cstddef>

@@ -1,7 +1,7 @@
 // Variance occlusion maps (Penner & Mitchell 2008), host code: a pyramid of Gaussian-
 // blurred moments of the volume, sampled at points offset from an isosurface to estimate
-// its ambient occlusion and soft shadows. Definitions: the Penner & Mitchell section of
-// METHODS.md. The pyramid is built once; moving the iso value, the surface or the light
+// its ambient occlusion and soft shadows. Definitions: docs/methods.md, Penner and
+// Mitchell. The pyramid is built once; moving the iso value, the surface or the light
 // only samples it again.
 #pragma once
 

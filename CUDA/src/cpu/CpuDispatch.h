@@ -51,8 +51,8 @@ SimdTier cpuSimdTier();
 /// SimdTier::Avx512 lifts the cap.
 void limitSimdTier(SimdTier limit);
 
-/// cpuSimdTier(), at most `ceiling`: loops that measured no faster (or slower) in AVX-512
-/// stay on AVX2.
+/// cpuSimdTier(), at most `ceiling`: loops that gain nothing from AVX-512 (or lose) stay
+/// on AVX2.
 inline SimdTier cpuSimdTierUpTo(SimdTier ceiling)
 {
   const SimdTier tier = cpuSimdTier();

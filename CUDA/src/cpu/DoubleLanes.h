@@ -174,10 +174,9 @@ VAO_LANES D ofPiece(const double* table, I piece)
   return _mm512_permutex2var_pd(_mm512_load_pd(table), piece, _mm512_load_pd(table + 8));
 }
 /// erf from ErfPieces.h's 16 polynomials on [0, 6): within 2^-52 of erf (+-1 in doubles
-/// past 6), odd, and within 2^-50 relative below 3/8 (erf(0) = 0); half the time of
-/// glibc's vector erf in a loop of independent calls (6.2 against 12.2 ns on a Zen 5),
-/// and a shorter chain of dependent operations. (1 + erf) / 2, the openness, shows an
-/// absolute error alone.
+/// past 6), odd, and within 2^-50 relative below 3/8 (erf(0) = 0); cheaper than glibc's
+/// vector erf, with a shorter chain of dependent operations. (1 + erf) / 2, the openness,
+/// shows an absolute error alone.
 VAO_LANES D erf(D x)
 {
   const D a = min(abs(x), set1(kErfTop)); // kErfTop for NaN, which is put back below

@@ -54,7 +54,7 @@ std::int64_t rowHalfWidth(const Radius& r, std::int64_t dy, std::int64_t dz, boo
   return dx;
 }
 
-/// A voxel counts when double(v) <= q (METHODS.md). Every value of a type of up to 32 bits
+/// A voxel counts when double(v) <= q (docs/methods.md, Notation). Every value of a type of up to 32 bits
 /// is a double, so that test holds exactly when v <= t, t the largest value of the type at
 /// most q, and it runs in the type itself: 8 to 32 lanes a vector. 64-bit integers round
 /// on the way to double, so they compare as doubles.

@@ -50,10 +50,10 @@ std::int64_t tileStateBytes(std::int64_t tile, const Radius& r, int lanes, int l
   return (span * span + span * tile) * lanes * laneBytes;
 }
 
-/// The tile's side: 64 (the fastest measured on 256^2 slices at R = 5 and 10; larger tiles
-/// leave the L2 cache, smaller ones recount more of their border), smaller when the
-/// workers' states would exceed an eighth of the input (the rest of the 25% the filter
-/// may add goes to buffers that do not shrink with the tile), down to 16.
+/// The tile's side: 64 (larger tiles leave the L2 cache, smaller ones recount more of
+/// their border), smaller when the workers' states would exceed an eighth of the input
+/// (the rest of the 25% the filter may add goes to buffers that do not shrink with the
+/// tile), down to 16.
 std::int64_t tileSize(std::int64_t inputBytes, const Radius& r, int lanes, int laneBytes, int threads)
 {
   std::int64_t tile = 64;
@@ -386,7 +386,7 @@ bool computeHistogramOpenness(const VolumeView& view, const Region& region, cons
     const TypedVolume<T> volume(view);
     const std::int64_t inputBytes = view.voxelCount() * static_cast<std::int64_t>(sizeof(T));
     const HistogramJob job{ tileSize(inputBytes, radius, lanes, laneBytes, resolveThreadCount(execution.threads)),
-      region, radius, thresholds, query, openness, cpuSimdTierUpTo(SimdTier::Avx2) }; // AVX-512: about 30% slower
+      region, radius, thresholds, query, openness, cpuSimdTierUpTo(SimdTier::Avx2) }; // AVX-512 loses here
     return laneBytes == 2 ? computeTiles<T, std::uint16_t>(volume, job, execution)
                           : computeTiles<T, std::uint32_t>(volume, job, execution);
   });

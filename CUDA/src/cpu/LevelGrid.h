@@ -18,9 +18,8 @@ namespace vao
 namespace detail
 {
 
-/// Points a surface query samples together. (16 rather than 8: the march's independent
-/// vectors overlap their loads; the CT head's bone surface shadows ran 12% faster in
-/// AVX-512 and in AVX2.)
+/// Points a surface query samples together. (16 rather than 8: the march then has
+/// independent vectors whose loads overlap, in AVX-512 and in AVX2.)
 constexpr int kLanes = 16;
 
 /// The numbers of one level that its samples read.

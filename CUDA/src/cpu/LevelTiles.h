@@ -15,7 +15,7 @@
 // offsets (LevelGrid's tileOffsets); a released tile's slot goes to the next tile built.
 // The pool is a reservation whose pages the system backs when first written
 // (allocateSparseStorage): its memory is the most tiles held at once, and reusing slots
-// costs no page fault (17 us each on some virtual machines, more than a tile's blur).
+// costs no page fault (on some virtual machines a fault costs more than a tile's blur).
 #pragma once
 
 #include "vao/VarianceOcclusionMap.h"
@@ -55,7 +55,7 @@ public:
   std::int32_t take();
   void give(std::int32_t offset) { this->Free.push_back(offset); }
   /// Backs the slots handed out since the last call, in one call, not a fault a page (on
-  /// some virtual machines a fault costs 17 us, more than blurring a tile). Throws
+  /// some virtual machines a fault costs more than blurring a tile). Throws
   /// std::bad_alloc when the system has no memory for them.
   void prepare();
   /// The memory of the slots ever handed out: the most tiles held at once.

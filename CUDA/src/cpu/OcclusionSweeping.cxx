@@ -1,4 +1,4 @@
-// Occlusion sweeping (Singh, Yuksel & House 2009; the Singh et al. section of METHODS.md):
+// Occlusion sweeping (Singh, Yuksel & House 2009; docs/methods.md, Singh et al.):
 // fast sweeping of the signed distance with the octant visibility of Eq. 6 carried along
 // in the same sweeps, then the per-voxel combination into AmbientOcclusion (Eq. 4/5).
 // This file is the whole-volume driver; the stages are in SweepingCore.h.

@@ -1,5 +1,5 @@
-// The one blur of the moment pyramid (Penner & Mitchell 2008; the Penner & Mitchell
-// section of METHODS.md): blurDecimate turns a "source" grid into the next level, a
+// The one blur of the moment pyramid (Penner & Mitchell 2008; docs/methods.md,
+// Penner and Mitchell): blurDecimate turns a "source" grid into the next level, a
 // separable normalised 5-tap Gaussian (sigma = 1 voxel, weights renormalised where the
 // kernel is clipped by the volume) evaluated only at the kept voxels (every voxel, or
 // every second one per axis). It streams: for each output slice, rows are first blurred

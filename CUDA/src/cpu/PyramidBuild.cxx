@@ -1,5 +1,5 @@
-// The moment pyramid of variance occlusion maps (Penner & Mitchell 2008; the Penner &
-// Mitchell section of METHODS.md).
+// The moment pyramid of variance occlusion maps (Penner & Mitchell 2008;
+// docs/methods.md, Penner and Mitchell).
 //
 // The blur itself, its precision and its windows: PyramidBlur.h.
 #include "vao/VarianceOcclusionMap.h"

@@ -1,6 +1,6 @@
 // The inner loops of the moment pyramid's blur (PyramidBuild.cxx), written once as plain
 // templates and compiled twice: for the baseline instruction set and, on x86 with GCC or
-// Clang, for AVX2 + FMA, chosen at run time (about 30% faster on the build machine).
+// Clang, for AVX2 + FMA, chosen at run time (the blur is multiply-adds, which FMA fuses).
 //
 // How: each loop is the always-inlined static run() of a small struct, which runRows
 // (CpuDispatch.h) compiles for both targets.

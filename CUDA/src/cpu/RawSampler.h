@@ -1,6 +1,6 @@
 // Trilinear values of the raw volume at world positions, clamped to its bounds: the
-// definition of the half-voxel-inside query of surface ambient occlusion (the Penner &
-// Mitchell section of METHODS.md) and of sampleVolume. SurfaceLanes.h samples kLanes
+// definition of the half-voxel-inside query of surface ambient occlusion (docs/methods.md,
+// Penner and Mitchell) and of sampleVolume. SurfaceLanes.h samples kLanes
 // positions at once in vector registers with the same formula and the same bits.
 #pragma once
 

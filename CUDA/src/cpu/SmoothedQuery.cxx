@@ -1,4 +1,4 @@
-// The smoothed query (METHODS.md 9): a normalised, truncated Gaussian average of v.
+// The smoothed query (docs/methods.md section 9): a normalised, truncated Gaussian average of v.
 //
 // The window of half-width ceil(3 sigma) clipped to the volume is a product of clipped
 // intervals and the weight a product of 1-D Gaussians, so the normalised 3-D average is

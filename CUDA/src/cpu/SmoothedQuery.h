@@ -8,7 +8,7 @@ namespace vao
 namespace detail
 {
 
-/// q(x) of METHODS.md 9 for the region's voxels (x fastest) with sigma in voxels, the
+/// q(x) of docs/methods.md section 9 for the region's voxels (x fastest) with sigma in voxels, the
 /// window clipped to the volume. Returns false when cancelled.
 bool computeSmoothedQuery(
   const VolumeView& volume, const Region& region, double sigma, double* query, const Execution& execution);

@@ -145,8 +145,7 @@ VAO_LANES_ENTRY void prefetchLanes(const LevelGrid& g, const double* x, const do
 
 /// The raw values base[at[k]] as doubles, whatever the volume's type: one load a lane.
 /// Floats gather as the levels' do; types of up to 16 bits go through one vector of 32-bit
-/// integers and one conversion (a conversion a lane made the CT head's bone surface AO
-/// about 2% slower).
+/// integers and one conversion (rather than a conversion a lane).
 template <class T>
 VAO_LANES D gatherAsDoubles(const T* base, Idx at)
 {

@@ -1,5 +1,5 @@
 // Surface ambient occlusion and soft shadows sampled from the moment pyramid (Penner &
-// Mitchell 2008; the Penner & Mitchell section of METHODS.md).
+// Mitchell 2008; docs/methods.md, Penner and Mitchell).
 #include "vao/VarianceOcclusionMap.h"
 #include "vao/Validation.h"
 
@@ -51,8 +51,8 @@ struct PreparedPyramid
 
   /// Cell bounds for the vector march on the whole levels of at most one voxel a point
   /// (building them reads the level once): the coarsest, where most of a march's steps
-  /// fall. (Those of the next level, with 8 voxels a point, made the bone surface of the
-  /// CT head no faster and cost 7 MB.)
+  /// fall. (The next level, with 8 voxels a point, holds few of a march's steps: its bounds
+  /// would cost memory for little.)
   void boundCells(std::int64_t count)
   {
     this->bounds.reserve(this->grids.size());
@@ -64,8 +64,8 @@ struct PreparedPyramid
   }
 
   /// The ray bounds of the last level, where it has cell bounds, for the march's steps
-  /// along the unit `light`: they let a lane stop once nothing ahead can raise it (the
-  /// CT head's bone surface shadows: 13.8 -> 15.4 M points/s, 0.8 ms to build).
+  /// along the unit `light`: they let a lane stop once nothing ahead can raise it, which
+  /// saves more steps than building them costs.
   void boundRays(const std::array<double, 3>& light)
   {
     const int last = static_cast<int>(this->grids.size()) - 1;
@@ -115,8 +115,7 @@ void batchOcclusion(const PreparedPyramid& pyramid, int levels, PointLanes& lane
     lanes.along(parameters.offsetFactor * pyramid.kernelRadius[l], x[l % 2], y[l % 2], z[l % 2]);
   };
   // Levels 0 and 1 (96% of a pyramid's bytes) are far larger than the caches: the batch
-  // first asks for their lines, so their misses overlap (CT head bone surface AO on the
-  // whole pyramid: 40 -> 35 ms in alternated runs).
+  // first asks for their lines, so their misses overlap instead of following one another.
   for (int l = 0; l < std::min(levels, 2); ++l)
   {
     positions(l);

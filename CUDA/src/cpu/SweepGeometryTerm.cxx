@@ -15,8 +15,8 @@ namespace
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// atan2(y, x) for x, y >= 0, to ~1e-10 and a few times faster than std::atan2 (the
-/// geometry term needs six of them per voxel). The ratio is reduced to |t| <= tan(pi/8)
+/// atan2(y, x) for x, y >= 0, to ~1e-10 and cheaper than std::atan2 (the geometry term
+/// needs six of them per voxel). The ratio is reduced to |t| <= tan(pi/8)
 /// with atan(r) = pi/4 + atan((r - 1) / (r + 1)), where the odd series converges fast.
 double quadrantAngle(double y, double x)
 {

@@ -80,8 +80,8 @@ struct ChunkRanges
         this->finite = this->finite && std::isfinite(x);
       }
     }
-    // A second pass for the norms: fused into the one above it was slower (the sums'
-    // strided loads stop the extremes' loop from vectorising).
+    // A second pass for the norms: fused into the one above, the sums' strided loads would
+    // stop the extremes' loop from vectorising.
     for (t = 0; withNorm && t < tuples; ++t)
     {
       double sum = 0.0;

@@ -1,4 +1,4 @@
-// Exact Box and Exact Sphere on the device (the references of Ruiz et al., METHODS.md):
+// Exact Box and Exact Sphere on the device (the references of Ruiz et al., docs/methods.md section 1-2):
 // one thread per region voxel counts the values at or below its query over the rows of
 // its clipped box or ellipsoid, as ExactReference.cxx does on the CPU, with the same rows
 // (neighbourhoodRowHalfWidths) and the same division. Written once for the CUDA executor

@@ -1,5 +1,5 @@
-// The moment pyramid on the device (vao/VarianceOcclusionMap.h; the Penner & Mitchell
-// section of METHODS.md). Each level is PyramidBuild.cxx's blur as three passes of one
+// The moment pyramid on the device (vao/VarianceOcclusionMap.h; docs/methods.md,
+// Penner and Mitchell). Each level is PyramidBuild.cxx's blur as three passes of one
 // thread per output value: along z from the source (the raw volume or the previous level)
 // into two double arrays, along y, and along x into the level's float mean and variance.
 // Every sum is BlurTaps.h's, as the CPU's rows (PyramidRows.h) take them, with the same

@@ -4,7 +4,7 @@
 // - a call succeeds, or fails with a message (never a crash, a hang, or an exception);
 // - on success every openness and occlusion lies in [0, 1], and on every box that holds
 //   one value only, every method gives the exact answer (q >= that value), the brute-force
-//   count of METHODS.md computed here (not for Histogram CDF, which interpolates between
+//   count of docs/methods.md section 1 computed here (not for Histogram CDF, which interpolates between
 //   thresholds by definition, nor for the smoothed query, which is not the box's value);
 // - the box statistics are ordered: minimum <= mean <= maximum, variance >= 0.
 // Used by the seeded test that runs in CI (test_fuzz_seeded.cxx) and by the libFuzzer
@@ -191,7 +191,7 @@ inline void fuzzAmbientOcclusion(ByteReader& in, const FuzzVolume& v)
   if (p.queryMode == vao::QueryMode::SmoothedValue || p.method == vao::Method::HistogramCdf)
   {
     // No flat rule here: the smoothed query is not the box's value, and Histogram CDF
-    // interpolates between thresholds by definition (METHODS.md 8).
+    // interpolates between thresholds by definition (docs/methods.md section 8).
     for (std::size_t i = 0; i < n; ++i)
       check(open[i] >= 0.0f && open[i] <= 1.0f, "openness in [0, 1] at voxel " + std::to_string(i));
     return;
