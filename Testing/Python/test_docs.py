@@ -1,0 +1,193 @@
+"""Checks that the filter reference pages in docs/filters match the ParaView proxies.
+
+Usage: python3 Testing/Python/test_docs.py REPO_ROOT
+
+Standard library only. For every SourceProxy of Plugin/*.xml it finds the proxy's page
+(PAGES below) and checks that every property of the proxy is a row of the page's
+properties table (a table whose header starts with "| Property |"), written as
+`PropertyName` in backticks in the first cell, and that the table documents no property
+the proxy does not have (a renamed or removed one). It also checks that the images the
+pages show exist, and that no file of the repository refers to the reference text outside
+it (the string built in OUTSIDE_REFERENCE). It prints one line per failure and ends with
+"N passed, M failed"; the exit status is 1 when anything failed.
+"""
+import os
+import re
+import sys
+import xml.etree.ElementTree as ET
+
+# Proxy name (the SourceProxy's name attribute) -> its page, relative to the repository.
+PAGES = {
+    "VolumetricAmbientOcclusion": "docs/filters/volumetric-ambient-occlusion.md",
+    "OcclusionSweeping": "docs/filters/occlusion-sweeping.md",
+    "VarianceOcclusionMap": "docs/filters/variance-occlusion-map.md",
+    "IsosurfaceAmbientOcclusion": "docs/filters/isosurface-ambient-occlusion.md",
+    "AmbientOcclusionShading": "docs/filters/ambient-occlusion-shading.md",
+    "AmbientOcclusionHeadPhantom": "docs/filters/head-phantom.md",
+    "ProbeOutsideSurface": "docs/filters/probe-outside-surface.md",
+}
+
+# The repository must stand alone: no reference to the text beside the checkout. Built
+# from two parts so that this file does not match itself.
+OUTSIDE_REFERENCE = "shared/" + "METHODS.md"
+SEARCHED = ["README.md", "docs", "Filters", "CUDA", "Plugin", "Python", "Testing", "Examples",
+            "Benchmarks", "cmake", ".ci"]
+SKIPPED_DIRECTORIES = {".git", "__pycache__"}
+
+# Elements under a SourceProxy whose Property children are references, not properties.
+REFERENCE_CONTAINERS = {"PropertyGroup", "Hints", "RequiredProperties", "ExposedProperties"}
+
+TABLE_ROW = re.compile(r"^\s*\|(.*)\|\s*$")
+PROPERTY_CELL = re.compile(r"^`([A-Za-z_][A-Za-z0-9_]*)`$")
+IMAGE_LINK = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
+
+
+class Results:
+    def __init__(self):
+        self.passed = 0
+        self.failures = []
+
+    def check(self, ok, message):
+        if ok:
+            self.passed += 1
+        else:
+            self.failures.append(message)
+        return ok
+
+
+def proxy_properties(proxy):
+    """The names of the proxy's properties, in the XML's order (references excluded)."""
+    names = []
+
+    def walk(element):
+        for child in element:
+            tag = child.tag if isinstance(child.tag, str) else ""
+            if tag in REFERENCE_CONTAINERS:
+                continue
+            name = child.get("name")
+            if tag.endswith("Property") and tag != "Property" and name:
+                names.append(name)
+            walk(child)
+
+    walk(proxy)
+    return names
+
+
+def source_proxies(plugin_dir, results):
+    """(proxy name, xml file, property names) for every SourceProxy of Plugin/*.xml."""
+    proxies = []
+    files = sorted(f for f in os.listdir(plugin_dir) if f.endswith(".xml")) if os.path.isdir(plugin_dir) else []
+    results.check(bool(files), "no Plugin/*.xml found under %s" % plugin_dir)
+    for name in files:
+        path = os.path.join(plugin_dir, name)
+        try:
+            root = ET.parse(path).getroot()
+        except ET.ParseError as error:
+            results.check(False, "Plugin/%s does not parse: %s" % (name, error))
+            continue
+        for proxy in root.iter("SourceProxy"):
+            proxies.append((proxy.get("name"), name, proxy_properties(proxy)))
+    return proxies
+
+
+def documented_properties(text):
+    """{name: line number} of the first cells of the page's properties tables."""
+    rows = {}
+    in_table = False
+    header_next = False
+    for number, line in enumerate(text.splitlines(), start=1):
+        match = TABLE_ROW.match(line)
+        if not match:
+            in_table = header_next = False
+            continue
+        cells = [c.strip() for c in match.group(1).split("|")]
+        if header_next:  # the |---|---| line under the header
+            header_next = False
+            continue
+        if not in_table and cells and cells[0] == "Property":
+            in_table = header_next = True
+            continue
+        if in_table:
+            cell = PROPERTY_CELL.match(cells[0]) if cells else None
+            if cell:
+                rows.setdefault(cell.group(1), number)
+    return rows
+
+
+def check_pages(root, results):
+    for proxy, xml_file, properties in source_proxies(os.path.join(root, "Plugin"), results):
+        page = PAGES.get(proxy)
+        if not results.check(page is not None,
+                             "proxy %s (Plugin/%s) has no page in docs/filters: add it to PAGES" % (proxy, xml_file)):
+            continue
+        path = os.path.join(root, page)
+        if not results.check(os.path.isfile(path), "proxy %s: its page %s does not exist" % (proxy, page)):
+            continue
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+        rows = documented_properties(text)
+        if not results.check(bool(rows), "%s: no properties table (a header '| Property | Default | ...')" % page):
+            continue
+        for name in properties:
+            results.check(name in rows, "%s: property `%s` of proxy %s (Plugin/%s) is not a row of the "
+                          "properties table" % (page, name, proxy, xml_file))
+        known = set(properties)
+        for name, line in sorted(rows.items(), key=lambda item: item[1]):
+            results.check(name in known, "%s:%d: documents `%s`, which proxy %s (Plugin/%s) does not have "
+                          "(renamed or removed?)" % (page, line, name, proxy, xml_file))
+        for line_number, line in enumerate(text.splitlines(), start=1):
+            for target in IMAGE_LINK.findall(line):
+                if "://" in target:
+                    continue
+                image = os.path.normpath(os.path.join(os.path.dirname(path), target))
+                results.check(os.path.isfile(image), "%s:%d: image %s does not exist" % (page, line_number, target))
+
+
+def searched_files(root):
+    for entry in SEARCHED:
+        path = os.path.join(root, entry)
+        if os.path.isfile(path):
+            yield path
+        elif os.path.isdir(path):
+            for directory, subdirectories, files in os.walk(path):
+                subdirectories[:] = sorted(d for d in subdirectories if d not in SKIPPED_DIRECTORIES)
+                for name in sorted(files):
+                    yield os.path.join(directory, name)
+
+
+def check_outside_references(root, results):
+    needle = OUTSIDE_REFERENCE.encode()
+    found = False
+    for path in searched_files(root):
+        try:
+            with open(path, "rb") as f:
+                data = f.read()
+        except OSError:
+            continue
+        start = data.find(needle)
+        while start >= 0:
+            found = True
+            line = data.count(b"\n", 0, start) + 1
+            results.check(False, "%s:%d: refers to %s, outside the repository" %
+                          (os.path.relpath(path, root), line, OUTSIDE_REFERENCE))
+            start = data.find(needle, start + len(needle))
+    if not found:
+        results.check(True, "")
+
+
+def main(argv):
+    if len(argv) != 2:
+        sys.stderr.write("usage: python3 %s REPO_ROOT\n" % argv[0])
+        return 2
+    root = os.path.abspath(argv[1])
+    results = Results()
+    check_pages(root, results)
+    check_outside_references(root, results)
+    for failure in results.failures:
+        print("FAILED: " + failure)
+    print("%d passed, %d failed" % (results.passed, len(results.failures)))
+    return 1 if results.failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
