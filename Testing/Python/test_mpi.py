@@ -144,26 +144,23 @@ from vtkmodules.vtkIOXML import vtkXMLPPolyDataReader  # noqa: E402
 from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 
 
-def shaded_points(path):
+def surface_arrays(path, names):
+    """{point rounded to 1e-4: (the point's values of each array in names)} of a .pvtp."""
     reader = vtkXMLPPolyDataReader()
     reader.SetFileName(path)
     reader.Update()
     surface = reader.GetOutput()
     points = vtk_to_numpy(surface.GetPoints().GetData()).astype("float64")
-    ao = vtk_to_numpy(surface.GetPointData().GetArray("AmbientOcclusion"))
-    shadow = vtk_to_numpy(surface.GetPointData().GetArray("Shadow"))
-    return {tuple(np.round(p, 4)): (a, s) for p, a, s in zip(points, ao, shadow)}
+    arrays = [vtk_to_numpy(surface.GetPointData().GetArray(name)) for name in names]
+    return {tuple(np.round(p, 4)): values for p, values in zip(points, zip(*arrays))}
+
+
+def shaded_points(path):
+    return surface_arrays(path, ("AmbientOcclusion", "Shadow"))
 
 
 def probed_points(path):
-    reader = vtkXMLPPolyDataReader()
-    reader.SetFileName(path)
-    reader.Update()
-    surface = reader.GetOutput()
-    points = vtk_to_numpy(surface.GetPoints().GetData()).astype("float64")
-    probed = vtk_to_numpy(surface.GetPointData().GetArray("AmbientOcclusion"))
-    normals = vtk_to_numpy(surface.GetPointData().GetArray("Normals"))
-    return {tuple(np.round(p, 4)): (a, n) for p, a, n in zip(points, probed, normals)}
+    return surface_arrays(path, ("AmbientOcclusion", "Normals"))
 
 
 def pyramid_pieces(path, ranks):
