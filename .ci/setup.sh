@@ -28,7 +28,7 @@ packages=(cmake g++ ninja-build paraview-dev paraview python3-paraview "${qt_pac
   libhdf5-openmpi-dev libutfcpp-dev libgl2ps-dev libglew-dev libgdal-dev libnetcdf-dev
   libavcodec-dev libavformat-dev libswscale-dev libtheora-dev libdouble-conversion-dev
   liblz4-dev libexpat1-dev libeigen3-dev libboost-dev libfreetype-dev mpi-default-dev
-  python3-mpi4py libgtest-dev xvfb xauth python3-numpy python3-scipy python3-dev qemu-user
+  python3-mpi4py libgtest-dev xvfb xauth python3-numpy python3-scipy python3-dev python3-tqdm qemu-user
   valgrind)
 # libFuzzer comes with clang (GCC's sanitizers come with g++).
 [ "$job" = fuzz ] && packages+=(clang-16 libclang-rt-16-dev)
