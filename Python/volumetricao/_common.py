@@ -134,7 +134,7 @@ def volume_image(volume, sampling=None, spacing=None, what="volume", stacklevel=
     if spacing is not None:
         if sampling is not None:
             raise TypeError("give sampling or spacing, not both")
-        warnings.warn("spacing (x, y, z) is deprecated and goes in 0.3: give sampling, one value per array axis "
+        warnings.warn("spacing (x, y, z) is deprecated and will be removed after 0.3: give sampling, one value per array axis "
                       "[z, y, x] as scipy.ndimage takes it (sampling=spacing[::-1])", DeprecationWarning,
                       stacklevel=stacklevel)
         sampling = tuple(reversed(three(spacing, "spacing")))

@@ -37,12 +37,18 @@ def _choice(value, table, what):
     return table[key]
 
 
-def _deprecated_origin(image, origin):
+def _volume(array, sampling, spacing, origin):
+    """The input as an image (_common.volume_image), with the deprecated origin (x, y, z)
+    of a numpy array applied; a vtkImageData carries its own."""
+    volume = _common.volume_image(array, sampling, spacing)
     if origin is None:
-        return
-    warnings.warn("origin (x, y, z) is deprecated and goes in 0.3: it does not change the results",
+        return volume
+    if volume.keep is None:
+        raise TypeError("a vtkImageData carries its own origin: leave origin out")
+    warnings.warn("origin (x, y, z) is deprecated and will be removed after 0.3: it does not change the results",
                   DeprecationWarning, stacklevel=3)
-    image.SetOrigin(*_common.three(origin, "origin"))
+    volume.image.SetOrigin(*_common.three(origin, "origin"))
+    return volume
 
 
 def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", world_radius=False,
@@ -97,10 +103,7 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
     chosen = _choice(method, _METHODS, "method")
     erf_key = _choice(erf, _ERF, "erf")
     backend_key = _common.check_backend(backend)
-    volume = _common.volume_image(array, sampling, spacing)
-    if volume.keep is None and origin is not None:
-        raise TypeError("a vtkImageData carries its own origin: leave origin out")
-    _deprecated_origin(volume.image, origin)
+    volume = _volume(array, sampling, spacing, origin)
     ao = vtkVolumetricAmbientOcclusion()
     ao.SetController(None)  # this process's array is the whole volume
     ao.SetInputData(volume.image)
@@ -169,10 +172,7 @@ def occlusion_sweeping(array, iso_value, spacing=None, inside_is_above=True, ite
     VolumetricAOWarning IsoValue 5 does not cross array 'Scalars': there is no surface; ...
     """
     backend_key = _common.check_backend(backend)
-    volume = _common.volume_image(array, sampling, spacing)
-    if volume.keep is None and origin is not None:
-        raise TypeError("a vtkImageData carries its own origin: leave origin out")
-    _deprecated_origin(volume.image, origin)
+    volume = _volume(array, sampling, spacing, origin)
     sweep = vtkOcclusionSweeping()
     sweep.SetController(None)
     sweep.SetInputData(volume.image)

@@ -17,13 +17,7 @@ sys.path.insert(0, site)
 import volumetricao  # noqa: E402
 from volumetricao import _common, numpy_helpers, surfaces, volumes  # noqa: E402
 
-failures = []
-
-
-def check(condition, what):
-    print(("ok: " if condition else "FAILED: ") + what, flush=True)
-    if not condition:
-        failures.append(what)
+from vao_test_utils import failures, finish, record as check, same  # noqa: E402,F401
 
 
 # pvpython's sys.stdout has no encoding, which doctest reads: print to the process's own.
@@ -51,5 +45,4 @@ for number, block in enumerate(blocks, 1):
     except Exception:  # noqa: BLE001
         check(False, "docs/python.md block %d runs:\n%s" % (number, traceback.format_exc()))
 check(len(blocks) >= 8, "docs/python.md has its examples (%d python blocks)" % len(blocks))
-print("FAILED" if failures else "all documentation examples ran")
-sys.exit(1 if failures else 0)
+finish("all documentation examples ran")

@@ -20,17 +20,7 @@ from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy  # noqa: E4
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData  # noqa: E402
 from vtkmodules.vtkFiltersCore import vtkFlyingEdges3D  # noqa: E402
 
-failures = []
-
-
-def check(condition, what):
-    print(("ok: " if condition else "FAILED: ") + what, flush=True)
-    if not condition:
-        failures.append(what)
-
-
-def same(a, b):
-    return a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b)
+from vao_test_utils import failures, finish, record as check, same  # noqa: E402,F401
 
 
 check(os.path.realpath(volumetricao.__file__).startswith(os.path.realpath(site)),
@@ -300,5 +290,4 @@ for what, given, options in (("no scalars (white)", None, {}),
     (expected,) = arrays_of(h.GetOutput(), ["ShadedRGB"], (n,))
     check(same(rgb, expected), "surface, %s, AO times Shadow: shade equals the filter (RGB per vertex)" % what)
 
-print("FAILED" if failures else "all package checks passed")
-sys.exit(1 if failures else 0)
+finish("all package checks passed")

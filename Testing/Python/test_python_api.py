@@ -22,17 +22,7 @@ from vtkmodules.util.numpy_support import numpy_to_vtk  # noqa: E402
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData  # noqa: E402
 from vtkmodules.vtkImagingCore import vtkImageCast  # noqa: E402
 
-failures = []
-
-
-def check(condition, what):
-    print(("ok: " if condition else "FAILED: ") + what, flush=True)
-    if not condition:
-        failures.append(what)
-
-
-def same(a, b):
-    return a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b)
+from vao_test_utils import failures, finish, record as check, same  # noqa: E402,F401
 
 
 # pvpython's sys.executable names a vtkpython that is not installed: run pvpython itself.
@@ -262,5 +252,4 @@ try:
 except TypeError:
     check(True, "spacing and sampling together raise TypeError")
 
-print("FAILED" if failures else "all Python API checks passed")
-sys.exit(1 if failures else 0)
+finish("all Python API checks passed")

@@ -2,6 +2,8 @@
 import os
 import sys
 
+import numpy as np
+
 # In the order the Method menu lists them (the default first).
 METHODS = ["Histogram CDF", "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box", "Exact Sphere"]
 
@@ -11,6 +13,27 @@ METHODS = ["Histogram CDF", "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "
 # defer reparsing, and the reader's early stop at <AppendedData> then fails as "not
 # well-formed (invalid token)").
 XML_OPTIONS = dict(DataMode="Binary")
+
+
+# The collecting idiom of the Python package's tests: every check prints ok or FAILED and
+# the run goes on; the script ends with finish(), which exits non-zero on a failure.
+failures = []
+
+
+def record(condition, what):
+    print(("ok: " if condition else "FAILED: ") + what, flush=True)
+    if not condition:
+        failures.append(what)
+
+
+def same(a, b):
+    """Equal bit for bit: the same dtype, shape and values."""
+    return a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b)
+
+
+def finish(passed_line):
+    print("FAILED" if failures else passed_line)
+    sys.exit(1 if failures else 0)
 
 
 def fail(message):
