@@ -8,7 +8,8 @@ properties table (a table whose header starts with "| Property |"), written as
 `PropertyName` in backticks in the first cell, and that the table documents no property
 the proxy does not have (a renamed or removed one). It also checks that the images the
 pages show exist, and that no file of the repository refers to the reference text outside
-it (the string built in OUTSIDE_REFERENCE). It prints one line per failure and ends with
+it (the string built in OUTSIDE_REFERENCE), and that every relative link of README.md,
+Data/README.md, CUDA/README.md and docs/ names a file that exists. It prints one line per failure and ends with
 "N passed, M failed"; the exit status is 1 when anything failed.
 """
 import os
@@ -175,6 +176,26 @@ def check_outside_references(root, results):
         results.check(True, "")
 
 
+def check_links(root, results):
+    """Every relative link of the README and the manual names a file of the repository."""
+    pages = [os.path.join(root, "README.md"), os.path.join(root, "Data", "README.md"),
+             os.path.join(root, "CUDA", "README.md")]
+    for folder, _, files in os.walk(os.path.join(root, "docs")):
+        pages += [os.path.join(folder, f) for f in sorted(files) if f.endswith(".md")]
+    for page in pages:
+        if not os.path.exists(page):
+            continue
+        text = open(page, encoding="utf-8").read()
+        for match in re.finditer(r"\]\(([^)#\s]+)(#[^)]*)?\)", text):
+            target = match.group(1)
+            if "://" in target or target.startswith("mailto:"):
+                continue
+            resolved = os.path.normpath(os.path.join(os.path.dirname(page), target))
+            line = text.count("\n", 0, match.start()) + 1
+            results.check(os.path.exists(resolved), "%s:%d: link to %s, which does not exist"
+                          % (os.path.relpath(page, root), line, target))
+
+
 def main(argv):
     if len(argv) != 2:
         sys.stderr.write("usage: python3 %s REPO_ROOT\n" % argv[0])
@@ -183,6 +204,7 @@ def main(argv):
     results = Results()
     check_pages(root, results)
     check_outside_references(root, results)
+    check_links(root, results)
     for failure in results.failures:
         print("FAILED: " + failure)
     print("%d passed, %d failed" % (results.passed, len(results.failures)))
