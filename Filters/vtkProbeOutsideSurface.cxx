@@ -2,6 +2,7 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionMemory.h"
 
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
@@ -18,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <sstream>
 #include <string>
 
@@ -30,10 +32,9 @@ namespace
 /// The array the sweeping writes, positive outside the occluder.
 constexpr const char* kSignedDistance = "SignedDistance";
 
-/// The volume's smallest spacing, in world units.
-double SmallestSpacing(vtkImageData* volume)
+/// The smallest of three spacings, in world units.
+double SmallestSpacing(const double h[3])
 {
-  const double* h = volume->GetSpacing();
   return std::min({ std::abs(h[0]), std::abs(h[1]), std::abs(h[2]) });
 }
 
@@ -66,9 +67,41 @@ void Displaced(vtkImageData* volume, const double p[3], const double n[3], doubl
     std::copy(moved, moved + 3, x);
 }
 
+/// For every surface point, in turn, Displaced by each of `offsets`: the points to sample.
+vtkSmartPointer<vtkPoints> DisplacedPoints(
+  vtkPolyData* surface, vtkDataArray* normals, vtkImageData* volume, std::initializer_list<double> offsets)
+{
+  const vtkIdType n = surface->GetNumberOfPoints();
+  const vtkIdType k = static_cast<vtkIdType>(offsets.size());
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  vtkAmbientOcclusionMemory::Allocate(points->GetData(), k * n, "the points to sample");
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    double p[3], normal[3], x[3];
+    surface->GetPoint(i, p);
+    normals->GetTuple(i, normal);
+    vtkIdType j = k * i;
+    for (double offset : offsets)
+    {
+      Displaced(volume, p, normal, offset, x);
+      points->SetPoint(j++, x);
+    }
+  }
+  return points;
+}
+
 /// vtkProbeFilter's samples of `volume`'s point arrays at `points`.
 vtkSmartPointer<vtkDataSet> Sample(vtkImageData* volume, vtkPoints* points)
 {
+  // The probe allocates through VTK, which aborts where an allocation fails: make sure
+  // first that its arrays (each of the volume's, the valid-point mask) fit.
+  double bytesPerPoint = 1.0;
+  vtkPointData* arrays = volume->GetPointData();
+  for (int a = 0; a < arrays->GetNumberOfArrays(); ++a)
+    if (vtkDataArray* array = arrays->GetArray(a))
+      bytesPerPoint += array->GetNumberOfComponents() * array->GetDataTypeSize();
+  vtkAmbientOcclusionMemory::Reserve(bytesPerPoint * points->GetNumberOfPoints(), "the samples of the volume's arrays");
   vtkNew<vtkPolyData> where;
   where->SetPoints(points);
   vtkNew<vtkProbeFilter> probe;
@@ -117,7 +150,7 @@ int vtkProbeOutsideSurface::RequestUpdateExtent(
   if (volumeInfo->Has(vtkDataObject::SPACING()))
     volumeInfo->Get(vtkDataObject::SPACING(), spacing);
   Extents::RequestedPiece(outInfo, whole, ext);
-  const double smallest = std::min({ std::abs(spacing[0]), std::abs(spacing[1]), std::abs(spacing[2]) });
+  const double smallest = SmallestSpacing(spacing);
   int reach[3];
   for (int a = 0; a < 3; ++a)
   {
@@ -141,7 +174,7 @@ std::string vtkProbeOutsideSurface::InputError(vtkPolyData* surface, vtkImageDat
     why << "No volume: connect image data to the Volume input (e.g. the output of Occlusion Sweeping).";
   else if (volume->GetPointData()->GetNumberOfArrays() == 0)
     why << "The volume has no point arrays to sample.";
-  else if (!(SmallestSpacing(volume) > 0.0) || !std::isfinite(SmallestSpacing(volume)))
+  else if (const double h = SmallestSpacing(volume->GetSpacing()); !(h > 0.0 && std::isfinite(h)))
     why << "The volume's spacing must be positive and finite.";
   else if (surface->GetNumberOfPoints() > 0 && !vtkAmbientOcclusionArrayInput::GivenNormals(surface))
     why << "The surface has no point normals: turn on Compute Normals in Contour, or apply Generate Surface "
@@ -151,6 +184,11 @@ std::string vtkProbeOutsideSurface::InputError(vtkPolyData* surface, vtkImageDat
     if (normals->GetNumberOfTuples() != surface->GetNumberOfPoints())
       why << vtkAmbientOcclusionArrayInput::PointCountError(normals, surface->GetNumberOfPoints());
   }
+  // The probe interpolates every array of the volume: one that does not fit its points
+  // would be read past its end.
+  vtkPointData* arrays = volume ? volume->GetPointData() : nullptr;
+  for (int a = 0; why.str().empty() && arrays && a < arrays->GetNumberOfArrays(); ++a)
+    why << vtkAmbientOcclusionArrayInput::PointCountError(arrays->GetArray(a), volume->GetNumberOfPoints());
   return why.str();
 }
 
@@ -170,20 +208,7 @@ int vtkProbeOutsideSurface::OutsideSide(
   field->CopyStructure(volume);
   field->GetPointData()->AddArray(distance);
   const vtkIdType n = surface->GetNumberOfPoints();
-  vtkNew<vtkPoints> both;
-  both->SetDataTypeToDouble();
-  both->SetNumberOfPoints(2 * n);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    double p[3], normal[3], out[3], in[3];
-    surface->GetPoint(i, p);
-    normals->GetTuple(i, normal);
-    Displaced(volume, p, normal, offset, out);
-    Displaced(volume, p, normal, -offset, in);
-    both->SetPoint(2 * i, out);
-    both->SetPoint(2 * i + 1, in);
-  }
-  vtkSmartPointer<vtkDataSet> samples = Sample(field, both);
+  vtkSmartPointer<vtkDataSet> samples = Sample(field, DisplacedPoints(surface, normals, volume, { offset, -offset }));
   vtkDataArray* sampled = samples->GetPointData()->GetArray(kSignedDistance);
   vtkIdType along = 0, against = 0;
   for (vtkIdType i = 0; sampled && i < n; ++i)
@@ -209,49 +234,41 @@ int vtkProbeOutsideSurface::RequestData(
     output->Initialize();
     return 1;
   }
-  output->ShallowCopy(surface);
-  const vtkIdType n = surface->GetNumberOfPoints();
-  if (n == 0)
+  // Allocation failure (the sample points, the probe's arrays) becomes an error and an
+  // empty output, not an abort.
+  return vtkAmbientOcclusionMemory::Guard(this, output,
+    "try a surface with fewer points (Decimate), or more MPI ranks.", [&]() -> int {
+    output->ShallowCopy(surface);
+    if (surface->GetNumberOfPoints() == 0)
+      return 1;
+    vtkDataArray* normals = vtkAmbientOcclusionArrayInput::GivenNormals(surface);
+    const double offset = this->Distance * SmallestSpacing(volume->GetSpacing());
+    this->LastSide = this->OutsideSide(surface, normals, volume, offset);
+    this->UpdateProgress(0.4);
+    if (this->GetAbortExecute())
+    {
+      output->Initialize();
+      return 1;
+    }
+    vtkSmartPointer<vtkDataSet> samples =
+      Sample(volume, DisplacedPoints(surface, normals, volume, { this->LastSide * offset }));
+    this->UpdateProgress(0.9);
+
+    // Every sampled array joins the surface's, under its own name; the probe's own mask
+    // and the volume's ghost flags are not fields of the volume.
+    vtkPointData* from = samples->GetPointData();
+    for (int a = 0; a < from->GetNumberOfArrays(); ++a)
+    {
+      vtkDataArray* array = from->GetArray(a);
+      const char* name = array ? array->GetName() : nullptr;
+      if (!name || !strcmp(name, "vtkValidPointMask") || !strcmp(name, vtkDataSetAttributes::GhostArrayName()))
+        continue;
+      output->GetPointData()->RemoveArray(name);
+      output->GetPointData()->AddArray(array);
+    }
+    this->UpdateProgress(1.0);
     return 1;
-
-  vtkDataArray* normals = vtkAmbientOcclusionArrayInput::GivenNormals(surface);
-  const double offset = this->Distance * SmallestSpacing(volume);
-  this->LastSide = this->OutsideSide(surface, normals, volume, offset);
-  this->UpdateProgress(0.4);
-  if (this->GetAbortExecute())
-  {
-    output->Initialize();
-    return 1;
-  }
-
-  vtkNew<vtkPoints> where;
-  where->SetDataTypeToDouble();
-  where->SetNumberOfPoints(n);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    double p[3], normal[3], x[3];
-    surface->GetPoint(i, p);
-    normals->GetTuple(i, normal);
-    Displaced(volume, p, normal, this->LastSide * offset, x);
-    where->SetPoint(i, x);
-  }
-  vtkSmartPointer<vtkDataSet> samples = Sample(volume, where);
-  this->UpdateProgress(0.9);
-
-  // Every sampled array joins the surface's, under its own name; the probe's own mask and
-  // the volume's ghost flags are not fields of the volume.
-  vtkPointData* from = samples->GetPointData();
-  for (int a = 0; a < from->GetNumberOfArrays(); ++a)
-  {
-    vtkDataArray* array = from->GetArray(a);
-    const char* name = array ? array->GetName() : nullptr;
-    if (!name || !strcmp(name, "vtkValidPointMask") || !strcmp(name, vtkDataSetAttributes::GhostArrayName()))
-      continue;
-    output->GetPointData()->RemoveArray(name);
-    output->GetPointData()->AddArray(array);
-  }
-  this->UpdateProgress(1.0);
-  return 1;
+  });
 }
 
 //------------------------------------------------------------------------------

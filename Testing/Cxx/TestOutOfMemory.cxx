@@ -14,7 +14,9 @@
 #include "vtkNew.h"
 #include "vtkOcclusionSweeping.h"
 #include "vtkPointData.h"
+#include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkProbeOutsideSurface.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkVarianceOcclusionMap.h"
 #include "vtkVolumetricAmbientOcclusion.h"
@@ -194,6 +196,43 @@ TEST(OutOfMemory, AmbientOcclusionShading)
   ExpectShortageThenSuccess(
     filter, [&](bool big) { filter->SetInputData(big ? large : small); },
     [&] { return vtkDataSet::SafeDownCast(filter->GetOutputDataObject(0))->GetNumberOfPoints(); });
+}
+
+TEST(OutOfMemory, ProbeOutsideSurface)
+{
+  // 10 M surface points with normals (240 MB, made before the limit): the points sampled
+  // on both sides of each for the vote (480 MB) and the samples do not fit; 500 points do.
+  const auto surfaceOf = [](vtkIdType n) {
+    auto surface = vtkSmartPointer<vtkPolyData>::New();
+    vtkNew<vtkPoints> points;
+    points->SetNumberOfPoints(n);
+    vtkNew<vtkFloatArray> normals;
+    normals->SetName("Normals");
+    normals->SetNumberOfComponents(3);
+    normals->SetNumberOfTuples(n);
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      points->SetPoint(i, 4.0 + (i % 16), 4.0 + (i / 16) % 16, 4.0 + (i / 256) % 16);
+      normals->SetTuple3(i, 0.0, 0.0, 1.0);
+    }
+    surface->SetPoints(points);
+    surface->GetPointData()->SetNormals(normals);
+    return surface;
+  };
+  const auto large = surfaceOf(10000000), small = surfaceOf(500);
+  const auto volume = Ball(24);
+  vtkNew<vtkFloatArray> distance;
+  distance->SetName("SignedDistance");
+  distance->SetNumberOfTuples(volume->GetNumberOfPoints());
+  for (vtkIdType i = 0; i < volume->GetNumberOfPoints(); ++i)
+    distance->SetValue(i, static_cast<float>(i % 24));
+  volume->GetPointData()->AddArray(distance);
+  vtkNew<vtkProbeOutsideSurface> filter;
+  filter->SetInputData(1, volume);
+  LimitAddressSpace(150);
+  ExpectShortageThenSuccess(
+    filter, [&](bool big) { filter->SetInputData(0, big ? large : small); },
+    [&] { return filter->GetOutput()->GetNumberOfPoints(); });
 }
 
 } // namespace

@@ -232,6 +232,10 @@ TEST(ProbeOutsideSurface, RejectsBadInputWithAClearError)
   vtkNew<vtkImageData> empty;
   empty->CopyStructure(field);
   expectRejected(surface, empty, kDefaults, "no point arrays");
+  // A volume array that does not fit its points would be read past its end by the probe.
+  for (vtkIdType tuples : { vtkIdType(7), field->GetNumberOfPoints() + 1 })
+    expectRejected(surface, vtkImageData::SafeDownCast(WithPointArrayResized(field, "AmbientOcclusion", tuples)),
+      kDefaults, "Array 'AmbientOcclusion' has " + std::to_string(tuples) + " tuples");
   vtkNew<vtkPolyData> shortNormals;
   shortNormals->DeepCopy(surface);
   shortNormals->GetPointData()->GetNormals()->SetNumberOfTuples(5);
