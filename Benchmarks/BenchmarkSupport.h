@@ -2,9 +2,10 @@
 // peers' scripts (Python, run in the same session as our code).
 #pragma once
 
+#include "ScanPath.h"
+
 #include <algorithm>
 #include <chrono>
-#include <fstream>
 #include <string>
 #include <thread>
 
@@ -42,14 +43,10 @@ struct Options
   int threads = 0;
 };
 
-/// Where a scan is: under Data/ (shipped), else under `extra` (--data), else the Data/ path,
-/// so that the reader's message names the file that is missing.
+/// Where a scan is: under Data/, else under `extra` (--data); see ScanPath.h.
 inline std::string ScanPath(const std::string& extra, const std::string& relative)
 {
-  const std::string shipped = std::string(VAO_DATA_DIR) + "/" + relative;
-  if (std::ifstream(shipped).good() || extra.empty())
-    return shipped;
-  return extra + "/" + relative;
+  return vaodata::ScanPath(VAO_DATA_DIR, extra, relative);
 }
 
 inline int ResolvedThreads(int requested)

@@ -226,10 +226,12 @@ void Benchmark(const std::string& label, vtkImageData* image, const std::string&
 /// A MetaImage scan (ScanPath); exits with a message when it cannot be read.
 vtkSmartPointer<vtkImageData> ReadScanOrExit(const std::string& path)
 {
+  // The reader gives a one-point image for a file that is not there: look first.
   vtkNew<vtkMetaImageReader> reader;
   reader->SetFileName(path.c_str());
-  reader->Update();
-  if (reader->GetOutput()->GetNumberOfPoints() == 0)
+  if (std::ifstream(path).good())
+    reader->Update();
+  if (reader->GetOutput()->GetNumberOfPoints() <= 1)
   {
     std::fprintf(stderr,
       "cannot read %s (a scan not shipped in Data/: pass --data DIR, or configure with "

@@ -1,4 +1,5 @@
 #include "TestHelpers.h"
+#include "ScanPath.h"
 
 #include "vtkMetaImageReader.h"
 #include "vtkNew.h"
@@ -12,26 +13,14 @@
 namespace vaotest
 {
 
-namespace
-{
-bool Readable(const std::string& path)
-{
-  return std::ifstream(path).good();
-}
-}
-
 std::string DataFile(const std::string& relative)
 {
-  const std::string shipped = std::string(VAO_DATA_DIR) + "/" + relative;
-  const std::string extra = std::string(VAO_EXTRA_DATA_DIR);
-  if (!Readable(shipped) && !extra.empty() && Readable(extra + "/" + relative))
-    return extra + "/" + relative;
-  return shipped;
+  return vaodata::ScanPath(VAO_DATA_DIR, VAO_EXTRA_DATA_DIR, relative);
 }
 
 bool HaveDataFile(const std::string& relative)
 {
-  return Readable(DataFile(relative));
+  return std::ifstream(DataFile(relative)).good();
 }
 
 std::string MissingDataMessage(const std::string& relative)
