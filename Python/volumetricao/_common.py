@@ -48,6 +48,15 @@ def filter_sentence(message):
     return _OBJECT.sub("", _LOCATION.sub("", str(message))).strip()
 
 
+def choice(value, table, what):
+    """table[value], the key spelt in any case and with _ for spaces; else a ValueError
+    that lists the choices."""
+    key = str(value).lower().replace("_", " ")
+    if key not in table:
+        raise ValueError("unknown %s %r (one of %s)" % (what, value, ", ".join(repr(k) for k in table)))
+    return table[key]
+
+
 def check_backend(backend):
     key = str(backend).lower()
     if key not in _BACKENDS:

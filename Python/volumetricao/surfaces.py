@@ -19,13 +19,6 @@ _PRESETS = {"grayscale": vtkAmbientOcclusionShading.GRAYSCALE, "bone": vtkAmbien
             "cool to warm": vtkAmbientOcclusionShading.COOL_TO_WARM}
 
 
-def _choice(value, table, what):
-    key = str(value).lower().replace("_", " ")
-    if key not in table:
-        raise ValueError("unknown %s %r (one of %s)" % (what, value, ", ".join(repr(k) for k in table)))
-    return table[key]
-
-
 def _xyz(values, name, count=None):
     """An (N, 3) array in (z, y, x) order as a contiguous (N, 3) array in VTK's (x, y, z)
     order; float32 stays float32, anything else becomes float64."""
@@ -112,8 +105,8 @@ def isosurface_ambient_occlusion(volume, vertices, normals=None, *, sampling=Non
     iso.SetNumberOfLevels(int(levels))
     iso.SetStartAtHalfResolution(bool(start_at_half_resolution))
     iso.SetOffsetFactor(_common.number(offset_factor, "offset_factor"))
-    iso.SetCombine(_choice(combine, _COMBINE, "combine"))
-    iso.SetEstimator(_choice(estimator, _ESTIMATOR, "estimator"))
+    iso.SetCombine(_common.choice(combine, _COMBINE, "combine"))
+    iso.SetEstimator(_common.choice(estimator, _ESTIMATOR, "estimator"))
     iso.SetComputeShadows(bool(shadows))
     iso.SetLightDirection(light[2], light[1], light[0])
     iso.SetNumberOfThreads(_common.check_threads(threads))
@@ -202,7 +195,7 @@ def shade(values, ao=None, *, variance=None, shadow=None, sampling=None, color_p
     shading.SetInputData(data)
     if scalars is not None:
         shading.SetScalarsArrayName(str(scalars))
-    shading.SetColorPreset(_choice(color_preset, _PRESETS, "color_preset"))
+    shading.SetColorPreset(_common.choice(color_preset, _PRESETS, "color_preset"))
     if scalar_range is not None:
         shading.SetScalarRange(*[_common.number(v, "scalar_range") for v in scalar_range])
     if opacity_ramp is not None:

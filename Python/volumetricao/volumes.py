@@ -30,13 +30,6 @@ Level.__doc__ = """One level of the variance occlusion map: the float32 arrays `
 ``origin``, both in array order (z, y, x)."""
 
 
-def _choice(value, table, what):
-    key = str(value).lower().replace("_", " ")
-    if key not in table:
-        raise ValueError("unknown %s %r (one of %s)" % (what, value, ", ".join(repr(k) for k in table)))
-    return table[key]
-
-
 def _volume(array, sampling, spacing, origin):
     """The input as an image (_common.volume_image), with the deprecated origin (x, y, z)
     of a numpy array applied; a vtkImageData carries its own."""
@@ -100,8 +93,8 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
         ...
     ValueError: Radius 0 rounds to 0 voxels on every axis: ... Use at least one voxel.
     """
-    chosen = _choice(method, _METHODS, "method")
-    erf_key = _choice(erf, _ERF, "erf")
+    chosen = _common.choice(method, _METHODS, "method")
+    erf_key = _common.choice(erf, _ERF, "erf")
     backend_key = _common.check_backend(backend)
     volume = _volume(array, sampling, spacing, origin)
     ao = vtkVolumetricAmbientOcclusion()
