@@ -5,10 +5,10 @@
 
 #include "TestVolumes.h"
 
-#include "../src/VolumeAccess.h"
-#include "../src/cuda/FusedStatistics.h"
-#include "../src/cuda/Pipeline.h"
-#include "../src/cuda/SlabPlan.h"
+#include "VolumeAccess.h"
+#include "cuda/box_statistics/FusedStatistics.h"
+#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/SlabPlan.h"
 
 #include "vao/AmbientOcclusion.h"
 

@@ -6,7 +6,7 @@
 // reason, where there is none; CudaBackend.ReportsItsStateWithoutCrashing runs everywhere.
 #include "CudaTestSupport.h"
 
-#include "../src/cpu/Parallel.h"
+#include "cpu/common/Parallel.h"
 
 #include "vao/HistogramCdf.h"
 

@@ -3,10 +3,10 @@
 // each tier the processor has) against the formulas of docs/methods.md written out again
 // (ReferenceFormulas.h): rows of every length around the vector width, queries per voxel
 // and one iso value, flat boxes among noisy ones, small and large magnitudes.
-#include "../src/cpu/CpuDispatch.h"
-#include "../src/cpu/DoubleLanes.h"
-#include "../src/cpu/EstimatorRows.h"
-#include "../src/cpu/MomentRows.h"
+#include "cpu/simd/CpuDispatch.h"
+#include "cpu/simd/DoubleLanes.h"
+#include "cpu/box_statistics/EstimatorRows.h"
+#include "cpu/box_statistics/MomentRows.h"
 #include "ReferenceFormulas.h"
 
 #include <gtest/gtest.h>

@@ -4,7 +4,7 @@
 #include "ReferenceFormulas.h"
 #include "TestVolumes.h"
 
-#include "../src/cpu/ExactReference.h"
+#include "cpu/exact_reference/ExactReference.h"
 
 #include <gtest/gtest.h>
 

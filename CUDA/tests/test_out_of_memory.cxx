@@ -4,7 +4,7 @@
 // it) with one that can be told to fail from a size on; until told, it is malloc.
 #include "PyramidTestSupport.h"
 
-#include "cpu/CpuDispatch.h"
+#include "cpu/simd/CpuDispatch.h"
 #include "vao/BlockSweeping.h"
 #include "vao/HistogramCdf.h"
 #include "vao/OcclusionSweeping.h"

@@ -1,15 +1,15 @@
-// The GPU pipeline (src/cuda/Pipeline.h) run on the host: every kernel's per-thread code
+// The GPU pipeline (src/cuda/box_statistics/Pipeline.h) run on the host: every kernel's per-thread code
 // in a loop, the transposes as plain loops. It checks the indexing, layouts, segments
 // and van Herk blocks of the CUDA backend against the CPU library on machines without a
 // GPU; test_cuda.cxx checks the real device where there is one.
 #include "PipelineEmulation.h"
 
-#include "../src/cpu/ExactReference.h"
-#include "../src/cuda/ExactPipeline.h"
-#include "../src/cpu/PyramidPlan.h"
-#include "../src/cuda/HistogramPipeline.h"
-#include "../src/cuda/PyramidPipeline.h"
-#include "../src/cuda/Pipeline.h"
+#include "cpu/exact_reference/ExactReference.h"
+#include "cuda/exact_reference/ExactPipeline.h"
+#include "cpu/moment_pyramid/PyramidPlan.h"
+#include "cuda/histogram_cdf/HistogramPipeline.h"
+#include "cuda/moment_pyramid/PyramidPipeline.h"
+#include "cuda/box_statistics/Pipeline.h"
 
 #include "vao/HistogramCdf.h"
 #include "vao/VarianceOcclusionMap.h"

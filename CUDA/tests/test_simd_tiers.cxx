@@ -6,8 +6,8 @@
 // tiers fall back to the ones below, and the comparisons still run.
 #include "PyramidTestSupport.h"
 
-#include "cpu/CpuDispatch.h"
-#include "cpu/RunningTotals.h"
+#include "cpu/simd/CpuDispatch.h"
+#include "cpu/box_statistics/RunningTotals.h"
 
 #include "vao/HistogramCdf.h"
 

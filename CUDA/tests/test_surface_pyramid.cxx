@@ -3,8 +3,8 @@
 // voxels), on every SIMD tier, for every query, and it must build only part of level 0.
 #include "PyramidTestSupport.h"
 
-#include "cpu/CpuDispatch.h"
-#include "cpu/LevelTiles.h"
+#include "cpu/simd/CpuDispatch.h"
+#include "cpu/moment_pyramid/LevelTiles.h"
 
 #include <random>
 

@@ -3,8 +3,8 @@
 #include "vao/ValueRanges.h"
 
 #include "vao/AmbientOcclusion.h"
-#include "cpu/ConcurrentRange.h"
-#include "cpu/CpuDispatch.h"
+#include "cpu/common/ConcurrentRange.h"
+#include "cpu/simd/CpuDispatch.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-// The one threading primitive (src/cpu/Parallel.h): persistent workers, teams, nesting,
+// The one threading primitive (src/cpu/common/Parallel.h): persistent workers, teams, nesting,
 // exceptions, and the default thread count.
-#include "../src/cpu/Parallel.h"
+#include "cpu/common/Parallel.h"
 #include "SweepTestSupport.h"
 #include "TestVolumes.h"
 #include "vao/AmbientOcclusion.h"

@@ -1,13 +1,13 @@
 // computeAmbientOcclusion: the estimators of Estimators.h fed by the streamed box moments
 // (and the box extrema for CDF Reconstruction), the box histograms of Histogram CDF, or the
 // exact references; with the voxel's value, the iso value or the smoothed query as q.
-#include "BoxEngine.h"
-#include "ConcurrentRange.h"
-#include "CpuDispatch.h"
-#include "EstimatorRows.h"
-#include "ExactReference.h"
-#include "HistogramChannels.h"
-#include "SmoothedQuery.h"
+#include "cpu/box_statistics/BoxEngine.h"
+#include "cpu/common/ConcurrentRange.h"
+#include "cpu/simd/CpuDispatch.h"
+#include "cpu/box_statistics/EstimatorRows.h"
+#include "cpu/exact_reference/ExactReference.h"
+#include "cpu/histogram_cdf/HistogramChannels.h"
+#include "cpu/smoothed_query/SmoothedQuery.h"
 #include "vao/Storage.h"
 
 #include "vao/Validation.h"

@@ -6,15 +6,15 @@
 #include "vao/Validation.h"
 
 #include "VolumeAccess.h"
-#include "CudaExecutor.h"
-#include "ExactPipeline.h"
-#include "HistogramPipeline.h"
-#include "PyramidPipeline.h"
-#include "SlabTransfers.h"
-#include "cpu/ExactReference.h"
-#include "cpu/PyramidPlan.h"
-#include "cpu/Parallel.h"
-#include "Pipeline.h"
+#include "cuda/CudaExecutor.h"
+#include "cuda/exact_reference/ExactPipeline.h"
+#include "cuda/histogram_cdf/HistogramPipeline.h"
+#include "cuda/moment_pyramid/PyramidPipeline.h"
+#include "cuda/common/SlabTransfers.h"
+#include "cpu/exact_reference/ExactReference.h"
+#include "cpu/moment_pyramid/PyramidPlan.h"
+#include "cpu/common/Parallel.h"
+#include "cuda/box_statistics/Pipeline.h"
 
 #include <cuda_runtime.h>
 

@@ -3,9 +3,9 @@
 // passes on the device with optional timing.
 #pragma once
 
-#include "FusedStatistics.h"
-#include "PinnedStaging.h"
-#include "Pipeline.h"
+#include "cuda/box_statistics/FusedStatistics.h"
+#include "cuda/common/PinnedStaging.h"
+#include "cuda/box_statistics/Pipeline.h"
 
 #include "vao/Cuda.h"
 
