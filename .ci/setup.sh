@@ -9,6 +9,7 @@
 #   bash .ci/setup.sh build                       set-up only
 #   bash .ci/setup.sh sanitize [--filters]        the tests under ASan + UBSan and TSan
 #   bash .ci/setup.sh fuzz [seconds]              libFuzzer on the kernel library (600 s)
+#   bash .ci/setup.sh format [--fix]              the C++ sources against .clang-format
 set -euo pipefail
 cd "$(dirname "$0")/.."
 job="${1:-demo}"
@@ -32,6 +33,8 @@ packages=(cmake g++ ninja-build paraview-dev paraview python3-paraview "${qt_pac
   valgrind)
 # libFuzzer comes with clang (GCC's sanitizers come with g++).
 [ "$job" = fuzz ] && packages+=(clang-16 libclang-rt-16-dev)
+# The formatter at the version .clang-format is written for (git lists the sources).
+[ "$job" = format ] && packages=(clang-format-16 git)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -48,6 +51,7 @@ fi
 case "$job" in
   sanitize) exec bash .ci/sanitize.sh "$@" ;;
   fuzz) exec bash .ci/fuzz.sh "$@" ;;
+  format) exec bash .ci/format.sh "$@" ;;
 esac
 
 echo "== configuring and building (build/)"
