@@ -8,6 +8,7 @@
 #pragma once
 
 #include "vao/Estimators.h"
+#include "vao/TransferFunction.h"
 
 #include <array>
 #include <cstdint>
@@ -93,6 +94,8 @@ struct AmbientOcclusionParameters
   // Histogram CDF: the ascending thresholds t_k, fixed from the whole data set's values
   // (vao/HistogramCdf.h), never from one piece's.
   std::vector<double> thresholds;
+  // Transfer Function: the opacity whose box mean occludes (checkOpacityFunction).
+  OpacityFunction opacity;
 };
 
 /// The half-width in voxels of the smoothed query's window (ceil(3 sigma)): a piece of a

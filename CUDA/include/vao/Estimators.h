@@ -25,6 +25,7 @@ enum class Method : int
   ExactBox = 3,
   ExactSphere = 4,
   HistogramCdf = 5,
+  TransferFunction = 6, // 1 - the box's mean opacity (vao/TransferFunction.h)
 };
 
 enum class ErfMode : int

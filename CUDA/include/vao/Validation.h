@@ -38,6 +38,10 @@ std::string checkQuerySmoothing(double sigma);
 /// Histogram CDF's thresholds: 1 to kMaximumHistogramBins, finite, strictly ascending.
 Status checkHistogramThresholds(const std::vector<double>& thresholds);
 
+/// The Transfer Function method's opacity: at least one node; every x, opacity, midpoint
+/// and sharpness finite; x ascending; opacity, midpoint and sharpness in [0, 1].
+Status checkOpacityFunction(const OpacityFunction& function);
+
 /// What one parallel pass over the values finds: the non-finite ones, and the range of
 /// the finite ones (0, 0 when there is none).
 struct ValueScan

@@ -8,6 +8,7 @@
 #include "cpu/exact_reference/ExactReference.h"
 #include "cpu/histogram_cdf/HistogramChannels.h"
 #include "cpu/smoothed_query/SmoothedQuery.h"
+#include "cpu/transfer_function/TransferFunctionOpenness.h"
 #include "vao/Storage.h"
 
 #include "vao/Validation.h"
@@ -92,6 +93,10 @@ Status checkParameters(const AmbientOcclusionParameters& p)
   {
     return checkHistogramThresholds(p.thresholds);
   }
+  if (p.method == Method::TransferFunction)
+  {
+    return checkOpacityFunction(p.opacity);
+  }
   return Status::success();
 }
 
@@ -148,6 +153,13 @@ Status ambientOcclusion(const VolumeView& volume, const Region& region,
     if (!detail::computeHistogramOpenness(
           volume, region, parameters.radius, parameters.thresholds, source, output.openness, stage))
       return Status::cancelled();
+  }
+  else if (separate && parameters.method == Method::TransferFunction)
+  {
+    status = detail::computeTransferFunctionOpenness(
+      volume, region, parameters.radius, parameters.opacity, output.openness, stage);
+    if (!status.ok)
+      return status;
   }
   else if (separate)
   {

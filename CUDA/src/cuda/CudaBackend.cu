@@ -283,6 +283,10 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   {
     return Status::device("the smoothed query runs on the CPU only");
   }
+  if (p.method == Method::TransferFunction)
+  {
+    return Status::device("the Transfer Function method runs on the CPU only");
+  }
   if (!isSeparableMethod(p.method))
   {
     Status status = p.method == Method::HistogramCdf ? checkHistogramThresholds(p.thresholds) : Status::success();

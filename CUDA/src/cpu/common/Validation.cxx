@@ -214,6 +214,38 @@ Status checkHistogramThresholds(const std::vector<double>& thresholds)
   return Status::success();
 }
 
+Status checkOpacityFunction(const OpacityFunction& function)
+{
+  if (function.nodes.empty())
+  {
+    return Status::failure("the opacity function has no points: give it at least one (x, opacity) point");
+  }
+  for (std::size_t k = 0; k < function.nodes.size(); ++k)
+  {
+    const OpacityNode& node = function.nodes[k];
+    const std::string which = "opacity point " + std::to_string(k);
+    if (!std::isfinite(node.x) || !std::isfinite(node.y) || !std::isfinite(node.midpoint) ||
+      !std::isfinite(node.sharpness))
+    {
+      return Status::failure(which + " is not finite (NaN or infinity)");
+    }
+    if (node.y < 0.0 || node.y > 1.0)
+    {
+      return Status::failure(which + " has opacity " + std::to_string(node.y) + ": opacities must lie in [0, 1]");
+    }
+    if (node.midpoint < 0.0 || node.midpoint > 1.0 || node.sharpness < 0.0 || node.sharpness > 1.0)
+    {
+      return Status::failure(which + "'s midpoint and sharpness must lie in [0, 1]");
+    }
+    if (k > 0 && node.x < function.nodes[k - 1].x)
+    {
+      return Status::failure("the opacity function's points must be in ascending order of value (" + which +
+        " is not)");
+    }
+  }
+  return Status::success();
+}
+
 Status finiteStatus(const ValueScan& scan)
 {
   return scan.nonFiniteCount > 0 ? Status::nonFinite(scan.nonFiniteCount, scan.firstNonFinite) : Status::success();

@@ -1,0 +1,41 @@
+// The opacity transfer function of the Transfer Function method (docs/methods.md section
+// 10): the nodes of a vtkPiecewiseFunction, without VTK, and its evaluation as VTK 9.2's
+// vtkPiecewiseFunction::GetValue evaluates it, so that the openness follows the opacity the
+// user sees in ParaView's Color Map Editor.
+#pragma once
+
+#include <vector>
+
+namespace vao
+{
+
+/// One control point: the opacity y at value x; midpoint and sharpness shape the curve
+/// from this point to the next (both in [0, 1]; 0.5 and 0 give a straight line).
+struct OpacityNode
+{
+  double x = 0.0;
+  double y = 0.0;
+  double midpoint = 0.5;
+  double sharpness = 0.0;
+};
+
+/// A piecewise opacity function: nodes in ascending x (equal x allowed, as ParaView's
+/// opacity functions allow them), the value outside the nodes (clamping: the nearest end
+/// node's opacity, else 0), and interpolation in log10(x) (logScale).
+struct OpacityFunction
+{
+  std::vector<OpacityNode> nodes;
+  bool clamping = true;
+  bool logScale = false;
+};
+
+/// alpha(x) as vtkPiecewiseFunction::GetValue(x) gives it: the first node whose x is
+/// greater than the value and the one before it bound the segment (a value on the last
+/// node is beyond the nodes); within the segment the position is moved by the midpoint,
+/// then sharpness 0 interpolates linearly, sharpness 1 steps at the midpoint and values
+/// between bend a Hermite curve, clamped to the two nodes' opacities. NaN where the log
+/// scale meets a value or node at or below 0. The function must pass
+/// checkOpacityFunction (vao/Validation.h).
+double evaluateOpacity(const OpacityFunction& function, double x);
+
+} // namespace vao

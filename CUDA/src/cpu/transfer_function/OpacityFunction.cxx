@@ -1,0 +1,93 @@
+// evaluateOpacity (vao/TransferFunction.h): VTK 9.2's piecewise-function evaluation written
+// without VTK. The tests compare it with vtkPiecewiseFunction::GetValue itself.
+#include "vao/TransferFunction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vao
+{
+
+namespace
+{
+
+/// VTK keeps the midpoint this far from 0 and 1, where its rescaling would divide by 0.
+constexpr double kMidpointMargin = 1e-5;
+
+/// The position in [0, 1] within the segment [x1, x2], in log10 where the function asks.
+double segmentPosition(const OpacityFunction& f, double x, double x1, double x2)
+{
+  if (f.logScale)
+  {
+    const double l1 = std::log10(x1);
+    return (std::log10(x) - l1) / (std::log10(x2) - l1);
+  }
+  return (x - x1) / (x2 - x1);
+}
+
+/// The opacity between two nodes at `scale`, VTK's curve: the midpoint moves the position,
+/// then linear (sharpness < 0.01), a step (above 0.99) or the sharpened Hermite curve. A
+/// sharpness above 0.99 ends up in the Hermite branch in VTK as well, where (1 - sharpness)
+/// nearly zeroes the tangents: the result is the curve's, which is what GetValue returns.
+double segmentOpacity(const OpacityNode& a, const OpacityNode& b, double scale)
+{
+  const double midpoint = std::min(std::max(a.midpoint, kMidpointMargin), 1.0 - kMidpointMargin);
+  scale = scale < midpoint ? 0.5 * scale / midpoint : 0.5 + 0.5 * (scale - midpoint) / (1.0 - midpoint);
+  const double sharpness = a.sharpness;
+  if (sharpness < 0.01)
+  {
+    return (1 - scale) * a.y + scale * b.y;
+  }
+  const double power = 1.0 + 10 * sharpness;
+  if (scale < 0.5)
+  {
+    scale = 0.5 * std::pow(scale * 2, power);
+  }
+  else if (scale > 0.5)
+  {
+    scale = 1.0 - 0.5 * std::pow((1.0 - scale) * 2, power);
+  }
+  const double ss = scale * scale;
+  const double sss = ss * scale;
+  const double h1 = 2 * sss - 3 * ss + 1;
+  const double h2 = -2 * sss + 3 * ss;
+  const double h3 = sss - 2 * ss + scale;
+  const double h4 = sss - ss;
+  const double tangent = (1.0 - sharpness) * (b.y - a.y);
+  const double value = h1 * a.y + h2 * b.y + h3 * tangent + h4 * tangent;
+  const double lowest = std::min(a.y, b.y);
+  const double highest = std::max(a.y, b.y);
+  return std::min(std::max(value, lowest), highest);
+}
+
+} // namespace
+
+double evaluateOpacity(const OpacityFunction& f, double x)
+{
+  const std::vector<OpacityNode>& nodes = f.nodes;
+  if (nodes.empty())
+  {
+    return 0.0;
+  }
+  const auto upper = std::upper_bound(nodes.begin(), nodes.end(), x,
+    [](double value, const OpacityNode& node) { return value < node.x; });
+  if (upper == nodes.end())
+  {
+    return f.clamping ? nodes.back().y : 0.0;
+  }
+  if (upper == nodes.begin())
+  {
+    return f.clamping ? nodes.front().y : 0.0;
+  }
+  const OpacityNode& a = *(upper - 1);
+  const OpacityNode& b = *upper;
+  const double scale = segmentPosition(f, x, a.x, b.x);
+  if (std::isnan(scale))
+  {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  return segmentOpacity(a, b, scale);
+}
+
+} // namespace vao
