@@ -100,15 +100,14 @@ Status checkParameters(const AmbientOcclusionParameters& p)
   return Status::success();
 }
 
-Status ambientOcclusion(const VolumeView& volume, const Region& region,
-  const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
-  const Execution& execution)
+/// The request's checks: the parameters', then the volume and the region (with the scan of
+/// the values that the moments need, or, for the other methods, a scan of float volumes
+/// for non-finite values), then the range the smoothed query can take. `scan` keeps what
+/// was scanned (nothing for integer volumes without moments).
+Status validateRequest(const VolumeView& volume, const Region& region,
+  const AmbientOcclusionParameters& parameters, bool moments, ValueScan& scan)
 {
-  if (output.opennessRange)
-    *output.opennessRange = OutputRange{}; // unknown unless the pass that writes it keeps it
   Status status = checkParameters(parameters);
-  const bool moments = output.variance || (output.openness && isSeparableMethod(parameters.method));
-  ValueScan scan;
   if (status.ok && moments)
   {
     status = validateMomentRequest(volume, region, parameters.radius, scan);
@@ -126,6 +125,45 @@ Status ambientOcclusion(const VolumeView& volume, const Region& region,
     status = Status::failure("the smoothed query needs values within +-1e300 (their differences would overflow "
                              "double precision): rescale the data (e.g. with the Calculator) first");
   }
+  return status;
+}
+
+/// The openness of the methods that do not come from the streamed moments: Histogram CDF
+/// (box histograms), Transfer Function (the box mean of the opacity) and the exact
+/// references. `q` is the smoothed query, or null.
+Status separateOpenness(const VolumeView& volume, const Region& region,
+  const AmbientOcclusionParameters& parameters, const double* q, float* openness, const Execution& stage)
+{
+  if (parameters.method == Method::HistogramCdf)
+  {
+    detail::HistogramQuery source;
+    source.values = q;
+    source.isoValue = parameters.queryMode == QueryMode::IsoValue ? &parameters.isoValue : nullptr;
+    if (!detail::computeHistogramOpenness(
+          volume, region, parameters.radius, parameters.thresholds, source, openness, stage))
+      return Status::cancelled();
+    return Status::success();
+  }
+  if (parameters.method == Method::TransferFunction)
+  {
+    return detail::computeTransferFunctionOpenness(
+      volume, region, parameters.radius, parameters.opacity, openness, stage);
+  }
+  return detail::computeExactOpenness(volume, region, parameters, q, openness, stage);
+}
+
+/// The request checked, then its stages: the smoothed query, the openness of the methods
+/// that do not stream the moments (separateOpenness), and what the moments give (the
+/// separable methods' openness, the variance).
+Status ambientOcclusion(const VolumeView& volume, const Region& region,
+  const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
+  const Execution& execution)
+{
+  if (output.opennessRange)
+    *output.opennessRange = OutputRange{}; // unknown unless the pass that writes it keeps it
+  const bool moments = output.variance || (output.openness && isSeparableMethod(parameters.method));
+  ValueScan scan;
+  const Status status = validateRequest(volume, region, parameters, moments, scan);
   if (!status.ok)
   {
     return status;
@@ -144,28 +182,12 @@ Status ambientOcclusion(const VolumeView& volume, const Region& region,
       return Status::cancelled();
   }
   const double* q = query.empty() ? nullptr : query.data();
-  const Execution stage = detail::stageExecution(execution, queryEnd, opennessEnd);
-  if (separate && parameters.method == Method::HistogramCdf)
+  if (separate)
   {
-    detail::HistogramQuery source;
-    source.values = q;
-    source.isoValue = parameters.queryMode == QueryMode::IsoValue ? &parameters.isoValue : nullptr;
-    if (!detail::computeHistogramOpenness(
-          volume, region, parameters.radius, parameters.thresholds, source, output.openness, stage))
-      return Status::cancelled();
-  }
-  else if (separate && parameters.method == Method::TransferFunction)
-  {
-    status = detail::computeTransferFunctionOpenness(
-      volume, region, parameters.radius, parameters.opacity, output.openness, stage);
-    if (!status.ok)
-      return status;
-  }
-  else if (separate)
-  {
-    status = detail::computeExactOpenness(volume, region, parameters, q, output.openness, stage);
-    if (!status.ok)
-      return status;
+    const Status openness = separateOpenness(volume, region, parameters, q, output.openness,
+      detail::stageExecution(execution, queryEnd, opennessEnd));
+    if (!openness.ok)
+      return openness;
   }
   if (!moments)
   {

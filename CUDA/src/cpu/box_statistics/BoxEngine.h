@@ -1,191 +1,16 @@
 // The separable box statistics of every voxel: the streamed box sums (MomentPlanes.h) and,
-// for CDF Reconstruction and the statistics, the box minimum and maximum, which are not
-// invertible and take three van Herk passes (y per slice, z per row, then x per slice as
-// its rows are consumed); handed to consumers row by row.
+// for CDF Reconstruction and the statistics, the box minimum and maximum (BoxExtrema.h);
+// handed to consumers row by row.
 #pragma once
 
+#include "cpu/box_statistics/BoxExtrema.h"
 #include "cpu/box_statistics/MomentPlanes.h"
 #include "cpu/box_statistics/MomentRows.h"
-#include "cpu/box_statistics/RowTranspose.h"
-#include "cpu/box_statistics/SlidingExtremum.h"
-#include "vao/Storage.h"
 
 #include <algorithm>
 #include <cstdint>
 #include <type_traits>
 #include <vector>
-
-namespace vao
-{
-namespace detail
-{
-
-/// Box minimum and maximum of every region voxel, in two steps. computeBoxExtrema runs
-/// the y pass on every slice the region reads, straight from the volume, and then the z
-/// pass along each row, into planes of the region's rows by the x span its boxes read;
-/// SliceExtrema runs the x pass of one region slice as its rows are consumed. The x pass
-/// comes last so that it takes the region's rows alone: a band of rows (forEachNeighbourhoodRow)
-/// reads R rows above and below it, which an x pass first would also take. Minima and
-/// maxima are exact in any order of the passes.
-template <class T>
-struct BoxExtrema
-{
-  StorageArray<T> minimumPlanes; // uninitialised: the y pass writes every plane whole
-  StorageArray<T> maximumPlanes;
-  std::int64_t offset = 0; // where the region's first slice starts
-  std::int64_t width = 0;  // values a plane row holds: the x span the boxes read
-  std::int64_t rows = 0;   // rows a plane holds: the region's
-
-  /// Row j of region slice k, after the y and z passes.
-  const T* minimumRow(std::int64_t k, std::int64_t j) const
-  {
-    return this->minimumPlanes.data() + this->offset + (k * this->rows + j) * this->width;
-  }
-  const T* maximumRow(std::int64_t k, std::int64_t j) const
-  {
-    return this->maximumPlanes.data() + this->offset + (k * this->rows + j) * this->width;
-  }
-};
-
-/// Rows of a slice whose x passes run together (one AVX2 vector of 16-bit values).
-constexpr std::int64_t kExtremumRows = 16;
-
-/// The y pass of every slice the region reads, then the z pass along each region row,
-/// written back in place (BoxExtrema). Progress: slices, then rows.
-template <class T>
-bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry,
-  const Execution& execution, BoxExtrema<T>& result)
-{
-  const Region& region = geometry.region;
-  const std::int64_t span = geometry.xs.size();
-  const std::int64_t rows = region.size[1];
-  const std::int64_t plane = span * rows;
-  const std::int64_t slices = geometry.zs.size();
-  StorageArray<T>& planeMin = result.minimumPlanes;
-  StorageArray<T>& planeMax = result.maximumPlanes;
-  planeMin.resize(static_cast<std::size_t>(slices * plane));
-  planeMax.resize(static_cast<std::size_t>(slices * plane));
-  result.offset = (region.begin[2] - geometry.zs.lo) * plane;
-  result.width = span;
-  result.rows = rows;
-  const int threads = resolveThreadCount(execution.threads);
-  // Progress: the slices of the y pass, then the rows of the z pass.
-  const std::int64_t work = slices + rows;
-  const bool planesDone = parallelFor(slices, threads, threads, stageExecution(execution, 0.0, double(slices) / work),
-    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
-      const std::int64_t read = geometry.ys.size();
-      // Interleaved voxels (one component of several) are gathered first: the pass takes
-      // each row's span as contiguous lanes.
-      std::vector<T> gathered(volume.stride == 1 ? 0 : static_cast<std::size_t>(read * span));
-      ExtremumScratch<T> scratch;
-      for (std::int64_t s = begin; s < end && !progress.stopped(); ++s)
-      {
-        const std::int64_t z = geometry.zs.lo + s;
-        const T* first = volume.row(geometry.ys.lo, z) + geometry.xs.lo * volume.stride;
-        std::int64_t rowStride = volume.dims[0]; // values from one row's first to the next's
-        if (volume.stride != 1)
-        {
-          for (std::int64_t j = 0; j < read; ++j)
-          {
-            const T* row = volume.row(geometry.ys.lo + j, z) + geometry.xs.lo * volume.stride;
-            for (std::int64_t i = 0; i < span; ++i)
-              gathered[static_cast<std::size_t>(j * span + i)] = row[i * volume.stride];
-          }
-          first = gathered.data();
-          rowStride = span;
-        }
-        // y pass: the rows are the sequence, their x spans the lanes.
-        slidingMinMax(first, first, read, span, geometry.radius.y, region.begin[1] - geometry.ys.lo, rows,
-          &planeMin[s * plane], &planeMax[s * plane], scratch, rowStride);
-        progress.advance();
-      }
-    });
-  if (!planesDone)
-  {
-    return false;
-  }
-
-  return parallelFor(rows, threads, threads, stageExecution(execution, double(slices) / work, 1.0),
-    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
-      ExtremumScratch<T> scratch;
-      const std::int64_t z0 = region.begin[2] - geometry.zs.lo;
-      for (std::int64_t y = begin; y < end && !progress.stopped(); ++y)
-      {
-        // z pass: row y of every slice is a sequence of lane vectors, a plane apart; the
-        // results go back in place (the pass reads all of its input first).
-        T* rowMin = &planeMin[y * span];
-        T* rowMax = &planeMax[y * span];
-        slidingMinMax(rowMin, rowMax, slices, span, geometry.radius.z, z0, region.size[2], rowMin + result.offset,
-          rowMax + result.offset, scratch, plane, plane);
-        progress.advance();
-      }
-    });
-}
-
-/// The x pass of one region slice (BoxExtrema's y and z passes done): the box minima and
-/// maxima of its voxels, a row of the region's width per region row. Each worker of
-/// visitBand keeps one for the slices it consumes, so its buffers are made once.
-template <class T>
-class SliceExtrema
-{
-public:
-  const T* minima(std::int64_t j) const { return this->Minima.data() + j * this->Width; }
-  const T* maxima(std::int64_t j) const { return this->Maxima.data() + j * this->Width; }
-
-  /// Region slice k: kExtremumRows rows at once, transposed so that the rows are the
-  /// lanes and the recurrence runs along x on vectors.
-  void compute(const BoxExtrema<T>& extrema, const BoxGeometry& geometry, std::int64_t k)
-  {
-    const Region& region = geometry.region;
-    const std::int64_t nx = region.size[0], span = extrema.width;
-    this->Width = nx;
-    this->Minima.resize(static_cast<std::size_t>(extrema.rows * nx));
-    this->Maxima.resize(this->Minima.size());
-    this->LanesMin.resize(static_cast<std::size_t>(span * kExtremumRows));
-    this->LanesMax.resize(this->LanesMin.size());
-    this->OutMin.resize(static_cast<std::size_t>(nx * kExtremumRows));
-    this->OutMax.resize(this->OutMin.size());
-    // A last group of fewer rows runs as a whole one where the transposes take blocks of
-    // 16 rows (else they and the pass would go value by value): its spare lanes repeat
-    // the last row and their results go to a row that is not kept.
-    const bool padded = transposesInBlocks<T>();
-    this->Spare.resize(static_cast<std::size_t>(padded ? 2 * nx : 0));
-    const std::int64_t x0 = region.begin[0] - geometry.xs.lo;
-    for (std::int64_t j0 = 0; j0 < extrema.rows; j0 += kExtremumRows)
-    {
-      const std::int64_t m = std::min(kExtremumRows, extrema.rows - j0);
-      const std::int64_t lanes = padded ? kExtremumRows : m;
-      const T* inMin[kExtremumRows];
-      const T* inMax[kExtremumRows];
-      T* minRows[kExtremumRows];
-      T* maxRows[kExtremumRows];
-      for (std::int64_t r = 0; r < lanes; ++r)
-      {
-        const std::int64_t j = j0 + std::min(r, m - 1);
-        inMin[r] = extrema.minimumRow(k, j);
-        inMax[r] = extrema.maximumRow(k, j);
-        minRows[r] = r < m ? &this->Minima[static_cast<std::size_t>(j * nx)] : this->Spare.data();
-        maxRows[r] = r < m ? &this->Maxima[static_cast<std::size_t>(j * nx)] : this->Spare.data() + nx;
-      }
-      rowsToLanes(inMin, lanes, 1, span, this->LanesMin.data());
-      rowsToLanes(inMax, lanes, 1, span, this->LanesMax.data());
-      slidingMinMax(this->LanesMin.data(), this->LanesMax.data(), span, lanes, geometry.radius.x, x0, nx,
-        this->OutMin.data(), this->OutMax.data(), this->Scratch);
-      lanesToRows(this->OutMin.data(), lanes, nx, minRows);
-      lanesToRows(this->OutMax.data(), lanes, nx, maxRows);
-    }
-  }
-
-private:
-  std::int64_t Width = 0;
-  std::vector<T> Minima, Maxima;                     // rows of the region's width
-  std::vector<T> LanesMin, LanesMax, OutMin, OutMax; // the transposed rows, in and out
-  std::vector<T> Spare;                              // results of padding lanes, not kept
-  ExtremumScratch<T> Scratch;
-};
-
-} // namespace detail
-} // namespace vao
 
 namespace vao
 {
@@ -279,7 +104,183 @@ struct RowContents
   bool raw = false;
 };
 
-/// forEachNeighbourhoodRow on one band (band.region, a slab of rows of `whole`): voxel
+/// What the workers of one band of visitBand share: the band (a slab of rows of `whole`),
+/// its extrema planes, the clipped box sizes along x and y, and where its rows lie in the
+/// whole region (NeighbourhoodRow::index counts voxels of the whole region).
+template <class T>
+struct BandRows
+{
+  const TypedVolume<T>& volume;
+  const BoxGeometry& band;
+  const Region& whole;
+  RowContents contents;
+  const BoxExtrema<T>& extrema;
+  std::vector<std::int64_t> countX; // voxels along x of each row voxel's clipped box
+  std::vector<std::int64_t> countY; // voxels along y, per band row
+  std::int64_t wholePlane;          // voxels of a slice of the whole region
+  std::int64_t firstRow;            // the band's first row in the whole region
+};
+
+/// visitBand's second pass, one per worker: each slice's box sums (streamMoments) and, with
+/// the extrema, its x pass (SliceExtrema) become NeighbourhoodRows handed to visit row by
+/// row. The row buffers are the worker's, made once for its chunk of slices, not per slice.
+template <class T, class Visit>
+class BandRowConsumer
+{
+public:
+  BandRowConsumer(const BandRows<T>& rows, Visit& visit)
+    : Rows(rows)
+    , VisitRow(visit)
+    , Value(width(rows))
+    , Count(width(rows))
+    , Mean(width(rows))
+    , Variance(width(rows))
+    , Minimum(rows.contents.extrema ? width(rows) : 0)
+    , Maximum(rows.contents.extrema ? width(rows) : 0)
+    , Sums(width(rows))
+  {
+  }
+
+  /// Slice slice.z of the band: the x pass of its extrema first (the rows read them), then
+  /// its rows in order, raw where the consumer takes raw rows (RowContents::raw).
+  template <class Lin>
+  void operator()(const MomentSlice<T, Lin>& slice)
+  {
+    const BandRows<T>& rows = this->Rows;
+    const Region& region = rows.band.region;
+    const std::int64_t nx = region.size[0], ny = region.size[1];
+    const std::int64_t base = (slice.z - rows.whole.begin[2]) * rows.wholePlane + rows.firstRow * nx;
+    constexpr bool narrow = std::is_same<Lin, std::uint32_t>::value;
+    if (rows.contents.extrema)
+      this->Extrema.compute(rows.extrema, rows.band, slice.z - region.begin[2]);
+    const SimdTier simd = cpuSimdTier();
+    NeighbourhoodRow out = this->rowBuffers(slice.roundingVariance);
+    const bool raw = narrow && kSixteenBit && rows.contents.raw && rows.volume.stride == 1;
+    if (raw)
+    {
+      out.value = out.count = out.mean = out.variance = out.minimum = out.maximum = nullptr;
+      out.raw.type = std::is_signed<T>::value ? ScalarType::Int16 : ScalarType::UInt16;
+    }
+    for (std::int64_t j = 0; j < ny; ++j)
+    {
+      const T* row = rows.volume.row(region.begin[1] + j, slice.z) + region.begin[0] * rows.volume.stride;
+      const std::int64_t countYZ = rows.countY[j] * slice.countZ;
+      out.index = base + j * nx;
+      if constexpr (narrow && kSixteenBit)
+      {
+        if (raw)
+        {
+          this->rawRow(slice, j, row, countYZ, out);
+          continue;
+        }
+      }
+      this->statisticsRow(slice, j, row, countYZ, simd, out);
+    }
+  }
+
+private:
+  static constexpr bool kSixteenBit =
+    std::is_same<T, std::int16_t>::value || std::is_same<T, std::uint16_t>::value;
+
+  static std::size_t width(const BandRows<T>& rows)
+  {
+    return static_cast<std::size_t>(rows.band.region.size[0]);
+  }
+
+  /// The row every slice hands over, pointing at this worker's buffers; only what was
+  /// asked for is set (RowContents).
+  NeighbourhoodRow rowBuffers(double roundingVariance)
+  {
+    const bool withExtrema = this->Rows.contents.extrema;
+    NeighbourhoodRow out;
+    out.size = this->Rows.band.region.size[0];
+    out.value = this->Value.data();
+    out.count = this->Count.data();
+    out.mean = this->Mean.data();
+    out.variance = this->Rows.contents.variance ? this->Variance.data() : nullptr;
+    out.minimum = withExtrema ? this->Minimum.data() : nullptr;
+    out.maximum = withExtrema ? this->Maximum.data() : nullptr;
+    out.roundingVariance = roundingVariance;
+    return out;
+  }
+
+  /// Row j of 16-bit voxels as the passes leave it (RawRow): the voxels, the 32-bit sums
+  /// and the extrema, not widened, for a consumer that widens them on its own lanes.
+  template <class Lin>
+  VAO_ALWAYS_INLINE void rawRow(const MomentSlice<T, Lin>& slice, std::int64_t j, const T* row,
+    std::int64_t countYZ, NeighbourhoodRow& out)
+  {
+    const std::int64_t nx = out.size;
+    const bool withExtrema = this->Rows.contents.extrema;
+    out.raw.value = this->Rows.contents.values ? row : nullptr;
+    out.raw.minimum = withExtrema ? this->Extrema.minima(j) : nullptr;
+    out.raw.maximum = withExtrema ? this->Extrema.maxima(j) : nullptr;
+    // The 32-bit sums hold the bits of exact int32 sums (MomentPlanes.h).
+    out.raw.sum = reinterpret_cast<const std::int32_t*>(slice.sum + j * nx);
+    out.sumSquares = slice.sumSquares ? slice.sumSquares + j * nx : nullptr;
+    out.countX = this->Rows.countX.data();
+    out.countYZ = countYZ;
+    this->VisitRow(static_cast<const NeighbourhoodRow&>(out));
+  }
+
+  /// Row j widened to doubles: the voxels' values, the boxes' counts, means and variances
+  /// (from exact integer sums, which are handed over too, or from double sums), and the
+  /// extrema of the slice's x pass.
+  template <class Lin>
+  VAO_ALWAYS_INLINE void statisticsRow(const MomentSlice<T, Lin>& slice, std::int64_t j, const T* row,
+    std::int64_t countYZ, SimdTier simd, NeighbourhoodRow& out)
+  {
+    const std::int64_t nx = out.size;
+    const std::vector<std::int64_t>& countX = this->Rows.countX;
+    if (this->Rows.contents.values)
+      runRows<WidenRow<T>>(simd, row, this->Rows.volume.stride, nx, this->Value.data());
+    if constexpr (MomentTraits<T>::exactInteger)
+    {
+      if constexpr (std::is_same<Lin, std::uint32_t>::value)
+      {
+        runRows<WidenSums>(simd, slice.sum + j * nx, nx, this->Sums.data());
+        out.sum = this->Sums.data();
+      }
+      else
+        out.sum = slice.sum + j * nx;
+      out.sumSquares = slice.sumSquares ? slice.sumSquares + j * nx : nullptr;
+      out.countX = countX.data();
+      out.countYZ = countYZ;
+      if (this->Rows.contents.moments) // double sums below always give them
+        meanVarianceRowExact(out.sum, out.sumSquares, countX.data(), countYZ, nx, this->Count.data(),
+          this->Mean.data(), out.sumSquares ? this->Variance.data() : nullptr);
+    }
+    else
+    {
+      for (std::int64_t i = 0; i < nx; ++i)
+      {
+        const std::int64_t p = j * nx + i;
+        const std::int64_t c = countX[i] * countYZ;
+        this->Count[i] = static_cast<double>(c);
+        // Without the squares the mean comes out the same and the variance is dropped.
+        meanVarianceFromSums(slice.sum[p], slice.sumSquares ? slice.sumSquares[p] : 0.0, c, slice.shift,
+          this->Mean[i], this->Variance[i]);
+      }
+    }
+    if (this->Rows.contents.extrema)
+    {
+      runRows<WidenRow<T>>(simd, this->Extrema.minima(j), std::int64_t(1), nx, this->Minimum.data());
+      runRows<WidenRow<T>>(simd, this->Extrema.maxima(j), std::int64_t(1), nx, this->Maximum.data());
+    }
+    this->VisitRow(static_cast<const NeighbourhoodRow&>(out));
+  }
+
+  const BandRows<T>& Rows;
+  Visit& VisitRow;
+  std::vector<double> Value, Count, Mean, Variance, Minimum, Maximum;
+  std::vector<std::int64_t> Sums; // a row's 32-bit sums widened
+  SliceExtrema<T> Extrema;
+};
+
+/// forEachNeighbourhoodRow on one band (band.region, a slab of rows of `whole`), in two
+/// passes: the band's box extrema first (computeBoxExtrema, when asked for: their y and z
+/// passes need every slice the band reads before any row can be handed over), then the
+/// streamed moments, whose slices the workers' BandRowConsumers turn into rows. Voxel
 /// indices are those of the whole region. `extrema` holds the band's extrema planes (kept
 /// from band to band, so that their pages are not cleared anew for each).
 template <class T, class Visit>
@@ -294,117 +295,10 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
   {
     return false;
   }
-  const auto countX = band.windowCounts(0);
-  const auto countY = band.windowCounts(1);
-  const std::int64_t nx = region.size[0], ny = region.size[1];
-  const std::int64_t wholePlane = whole.size[0] * whole.size[1];
-  const std::int64_t firstRow = region.begin[1] - whole.begin[1];
-  // A worker's row buffers and x pass, made once for its chunk of slices.
-  struct Buffers
-  {
-    Buffers(std::size_t n, bool extrema)
-      : value(n)
-      , count(n)
-      , mean(n)
-      , variance(n)
-      , minimum(extrema ? n : 0)
-      , maximum(extrema ? n : 0)
-      , sums(n)
-    {
-    }
-    std::vector<double> value, count, mean, variance, minimum, maximum;
-    std::vector<std::int64_t> sums; // a row's 32-bit sums widened
-    SliceExtrema<T> sliceExtrema;
-  };
-  const auto consumeSlice = [&](const auto& slice, Buffers& buffers) {
-    const std::int64_t base = (slice.z - whole.begin[2]) * wholePlane + firstRow * nx;
-    std::vector<double>&value = buffers.value, &count = buffers.count, &mean = buffers.mean,
-                       &variance = buffers.variance, &minimum = buffers.minimum, &maximum = buffers.maximum;
-    std::vector<std::int64_t>& sums = buffers.sums;
-    constexpr bool narrow = std::is_same<std::decay_t<decltype(*slice.sum)>, std::uint32_t>::value;
-    SliceExtrema<T>& sliceExtrema = buffers.sliceExtrema;
-    if (withExtrema)
-      sliceExtrema.compute(extrema, band, slice.z - region.begin[2]);
-    const SimdTier simd = cpuSimdTier();
-    NeighbourhoodRow out;
-    out.size = nx;
-    out.value = value.data();
-    out.count = count.data();
-    out.mean = mean.data();
-    out.variance = contents.variance ? variance.data() : nullptr;
-    out.minimum = withExtrema ? minimum.data() : nullptr;
-    out.maximum = withExtrema ? maximum.data() : nullptr;
-    out.roundingVariance = slice.roundingVariance;
-    constexpr bool sixteenBit = std::is_same<T, std::int16_t>::value || std::is_same<T, std::uint16_t>::value;
-    const bool raw = narrow && sixteenBit && contents.raw && volume.stride == 1;
-    if (raw)
-    {
-      out.value = out.count = out.mean = out.variance = out.minimum = out.maximum = nullptr;
-      out.raw.type = std::is_signed<T>::value ? ScalarType::Int16 : ScalarType::UInt16;
-    }
-    for (std::int64_t j = 0; j < ny; ++j)
-    {
-      const T* row = volume.row(region.begin[1] + j, slice.z) + region.begin[0] * volume.stride;
-      const std::int64_t countYZ = countY[j] * slice.countZ;
-      out.index = base + j * nx;
-      if constexpr (narrow && sixteenBit)
-      {
-        if (raw)
-        {
-          out.raw.value = contents.values ? row : nullptr;
-          out.raw.minimum = withExtrema ? sliceExtrema.minima(j) : nullptr;
-          out.raw.maximum = withExtrema ? sliceExtrema.maxima(j) : nullptr;
-          // The 32-bit sums hold the bits of exact int32 sums (MomentPlanes.h).
-          out.raw.sum = reinterpret_cast<const std::int32_t*>(slice.sum + j * nx);
-          out.sumSquares = slice.sumSquares ? slice.sumSquares + j * nx : nullptr;
-          out.countX = countX.data();
-          out.countYZ = countYZ;
-          visit(static_cast<const NeighbourhoodRow&>(out));
-          continue;
-        }
-      }
-      if (contents.values)
-        runRows<WidenRow<T>>(simd, row, volume.stride, nx, value.data());
-      if constexpr (MomentTraits<T>::exactInteger)
-      {
-        if constexpr (narrow)
-        {
-          runRows<WidenSums>(simd, slice.sum + j * nx, nx, sums.data());
-          out.sum = sums.data();
-        }
-        else
-          out.sum = slice.sum + j * nx;
-        out.sumSquares = slice.sumSquares ? slice.sumSquares + j * nx : nullptr;
-        out.countX = countX.data();
-        out.countYZ = countYZ;
-        if (contents.moments) // double sums below always give them
-          meanVarianceRowExact(out.sum, out.sumSquares, countX.data(), countYZ, nx, count.data(), mean.data(),
-            out.sumSquares ? variance.data() : nullptr);
-      }
-      else
-      {
-        for (std::int64_t i = 0; i < nx; ++i)
-        {
-          const std::int64_t p = j * nx + i;
-          const std::int64_t c = countX[i] * countYZ;
-          count[i] = static_cast<double>(c);
-          // Without the squares the mean comes out the same and the variance is dropped.
-          meanVarianceFromSums(slice.sum[p], slice.sumSquares ? slice.sumSquares[p] : 0.0, c, slice.shift,
-            mean[i], variance[i]);
-        }
-      }
-      if (withExtrema)
-      {
-        runRows<WidenRow<T>>(simd, sliceExtrema.minima(j), std::int64_t(1), nx, minimum.data());
-        runRows<WidenRow<T>>(simd, sliceExtrema.maxima(j), std::int64_t(1), nx, maximum.data());
-      }
-      visit(static_cast<const NeighbourhoodRow&>(out));
-    }
-  };
-  const auto makeConsumer = [&] {
-    return [&consumeSlice, buffers = Buffers(static_cast<std::size_t>(nx), withExtrema)](
-             const auto& slice) mutable { consumeSlice(slice, buffers); };
-  };
+  const BandRows<T> rows{ volume, band, whole, contents, extrema, band.windowCounts(0), band.windowCounts(1),
+    whole.size[0] * whole.size[1], region.begin[1] - whole.begin[1] };
+  using Consumer = BandRowConsumer<T, std::remove_reference_t<Visit>>;
+  const auto makeConsumer = [&] { return Consumer(rows, visit); };
   const Execution stage = stageExecution(execution, split, 1.0);
   if constexpr (MomentTraits<T>::exactInteger)
     if (linearSumsFit32<T>(band))

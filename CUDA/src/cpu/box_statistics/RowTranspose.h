@@ -1,4 +1,4 @@
-// The box extrema's x pass (BoxEngine.h) runs its recurrence on vectors whose lanes are
+// The box extrema's x pass (BoxExtrema.h) runs its recurrence on vectors whose lanes are
 // rows: it transposes kExtremumRows rows into lanes and its results back. For 16-bit
 // voxels (CT scans) and 16 contiguous rows, whole 16 x 16 blocks go through AVX2
 // registers (unless limitSimdTier caps the tier below AVX2); anything else element by

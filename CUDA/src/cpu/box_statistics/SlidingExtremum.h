@@ -134,7 +134,7 @@ struct SixteenValues<std::uint16_t>
   typedef std::uint16_t type __attribute__((vector_size(32)));
 };
 
-/// LaneLoops' steps on exactly 16 lanes of 16-bit values (the x pass's rows, BoxEngine.h):
+/// LaneLoops' steps on exactly 16 lanes of 16-bit values (the x pass's rows, BoxExtrema.h):
 /// one vector each, as the loops over a run-time m compile to a vector step wrapped in
 /// the checks and tails of a loop, which on 16 lanes cost more than the step.
 template <class T>

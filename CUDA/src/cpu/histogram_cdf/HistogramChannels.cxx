@@ -265,6 +265,11 @@ private:
     }
   }
 
+  /// The openness of output rows [y0, y0 + ny) of slice z from the window (the counts of
+  /// the slices around z), in three steps: every window row summed along x (RowSums), the
+  /// run along y started on the rows around y0, then per output row the query's bin, the
+  /// masked prefix of the run (the count below that bin) and the openness, before the run
+  /// slides one row down. The run holds one row of histograms, not a plane of them.
   void outputSlice(std::int64_t y0, std::int64_t ny, std::int64_t z)
   {
     const Radius& r = this->Job.radius;

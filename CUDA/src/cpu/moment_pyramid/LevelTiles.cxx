@@ -233,8 +233,67 @@ void blurBlock(SliceBlur<Source>& blur, const std::int64_t* lo, const std::int64
   }
 }
 
+/// The level's voxels that a run of `count` tiles along x from tile `first` holds: [lo, hi)
+/// in voxels of a level of n, each tile's cells and the shared face past its last cell.
+inline void runVoxels(std::int64_t first, std::int64_t count, const Index3& tiles, const Index3& n,
+  std::int64_t* lo, std::int64_t* hi)
+{
+  const std::int64_t c[3] = { first % tiles[0], (first / tiles[0]) % tiles[1], first / (tiles[0] * tiles[1]) };
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = c[a] * kTileSide;
+    hi[a] = std::min(lo[a] + kTileSide * (a == 0 ? count : 1) + 1, n[a]);
+  }
+}
+
+/// Level 1's voxels [lo, hi) into `block`, in two blurs: level 0 where level 1's taps reach
+/// (clamped to level 0's dims, as the blur clamps) into `baseBlock`, which `block0` then
+/// points blur1's source at, and level 1's blur of it: level 1 is the blur of level 0
+/// (PyramidBuild.cxx builds each level from the one before), not of the volume.
+template <class Blur0, class Blur1>
+void blurFromLevel0(Blur0& blur0, Blur1& blur1, BlockVoxels& block0, const Index3& level0, const std::int64_t* lo,
+  const std::int64_t* hi, std::vector<float>& baseBlock, float* block)
+{
+  std::int64_t baseHi[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    block0.lo[a] = std::max<std::int64_t>(0, 2 * lo[a] - kHalf);
+    baseHi[a] = std::min<std::int64_t>(level0[a], 2 * (hi[a] - 1) + kHalf + 1);
+    block0.size[a] = baseHi[a] - block0.lo[a];
+  }
+  baseBlock.resize(static_cast<std::size_t>(2 * block0.size[0] * block0.size[1] * block0.size[2]));
+  blurBlock(blur0, block0.lo, baseHi, baseBlock.data());
+  block0.mean = baseBlock.data();
+  blurBlock(blur1, lo, hi, block);
+}
+
+/// Tile k of a run from its block (means then variances, `ny` rows of `width` voxels a
+/// slice, `nz` slices): rows of (mean, variance) pairs, the layout the gathers read
+/// (LevelGrid's tiled strides). A partial tile's other voxels are never read.
+inline void blockToTile(const float* block, std::int64_t width, std::int64_t ny, std::int64_t nz, std::int64_t k,
+  float* tile)
+{
+  const std::int64_t plane = width * ny * nz;
+  const std::int64_t x0 = k * kTileSide, x1 = std::min(width, x0 + kTileSpan);
+  for (std::int64_t z = 0; z < nz; ++z)
+    for (std::int64_t y = 0; y < ny; ++y)
+    {
+      const float* mean = block + (z * ny + y) * width;
+      const float* variance = mean + plane;
+      float* to = tile + 2 * (z * kTileSpan + y) * kTileSpan;
+      for (std::int64_t x = x0; x < x1; ++x)
+      {
+        to[2 * (x - x0)] = mean[x];
+        to[2 * (x - x0) + 1] = variance[x];
+      }
+    }
+}
+
 } // namespace
 
+/// Each worker takes runs of marked tiles and, per run, two passes: the blur of the run's
+/// voxels into a block (level 0 from the volume; level 1 through the block of level 0 its
+/// taps read), then the block's rows into the run's tiles, each tile put in use once whole.
 template <class T>
 bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execution)
 {
@@ -253,55 +312,18 @@ bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execut
     for (std::int64_t r = begin; r < end; ++r)
     {
       const TileRun& run = runs[static_cast<std::size_t>(r)];
-      const std::int64_t c[3] = { run.first % this->Tiles[0], (run.first / this->Tiles[0]) % this->Tiles[1],
-        run.first / (this->Tiles[0] * this->Tiles[1]) };
       std::int64_t lo[3], hi[3];
-      for (int a = 0; a < 3; ++a)
-      {
-        lo[a] = c[a] * kTileSide;
-        hi[a] = std::min(lo[a] + kTileSide * (a == 0 ? run.count : 1) + 1, n[a]);
-      }
+      runVoxels(run.first, run.count, this->Tiles, n, lo, hi);
       const std::int64_t width = hi[0] - lo[0], rows = (hi[1] - lo[1]) * (hi[2] - lo[2]);
       block.resize(static_cast<std::size_t>(2 * width * rows));
       if (this->Level == 0)
-      {
         blurBlock(blur0, lo, hi, block.data());
-      }
       else
-      {
-        // Level 0 where level 1's taps reach (clamped to the level, as the blur clamps).
-        BlockVoxels& block0 = base.at;
-        std::int64_t baseHi[3];
-        for (int a = 0; a < 3; ++a)
-        {
-          block0.lo[a] = std::max<std::int64_t>(0, 2 * lo[a] - kHalf);
-          baseHi[a] = std::min<std::int64_t>(plan0.out[a], 2 * (hi[a] - 1) + kHalf + 1);
-          block0.size[a] = baseHi[a] - block0.lo[a];
-        }
-        baseBlock.resize(static_cast<std::size_t>(2 * block0.size[0] * block0.size[1] * block0.size[2]));
-        blurBlock(blur0, block0.lo, baseHi, baseBlock.data());
-        block0.mean = baseBlock.data();
-        blurBlock(blur1, lo, hi, block.data());
-      }
-      // Rows of the block to rows of its tiles, (mean, variance) pairs (a partial tile's
-      // other voxels are never read).
-      const std::int64_t plane = width * rows, ny = hi[1] - lo[1];
+        blurFromLevel0(blur0, blur1, base.at, plan0.out, lo, hi, baseBlock, block.data());
       for (std::int64_t k = 0; k < run.count; ++k)
       {
-        float* tile = this->Pool.data() + this->Offsets[run.first + k];
-        const std::int64_t x0 = k * kTileSide, x1 = std::min(width, x0 + kTileSpan);
-        for (std::int64_t z = 0; z < hi[2] - lo[2]; ++z)
-          for (std::int64_t y = 0; y < ny; ++y)
-          {
-            const float* mean = block.data() + (z * ny + y) * width;
-            const float* variance = mean + plane;
-            float* to = tile + 2 * (z * kTileSpan + y) * kTileSpan;
-            for (std::int64_t x = x0; x < x1; ++x)
-            {
-              to[2 * (x - x0)] = mean[x];
-              to[2 * (x - x0) + 1] = variance[x];
-            }
-          }
+        blockToTile(block.data(), width, hi[1] - lo[1], hi[2] - lo[2], k,
+          this->Pool.data() + this->Offsets[run.first + k]);
         this->State[run.first + k].store(kInUse, std::memory_order_release);
       }
       this->Built.fetch_add(run.count, std::memory_order_relaxed);
@@ -313,7 +335,6 @@ bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execut
     }
   });
 }
-
 
 bool PyramidTiles::buildMarked(const Execution& execution)
 {
