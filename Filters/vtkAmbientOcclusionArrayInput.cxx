@@ -5,9 +5,11 @@
 
 #include "vtkAlgorithm.h"
 #include "vtkDataArray.h"
+#include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkPointData.h"
+#include "vtkPoints.h"
 #include "vtkPolyData.h"
 
 #include <cmath>
@@ -211,6 +213,46 @@ bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points, con
     }
   }
   return true;
+}
+
+bool ReadSurfacePoints(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Frame& frame,
+  const ScalarVolume& volume, const std::array<double, 3>& origin, const std::array<double, 3>& spacing, bool needed,
+  SurfacePoints& out, std::string& error)
+{
+  const vtkIdType n = surface->GetNumberOfPoints();
+  out.count = n;
+  vtkDataArray* givenNormals = GivenNormals(surface);
+  if (givenNormals && givenNormals->GetNumberOfTuples() < n)
+  {
+    error = std::string("The surface's normals (\"") + (givenNormals->GetName() ? givenNormals->GetName() : "") +
+      "\") have " + std::to_string(givenNormals->GetNumberOfTuples()) + " tuples for " + std::to_string(n) +
+      " points: give one normal per point, or none (then they come from the volume's gradient).";
+    return false;
+  }
+  vtkFloatArray* floatPoints = vtkFloatArray::SafeDownCast(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr);
+  vtkFloatArray* floatNormals = vtkFloatArray::SafeDownCast(givenNormals);
+  out.inPlace = floatPoints && floatNormals && frame.identity;
+  if (out.inPlace)
+  {
+    out.floatPoints = floatPoints->GetPointer(0);
+    out.floatNormals = floatNormals->GetPointer(0);
+    return true;
+  }
+  if (!needed)
+  {
+    return true;
+  }
+  out.points.resize(static_cast<size_t>(3 * n));
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    surface->GetPoint(i, &out.points[3 * i]);
+    if (!frame.identity)
+    {
+      const std::array<double, 3> p = frame.PointToImage(&out.points[3 * i]);
+      std::copy(p.begin(), p.end(), out.points.begin() + 3 * i);
+    }
+  }
+  return SurfaceNormals(surface, out.points, frame, volume, origin, spacing, out.normals, error);
 }
 
 vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads)

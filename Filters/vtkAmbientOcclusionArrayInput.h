@@ -59,6 +59,36 @@ bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points, con
   const ScalarVolume& volume, const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
   std::vector<double>& normals, std::string& error);
 
+/// A surface's points and normals as the surface kernels read them: its float arrays in
+/// place (what contours give), or a copy in doubles in the image's frame.
+struct SurfacePoints
+{
+  vtkIdType count = 0;
+  bool inPlace = false;
+  const float* floatPoints = nullptr;
+  const float* floatNormals = nullptr;
+  std::vector<double> points, normals;
+
+  /// kernel(points, normals) on whichever form is held: one call for either.
+  template <class Kernel>
+  vao::Status Run(Kernel&& kernel) const
+  {
+    return this->inPlace ? kernel(this->floatPoints, this->floatNormals)
+                         : kernel(static_cast<const double*>(this->points.data()),
+                             static_cast<const double*>(this->normals.data()));
+  }
+};
+
+/// Fills `out` with the points of `surface`, which lie in `frame` (the image's, or the
+/// identity where the surface ignored it): in place when its points and given normals are
+/// float arrays and the frame is the identity, else (only when `needed`: a kernel will
+/// run) a copy turned into the image's frame, with the normals of SurfaceNormals. False,
+/// with the reason in `error`, when the given normals are fewer than the points or
+/// SurfaceNormals fails.
+bool ReadSurfacePoints(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Frame& frame,
+  const ScalarVolume& volume, const std::array<double, 3>& origin, const std::array<double, 3>& spacing, bool needed,
+  SurfacePoints& out, std::string& error);
+
 /// The kernels' execution hooks for an algorithm: its progress, its abort flag, and
 /// `threads` (the filter's NumberOfThreads; 0: the kernels' default).
 vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads);

@@ -1,5 +1,4 @@
 #include "vtkAmbientOcclusionMemory.h"
-#include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkAlgorithm.h"
 #include "vtkDataArray.h"
@@ -28,13 +27,13 @@ void Allocate(vtkDataArray* array, vtkIdType tuples, const std::string& what)
     return;
   }
   const double bytes = static_cast<double>(values) * array->GetDataTypeSize();
-  void* block = bytes < 9e18 ? vao::detail::allocateStorage(static_cast<std::size_t>(bytes)) : nullptr;
+  void* block = bytes < 9e18 ? vao::allocateStorage(static_cast<std::size_t>(bytes)) : nullptr;
   if (!block)
   {
     throw Shortage{ bytes, what };
   }
   array->SetVoidArray(block, values, 0, vtkAbstractArray::VTK_DATA_ARRAY_USER_DEFINED);
-  array->SetArrayFreeFunction(&vao::detail::freeStorage);
+  array->SetArrayFreeFunction(&vao::freeStorage);
 }
 
 void Reserve(double bytes, const std::string& what)
@@ -52,9 +51,7 @@ int Guard(vtkAlgorithm* algorithm, vtkDataObject* output, const char* hint, cons
   std::ostringstream why;
   try
   {
-    const int result = body();
-    vtkAmbientOcclusionRanges::CacheOutput(output);
-    return result;
+    return body();
   }
   catch (const Shortage& shortage)
   {

@@ -34,8 +34,7 @@ void Reserve(double bytes, const std::string& what);
 /// Runs a filter's RequestData body. A Shortage, or std::bad_alloc from anywhere inside
 /// (VTK arrays, the kernels' buffers), becomes the error "Not enough memory for N MB (what);
 /// <hint>" on the algorithm and an empty `output`; the pipeline stays usable. Returns
-/// what the body returned, or 1 after a shortage (the error is the user's answer). After
-/// the body, the ranges of the output's float arrays are cached (vtkAmbientOcclusionRanges).
+/// what the body returned, or 1 after a shortage (the error is the user's answer).
 int Guard(vtkAlgorithm* algorithm, vtkDataObject* output, const char* hint, const std::function<int()>& body);
 
 } // namespace vtkAmbientOcclusionMemory

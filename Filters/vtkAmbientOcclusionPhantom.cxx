@@ -1,6 +1,7 @@
 #include "vtkAmbientOcclusionPhantom.h"
 
 #include "vtkAmbientOcclusionMemory.h"
+#include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkDataObject.h"
 #include "vtkImageData.h"
@@ -195,42 +196,52 @@ int vtkAmbientOcclusionPhantom::RequestInformation(
 int vtkAmbientOcclusionPhantom::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  // Allocation failure anywhere below is an error and an empty output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, vtkDataObject::GetData(outputVector, 0),
+  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
+  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
+  // output, not an abort.
+  return vtkAmbientOcclusionMemory::Guard(this, output,
     "choose smaller Dimensions.", [&]() -> int {
-    vtkInformation* outInfo = outputVector->GetInformationObject(0);
-    vtkImageData* output = vtkImageData::GetData(outInfo);
-    int ext[6];
-    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), ext);
-    double spacing[3], origin[3];
-    outInfo->Get(vtkDataObject::SPACING(), spacing);
-    outInfo->Get(vtkDataObject::ORIGIN(), origin);
-    output->SetExtent(ext);
-    output->SetSpacing(spacing);
-    output->SetOrigin(origin);
-    vtkNew<vtkShortArray> values;
-    values->SetName("Density");
-    vtkAmbientOcclusionMemory::Allocate(values, output->GetNumberOfPoints(), "the Density output");
-    short* out = values->GetPointer(0);
-    for (int k = ext[4]; k <= ext[5]; ++k)
+    const int result = this->ProduceOutput(outputVector);
+    vtkAmbientOcclusionRanges::CacheOutput(output);
+    return result;
+  });
+}
+
+//------------------------------------------------------------------------------
+int vtkAmbientOcclusionPhantom::ProduceOutput(vtkInformationVector* outputVector)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkImageData* output = vtkImageData::GetData(outInfo);
+  int ext[6];
+  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), ext);
+  double spacing[3], origin[3];
+  outInfo->Get(vtkDataObject::SPACING(), spacing);
+  outInfo->Get(vtkDataObject::ORIGIN(), origin);
+  output->SetExtent(ext);
+  output->SetSpacing(spacing);
+  output->SetOrigin(origin);
+  vtkNew<vtkShortArray> values;
+  values->SetName("Density");
+  vtkAmbientOcclusionMemory::Allocate(values, output->GetNumberOfPoints(), "the Density output");
+  short* out = values->GetPointer(0);
+  for (int k = ext[4]; k <= ext[5]; ++k)
+  {
+    this->UpdateProgress(static_cast<double>(k - ext[4]) / (ext[5] - ext[4] + 1));
+    for (int j = ext[2]; j <= ext[3]; ++j)
     {
-      this->UpdateProgress(static_cast<double>(k - ext[4]) / (ext[5] - ext[4] + 1));
-      for (int j = ext[2]; j <= ext[3]; ++j)
+      for (int i = ext[0]; i <= ext[1]; ++i)
       {
-        for (int i = ext[0]; i <= ext[1]; ++i)
-        {
-          // Patient axes: image y runs front to back, image z foot to head.
-          const double hu = PartialVolume(origin[0] + i * spacing[0], origin[1] + j * spacing[1],
-            origin[2] + k * spacing[2], spacing);
-          // Air stays clean, as in a CT whose air is clipped at the bottom of its range.
-          const double noisy = hu <= -1000.0 ? hu : hu + this->NoiseAmplitude * SmoothNoise(i, j, k, this->Seed);
-          *out++ = static_cast<short>(std::lround(std::max(-1024.0, std::min(3000.0, noisy))));
-        }
+        // Patient axes: image y runs front to back, image z foot to head.
+        const double hu = PartialVolume(origin[0] + i * spacing[0], origin[1] + j * spacing[1],
+          origin[2] + k * spacing[2], spacing);
+        // Air stays clean, as in a CT whose air is clipped at the bottom of its range.
+        const double noisy = hu <= -1000.0 ? hu : hu + this->NoiseAmplitude * SmoothNoise(i, j, k, this->Seed);
+        *out++ = static_cast<short>(std::lround(std::max(-1024.0, std::min(3000.0, noisy))));
       }
     }
-    output->GetPointData()->SetScalars(values);
-    return 1;
-  });
+  }
+  output->GetPointData()->SetScalars(values);
+  return 1;
 }
 
 //------------------------------------------------------------------------------

@@ -59,6 +59,9 @@ protected:
 private:
   vtkAmbientOcclusionPhantom(const vtkAmbientOcclusionPhantom&) = delete;
   void operator=(const vtkAmbientOcclusionPhantom&) = delete;
+
+  /// Fills the requested extent of the phantom (RequestData's body, inside its memory guard).
+  int ProduceOutput(vtkInformationVector* outputVector);
 };
 
 #endif

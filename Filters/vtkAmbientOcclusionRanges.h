@@ -24,7 +24,8 @@ void Cache(vtkDataArray* array);
 void CacheKnown(vtkDataArray* array, double lowest, double highest);
 
 /// Cache() for every point-data array of the output (a data set, or the data sets of a
-/// composite output).
+/// composite output). The filters call it last in RequestData, inside their memory guard
+/// (vtkAmbientOcclusionMemory::Guard): it allocates too.
 void CacheOutput(vtkDataObject* output);
 
 } // namespace vtkAmbientOcclusionRanges

@@ -2,6 +2,7 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionMemory.h"
+#include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkAmbientOcclusionCollectives.h"
 
@@ -232,43 +233,54 @@ bool vtkAmbientOcclusionShading::ShadePoints(
 int vtkAmbientOcclusionShading::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  // Allocation failure anywhere below is an error and an empty output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, vtkDataObject::GetData(outputVector, 0),
+  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
+  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
+  // output, not an abort.
+  return vtkAmbientOcclusionMemory::Guard(this, output,
     "shade a smaller extent or compute it in pieces (streaming or more MPI ranks).", [&]() -> int {
-    vtkDataSet* input = vtkDataSet::GetData(inputVector[0]);
-    vtkDataSet* output = vtkDataSet::GetData(outputVector);
-    if (!input || !output)
-    {
-      return 1;
-    }
-    output->ShallowCopy(input);
-    vtkPointData* pd = input->GetPointData();
-    vtkDataArray* scalars =
-      this->ScalarsArrayName.empty() ? pd->GetScalars() : pd->GetArray(this->ScalarsArrayName.c_str());
-    const bool volume = vtkImageData::SafeDownCast(input) != nullptr;
-    const std::string error = this->CheckInput(pd, input->GetNumberOfPoints(), scalars, volume);
-    // The range is reduced before any error return: every process must take part.
-    double range[2];
-    this->ColourRange(scalars, range);
-    if (!error.empty())
-    {
-      vtkErrorMacro(<< error);
-      output->Initialize();
-      return 1;
-    }
-    vtkNew<vtkUnsignedCharArray> shaded;
-    shaded->SetNumberOfComponents(volume ? 4 : 3);
-    vtkAmbientOcclusionMemory::Allocate(shaded, input->GetNumberOfPoints(), "the shaded colours");
-    shaded->SetName(volume ? "ShadedRGBA" : "ShadedRGB");
-    if (!this->ShadePoints(pd, scalars, volume, range, shaded))
-    {
-      output->Initialize();
-      return 1;
-    }
-    output->GetPointData()->AddArray(shaded);
-    output->GetPointData()->SetActiveScalars(shaded->GetName());
-    return 1;
+    const int result = this->ProduceOutput(inputVector, outputVector);
+    vtkAmbientOcclusionRanges::CacheOutput(output);
+    return result;
   });
+}
+
+//------------------------------------------------------------------------------
+int vtkAmbientOcclusionShading::ProduceOutput(
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkDataSet* input = vtkDataSet::GetData(inputVector[0]);
+  vtkDataSet* output = vtkDataSet::GetData(outputVector);
+  if (!input || !output)
+  {
+    return 1;
+  }
+  output->ShallowCopy(input);
+  vtkPointData* pd = input->GetPointData();
+  vtkDataArray* scalars =
+    this->ScalarsArrayName.empty() ? pd->GetScalars() : pd->GetArray(this->ScalarsArrayName.c_str());
+  const bool volume = vtkImageData::SafeDownCast(input) != nullptr;
+  const std::string error = this->CheckInput(pd, input->GetNumberOfPoints(), scalars, volume);
+  // The range is reduced before any error return: every process must take part.
+  double range[2];
+  this->ColourRange(scalars, range);
+  if (!error.empty())
+  {
+    vtkErrorMacro(<< error);
+    output->Initialize();
+    return 1;
+  }
+  vtkNew<vtkUnsignedCharArray> shaded;
+  shaded->SetNumberOfComponents(volume ? 4 : 3);
+  vtkAmbientOcclusionMemory::Allocate(shaded, input->GetNumberOfPoints(), "the shaded colours");
+  shaded->SetName(volume ? "ShadedRGBA" : "ShadedRGB");
+  if (!this->ShadePoints(pd, scalars, volume, range, shaded))
+  {
+    output->Initialize();
+    return 1;
+  }
+  output->GetPointData()->AddArray(shaded);
+  output->GetPointData()->SetActiveScalars(shaded->GetName());
+  return 1;
 }
 
 //------------------------------------------------------------------------------

@@ -17,6 +17,12 @@
  * or let the filter build them from ColorPreset over ScalarRange (the data range when
  * ScalarRange is empty) and an opacity ramp from 0 at OpacityRamp[0] to 1 at
  * OpacityRamp[1] (by default the upper half of the range).
+ *
+ * Threads: the filter computes on its own pool of threads, NumberOfThreads of them (0,
+ * the default: the cores this process may use; under MPI, its share of the node's cores).
+ * VTK's SMP settings (vtkSMPTools, VTK_SMP_MAX_THREADS, VTK_SMP_BACKEND_IN_USE) do not
+ * apply: the default SMP backend of Debian 12's VTK 9.2 and ParaView 5.11 is Sequential
+ * (one thread), and the kernels the filter runs are a library that builds without VTK.
  */
 #ifndef vtkAmbientOcclusionShading_h
 #define vtkAmbientOcclusionShading_h
@@ -135,6 +141,9 @@ protected:
 private:
   vtkAmbientOcclusionShading(const vtkAmbientOcclusionShading&) = delete;
   void operator=(const vtkAmbientOcclusionShading&) = delete;
+
+  /// The input with its shaded colours (RequestData's body, inside its memory guard).
+  int ProduceOutput(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
 
   /// Why the parameters or the input's arrays cannot be shaded; empty when they can.
   std::string CheckInput(vtkPointData* pd, vtkIdType points, vtkDataArray* scalars, bool volume) const;

@@ -81,54 +81,63 @@ std::vector<std::vector<int>> SubtractExtents(const int ext[6], const std::vecto
   return boxes;
 }
 
-bool Compute(vtkMultiProcessController* controller, const vao::VolumeView* volume, const vao::ValueScan& scan,
-  const int inExt[6],
-  const int outExt[6], const int whole[6], int bins, bool failed, std::vector<double>& thresholds,
+namespace
+{
+
+/// Pass 1, which voxels this process counts: the boxes of its output extent that no lower
+/// process's output extent holds, so that each voxel is counted once, by the lowest process
+/// whose output extent holds it. Collective (`controller` null: one process). False when
+/// any process failed before.
+bool OwnedBoxes(vtkMultiProcessController* controller, const Piece& piece, std::vector<std::vector<int>>& owned,
   std::string& error)
 {
-  const int ranks = controller ? controller->GetNumberOfProcesses() : 1;
-  const bool distributed = ranks > 1;
-  const bool holds = volume && !failed;
+  const bool holds = piece.volume && !piece.failed;
   int mine[6] = { 0, -1, 0, -1, 0, -1 };
   if (holds)
   {
-    std::copy(outExt, outExt + 6, mine);
+    std::copy(piece.outExt, piece.outExt + 6, mine);
   }
   std::vector<int> all(mine, mine + 6);
-  if (distributed)
+  if (controller)
   {
-    all.resize(6 * static_cast<size_t>(ranks));
+    all.resize(6 * static_cast<size_t>(controller->GetNumberOfProcesses()));
     controller->AllGather(mine, all.data(), 6);
-    if (vtkAmbientOcclusionCollectives::GlobalMax(controller, failed ? 1.0 : 0.0) > 0.0)
+    if (vtkAmbientOcclusionCollectives::GlobalMax(controller, piece.failed ? 1.0 : 0.0) > 0.0)
     {
-      if (!failed)
+      if (!piece.failed)
         error = "Histogram CDF: another process failed, so the thresholds of the whole data set are unknown.";
       return false;
     }
   }
-  if (failed)
+  if (piece.failed)
   {
     return false;
   }
-  // Each voxel is counted by the lowest process whose output extent holds it.
   std::vector<const int*> lower;
-  const int rank = distributed ? controller->GetLocalProcessId() : 0;
+  const int rank = controller ? controller->GetLocalProcessId() : 0;
   for (int r = 0; r < rank; ++r)
   {
     lower.push_back(&all[6 * static_cast<size_t>(r)]);
   }
-  const auto owned = SubtractExtents(mine, lower);
+  owned = SubtractExtents(mine, lower);
+  return true;
+}
 
+/// Pass 2, the histogram's cells: they span the value range of every process's owned
+/// voxels and depend on the type (integers get one cell per value), which the processes
+/// agree on. Collective. False when no process holds any voxel.
+bool HistogramCells(vtkMultiProcessController* controller, const Piece& piece,
+  const std::vector<std::vector<int>>& owned, vao::ValueHistogram& histogram, std::string& error)
+{
   double range[2] = { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() };
-  if (holds && !owned.empty())
+  if (piece.volume && !owned.empty())
   {
-    range[0] = scan.minimum;
-    range[1] = scan.maximum;
+    range[0] = piece.scan->minimum;
+    range[1] = piece.scan->maximum;
   }
-  // The cells depend on the type (integers get one cell per value): take it from a
-  // process that has data, the same array everywhere.
-  double type = holds ? static_cast<double>(volume->type) : -1.0;
-  if (distributed)
+  // The type from a process that has data: the same array everywhere.
+  double type = piece.volume ? static_cast<double>(piece.volume->type) : -1.0;
+  if (controller)
   {
     vtkAmbientOcclusionCollectives::GlobalRange(controller, range);
     type = vtkAmbientOcclusionCollectives::GlobalMax(controller, type);
@@ -138,17 +147,25 @@ bool Compute(vtkMultiProcessController* controller, const vao::VolumeView* volum
     error = "Histogram CDF: no process holds any voxel of the data set.";
     return false;
   }
-  vao::ValueHistogram histogram =
-    vao::ValueHistogram::forRange(static_cast<vao::ScalarType>(static_cast<int>(type)), range[0], range[1]);
+  histogram = vao::ValueHistogram::forRange(static_cast<vao::ScalarType>(static_cast<int>(type)), range[0], range[1]);
+  return true;
+}
+
+/// Pass 3, the counts: this process's owned voxels into the histogram, then the sum of
+/// every process's. Collective: a failure on any process fails every one.
+bool CountOwnedVoxels(vtkMultiProcessController* controller, const Piece& piece,
+  const std::vector<std::vector<int>>& owned, vao::ValueHistogram& histogram, std::string& error)
+{
+  bool failed = false;
   for (const auto& box : owned)
   {
     vao::Region region;
     for (int a = 0; a < 3; ++a)
     {
-      region.begin[a] = box[2 * a] - inExt[2 * a];
+      region.begin[a] = box[2 * a] - piece.inExt[2 * a];
       region.size[a] = box[2 * a + 1] - box[2 * a] + 1;
     }
-    const vao::Status status = vao::addToValueHistogram(*volume, region, histogram);
+    const vao::Status status = vao::addToValueHistogram(*piece.volume, region, histogram);
     if (!status.ok)
     {
       if (!status.aborted)
@@ -157,20 +174,24 @@ bool Compute(vtkMultiProcessController* controller, const vao::VolumeView* volum
       break;
     }
   }
-  if (distributed)
+  if (!controller)
   {
-    if (vtkAmbientOcclusionCollectives::GlobalMax(controller, failed ? 1.0 : 0.0) > 0.0)
-    {
-      if (error.empty())
-        error = "Histogram CDF: another process failed, so the thresholds of the whole data set are unknown.";
-      return false;
-    }
-    Reduce(controller, histogram);
+    return !failed;
   }
-  else if (failed)
+  if (vtkAmbientOcclusionCollectives::GlobalMax(controller, failed ? 1.0 : 0.0) > 0.0)
   {
+    if (error.empty())
+      error = "Histogram CDF: another process failed, so the thresholds of the whole data set are unknown.";
     return false;
   }
+  Reduce(controller, histogram);
+  return true;
+}
+
+/// Pass 4, the check: the processes' output extents together cover the whole extent, so
+/// that the thresholds are the whole data set's.
+bool CoversWholeExtent(const vao::ValueHistogram& histogram, const int whole[6], std::string& error)
+{
   const long long counted = histogram.totalCount();
   const long long expected = vtkAmbientOcclusionExtents::ExtentPoints(whole);
   if (counted != expected)
@@ -178,6 +199,27 @@ bool Compute(vtkMultiProcessController* controller, const vao::VolumeView* volum
     error = "Histogram CDF takes its thresholds from every voxel of the data set, but the processes' pieces hold " +
       std::to_string(counted) + " of its " + std::to_string(expected) +
       " voxels: request the whole extent, or pieces that cover it.";
+    return false;
+  }
+  return true;
+}
+
+} // namespace
+
+bool Compute(vtkMultiProcessController* controller, const Piece& piece, int bins, std::vector<double>& thresholds,
+  std::string& error)
+{
+  const int ranks = controller ? controller->GetNumberOfProcesses() : 1;
+  if (ranks <= 1)
+  {
+    controller = nullptr; // one process: nothing to exchange
+  }
+  std::vector<std::vector<int>> owned;
+  vao::ValueHistogram histogram;
+  if (!OwnedBoxes(controller, piece, owned, error) || !HistogramCells(controller, piece, owned, histogram, error) ||
+    !CountOwnedVoxels(controller, piece, owned, histogram, error) ||
+    !CoversWholeExtent(histogram, piece.whole, error))
+  {
     return false;
   }
   thresholds = vao::histogramThresholds(histogram, bins);

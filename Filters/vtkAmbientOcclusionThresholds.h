@@ -20,18 +20,32 @@ struct VolumeView;
 namespace vtkAmbientOcclusionThresholds
 {
 
-/// The thresholds of Histogram CDF with `bins` bins. Each process passes its input
-/// (`volume`, extent `inExt`; null when it has none or failed before), the scan of its
-/// values (vao::scanValues: the caller has refused non-finite values with it) and the
-/// extent it produces (`outExt`); each voxel of the whole extent is counted once, by the lowest
-/// process whose output extent holds it, and the summaries are reduced over the
-/// controller's processes. Collective when the controller has several processes: each
-/// must call it, `failed` saying whether it failed before (then every process returns
-/// false). False, with the reason in `error`, when the processes' output extents do not
-/// cover the whole extent (the thresholds would not be the whole data set's).
-bool Compute(vtkMultiProcessController* controller, const vao::VolumeView* volume, const vao::ValueScan& scan,
-  const int inExt[6],
-  const int outExt[6], const int whole[6], int bins, bool failed, std::vector<double>& thresholds,
+/// One process's part in Compute.
+struct Piece
+{
+  /// Its input; null when it has none or failed before.
+  const vao::VolumeView* volume = nullptr;
+  /// The scan of its values (vao::scanValues: the caller has refused non-finite values
+  /// with it); read only with a volume.
+  const vao::ValueScan* scan = nullptr;
+  /// The extent of `volume`.
+  const int* inExt = nullptr;
+  /// The extent it produces.
+  const int* outExt = nullptr;
+  /// The data set's whole extent.
+  const int* whole = nullptr;
+  /// Whether it failed before (then every process returns false).
+  bool failed = false;
+};
+
+/// The thresholds of Histogram CDF with `bins` bins, from the whole data set: each voxel
+/// of the whole extent is counted once, by the lowest process whose output extent holds
+/// it, and the summaries are reduced over the controller's processes. Collective when the
+/// controller has several processes: each must call it with its `piece` (a failed one
+/// too). False, with the reason in `error`, when a process failed, or when the processes'
+/// output extents do not cover the whole extent (the thresholds would not be the whole
+/// data set's).
+bool Compute(vtkMultiProcessController* controller, const Piece& piece, int bins, std::vector<double>& thresholds,
   std::string& error);
 
 /// The thresholds of the data set produced by `producer` (output `port`), read in `slabs`

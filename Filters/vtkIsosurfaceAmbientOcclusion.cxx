@@ -1,6 +1,7 @@
 #include "vtkIsosurfaceAmbientOcclusion.h"
 
 #include "vtkAmbientOcclusionMemory.h"
+#include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionExtents.h"
@@ -211,52 +212,63 @@ bool vtkIsosurfaceAmbientOcclusion::CheckSurfaceInVolume(
 int vtkIsosurfaceAmbientOcclusion::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  // Allocation failure anywhere below is an error and an empty output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, vtkDataObject::GetData(outputVector, 0),
+  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
+  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
+  // output, not an abort.
+  return vtkAmbientOcclusionMemory::Guard(this, output,
     "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.", [&]() -> int {
-    vtkPolyData* surface = vtkPolyData::GetData(inputVector[0]);
-    vtkImageData* volume = vtkImageData::GetData(inputVector[1]);
-    vtkPolyData* output = vtkPolyData::GetData(outputVector);
-    output->Initialize();
-    if (!surface || !volume)
-    {
-      vtkErrorMacro(<< "Needs a surface (input 0) and a volume (input 1).");
-      return 1;
-    }
-    int whole[6];
-    inputVector[1]->GetInformationObject(0)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-    const bool distributed = this->IsDistributed();
-    if (!distributed && !std::equal(whole, whole + 6, volume->GetExtent()))
-    {
-      // Happens when the surface is extracted from the same source output in pieces (MPI):
-      // the shared output then holds the surface's piece, not the whole volume.
-      vtkErrorMacro(<< "The volume arrived as a piece, not whole: under MPI, feed the Volume input from its own "
-                       "reader rather than from the output the surface was extracted from.");
-      return 1;
-    }
-    if (!this->CheckParameters()) // the same answer on every process
-    {
-      return 1;
-    }
-    int piece[6];
-    std::copy(whole, whole + 6, piece);
-    vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
-    if (distributed ? !this->UpdateDistributedPyramid(volume, chosen, whole, piece)
-                    : !this->UpdatePyramid(volume, chosen))
-    {
-      return 1;
-    }
-    output->ShallowCopy(surface);
-    if (surface->GetNumberOfPoints() == 0)
-    {
-      return 1; // an empty surface (or an empty piece of one): nothing to shade
-    }
-    if (!this->CheckSurfaceInVolume(surface, volume, whole, piece) || !this->Shade(surface, output))
-    {
-      output->Initialize();
-    }
-    return 1;
+    const int result = this->ProduceOutput(inputVector, outputVector);
+    vtkAmbientOcclusionRanges::CacheOutput(output);
+    return result;
   });
+}
+
+//------------------------------------------------------------------------------
+int vtkIsosurfaceAmbientOcclusion::ProduceOutput(
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPolyData* surface = vtkPolyData::GetData(inputVector[0]);
+  vtkImageData* volume = vtkImageData::GetData(inputVector[1]);
+  vtkPolyData* output = vtkPolyData::GetData(outputVector);
+  output->Initialize();
+  if (!surface || !volume)
+  {
+    vtkErrorMacro(<< "Needs a surface (input 0) and a volume (input 1).");
+    return 1;
+  }
+  int whole[6];
+  inputVector[1]->GetInformationObject(0)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  const bool distributed = this->IsDistributed();
+  if (!distributed && !std::equal(whole, whole + 6, volume->GetExtent()))
+  {
+    // Happens when the surface is extracted from the same source output in pieces (MPI):
+    // the shared output then holds the surface's piece, not the whole volume.
+    vtkErrorMacro(<< "The volume arrived as a piece, not whole: under MPI, feed the Volume input from its own "
+                     "reader rather than from the output the surface was extracted from.");
+    return 1;
+  }
+  if (!this->CheckParameters()) // the same answer on every process
+  {
+    return 1;
+  }
+  int piece[6];
+  std::copy(whole, whole + 6, piece);
+  vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
+  if (distributed ? !this->UpdateDistributedPyramid(volume, chosen, whole, piece)
+                  : !this->UpdatePyramid(volume, chosen))
+  {
+    return 1;
+  }
+  output->ShallowCopy(surface);
+  if (surface->GetNumberOfPoints() == 0)
+  {
+    return 1; // an empty surface (or an empty piece of one): nothing to shade
+  }
+  if (!this->CheckSurfaceInVolume(surface, volume, whole, piece) || !this->Shade(surface, output))
+  {
+    output->Initialize();
+  }
+  return 1;
 }
 
 //------------------------------------------------------------------------------

@@ -26,6 +26,12 @@
  * its memory (build/bin/vao_memory; docs/performance.md). The volume's array
  * is read again when tiles are built. Under MPI each process keeps the whole levels of
  * its piece.
+ *
+ * Threads: the filter computes on its own pool of threads, NumberOfThreads of them (0,
+ * the default: the cores this process may use; under MPI, its share of the node's cores).
+ * VTK's SMP settings (vtkSMPTools, VTK_SMP_MAX_THREADS, VTK_SMP_BACKEND_IN_USE) do not
+ * apply: the default SMP backend of Debian 12's VTK 9.2 and ParaView 5.11 is Sequential
+ * (one thread), and the kernels the filter runs are a library that builds without VTK.
  */
 #ifndef vtkIsosurfaceAmbientOcclusion_h
 #define vtkIsosurfaceAmbientOcclusion_h
@@ -175,6 +181,10 @@ protected:
 private:
   vtkIsosurfaceAmbientOcclusion(const vtkIsosurfaceAmbientOcclusion&) = delete;
   void operator=(const vtkIsosurfaceAmbientOcclusion&) = delete;
+
+  /// The surface with its AmbientOcclusion (and Shadow) arrays (RequestData's body, inside
+  /// its memory guard).
+  int ProduceOutput(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
 
   struct Cache;
   std::unique_ptr<Cache> Pyramid;

@@ -26,6 +26,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 #include <tuple>
@@ -35,6 +36,7 @@ namespace Extents = vtkAmbientOcclusionExtents;
 namespace PyramidImages = vtkAmbientOcclusionPyramidImages;
 using vtkAmbientOcclusionArrayInput::ExecutionOf;
 using vtkAmbientOcclusionArrayInput::PrepareScalars;
+using vtkAmbientOcclusionArrayInput::SurfacePoints;
 
 namespace
 {
@@ -71,6 +73,26 @@ struct SurfaceKey
       std::tie(o.points, o.pointsTime, o.normals, o.normalsTime, o.count, o.query, o.pyramidBuilds);
   }
 };
+
+// PlaceSurface's guess of the frame a surface is in: the workaround for VTK 9.2's
+// vtkContourFilter and vtkSynchronizedTemplates3D (ParaView 5.11's Contour), which ignore an
+// oriented image's direction matrix. VTK places an oriented image's voxels at origin + D
+// (spacing index); vtkFlyingEdges3D and vtkMarchingCubes put a contour there, while those
+// two leave it along the image's axes. A contour's points lie on grid edges, where the
+// trilinear volume takes the iso value: the frame in which the sampled values agree is the
+// surface's. The axes win only where the physical frame's values clearly disagree: the
+// points of a physical surface read along the axes may all fall in flat air, and agree
+// there too.
+/// The points read: every (n / kFrameSamples)-th of n, so all of a surface under 1024
+/// points and 512 to 768 of a larger one; enough for the medians, few beside the shading.
+constexpr vtkIdType kFrameSamples = 512;
+/// The physical frame's values disagree: their median deviation exceeds this fraction of
+/// the spread of every value read (both frames').
+constexpr double kFrameDisagreement = 1e-4;
+/// The axes' values agree: their median deviation is below this fraction of the
+/// physical frame's.
+constexpr double kAxesAgreement = 1e-3;
+
 /// The median distance of the values from their median: near 0 when nearly all agree.
 double MedianDeviation(std::vector<double> values)
 {
@@ -81,6 +103,89 @@ double MedianDeviation(std::vector<double> values)
     v = std::abs(v - median);
   std::nth_element(values.begin(), middle, values.end());
   return *middle;
+}
+
+/// Whether the points of `surface` (some) lie on the iso-surface of the oriented volume
+/// only along the image's axes, its direction matrix ignored (see kFrameSamples).
+bool AlongImageAxes(vtkPolyData* surface, const vtkAmbientOcclusionArrayInput::ScalarVolume& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing)
+{
+  const vtkIdType n = surface->GetNumberOfPoints();
+  std::vector<double> inFrame, alongAxes;
+  for (vtkIdType i = 0; i < n; i += std::max<vtkIdType>(1, n / kFrameSamples))
+  {
+    const double* p = surface->GetPoint(i);
+    inFrame.push_back(vao::sampleVolume(volume.view, origin, spacing, volume.frame.PointToImage(p)));
+    alongAxes.push_back(vao::sampleVolume(volume.view, origin, spacing, { p[0], p[1], p[2] }));
+  }
+  const auto [low, high] = std::minmax_element(inFrame.begin(), inFrame.end());
+  const auto [lowAxes, highAxes] = std::minmax_element(alongAxes.begin(), alongAxes.end());
+  const double spread = std::max(*high, *highAxes) - std::min(*low, *lowAxes);
+  const double disagreement = MedianDeviation(inFrame);
+  return disagreement > kFrameDisagreement * spread && MedianDeviation(alongAxes) < kAxesAgreement * disagreement;
+}
+
+/// The bounds of the surface's points in the volume's axis-aligned frame (from `frame`).
+void BoundsInFrame(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Frame& frame, double bounds[6])
+{
+  if (frame.identity)
+  {
+    surface->GetBounds(bounds);
+    return;
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    bounds[2 * a] = std::numeric_limits<double>::infinity();
+    bounds[2 * a + 1] = -bounds[2 * a];
+  }
+  const vtkIdType n = surface->GetNumberOfPoints();
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    const std::array<double, 3> p = frame.PointToImage(surface->GetPoint(i));
+    for (int a = 0; a < 3; ++a)
+    {
+      bounds[2 * a] = std::min(bounds[2 * a], p[a]);
+      bounds[2 * a + 1] = std::max(bounds[2 * a + 1], p[a]);
+    }
+  }
+}
+
+/// What the shading's kernels read besides the pyramid and the points.
+struct Sampling
+{
+  const vao::VolumeView& volume;
+  const std::array<double, 3>& origin;
+  const std::array<double, 3>& spacing;
+  const vao::SurfaceOcclusionParameters parameters;
+  const vao::Execution execution;
+};
+
+/// The shading's two kernels on the form of the pyramid this process holds (see Shade).
+struct PyramidKernels
+{
+  std::function<vao::Status(const SurfacePoints& points, float* out)> occlusion;
+  std::function<vao::Status(const SurfacePoints& points, const std::array<double, 3>& light, float* out)> shadow;
+};
+
+/// The two queries on `source`: in one process the SurfacePyramid, whose finest levels are
+/// tiles built as the points reach them; under MPI the whole levels of this process's
+/// piece (a vector of MomentLevel), the coarsest shared by all.
+template <class Source>
+PyramidKernels Kernels(Source& source, const Sampling& s)
+{
+  PyramidKernels kernels;
+  kernels.occlusion = [&source, &s](const SurfacePoints& points, float* out) {
+    return points.Run([&](auto xyz, auto normals) {
+      return vao::surfaceAmbientOcclusion(
+        source, s.volume, s.origin, s.spacing, xyz, normals, points.count, s.parameters, out, s.execution);
+    });
+  };
+  kernels.shadow = [&source, &s](const SurfacePoints& points, const std::array<double, 3>& light, float* out) {
+    return points.Run([&](auto xyz, auto normals) {
+      return vao::surfaceShadow(source, xyz, normals, points.count, light, s.parameters, out, s.execution);
+    });
+  };
+  return kernels;
 }
 } // namespace
 
@@ -259,125 +364,48 @@ void vtkIsosurfaceAmbientOcclusion::ShareCoarsestLevel(
 //------------------------------------------------------------------------------
 void vtkIsosurfaceAmbientOcclusion::PlaceSurface(vtkPolyData* surface, double bounds[6])
 {
-  // VTK places an oriented image's voxels at origin + D (spacing index); vtkFlyingEdges3D
-  // and vtkMarchingCubes put a contour there, while vtkContourFilter and
-  // vtkSynchronizedTemplates3D of VTK 9.2 (ParaView 5.11's Contour) leave it along the
-  // image's axes. A contour's points lie on grid edges, where the trilinear volume takes
-  // the iso value: the frame in which the sampled values agree is the surface's. The
-  // axes win only where the physical frame's values clearly disagree: the points of a
-  // physical surface read along the axes may all fall in flat air, and agree there too.
   Cache& cache = *this->Pyramid;
-  const vtkAmbientOcclusionFrame::Frame& volumeFrame = cache.scalars.frame;
-  cache.surfaceFrame = volumeFrame;
-  const vtkIdType n = surface->GetNumberOfPoints();
-  if (!volumeFrame.identity && n > 0)
+  cache.surfaceFrame = cache.scalars.frame;
+  if (!cache.scalars.frame.identity && surface->GetNumberOfPoints() > 0 &&
+    AlongImageAxes(surface, cache.scalars, cache.origin, cache.spacing))
   {
-    std::vector<double> inFrame, alongAxes;
-    for (vtkIdType i = 0; i < n; i += std::max<vtkIdType>(1, n / 512))
-    {
-      const double* p = surface->GetPoint(i);
-      inFrame.push_back(vao::sampleVolume(cache.scalars.view, cache.origin, cache.spacing, volumeFrame.PointToImage(p)));
-      alongAxes.push_back(vao::sampleVolume(cache.scalars.view, cache.origin, cache.spacing, { p[0], p[1], p[2] }));
-    }
-    const auto [low, high] = std::minmax_element(inFrame.begin(), inFrame.end());
-    const auto [lowAxes, highAxes] = std::minmax_element(alongAxes.begin(), alongAxes.end());
-    const double spread = std::max(*high, *highAxes) - std::min(*low, *lowAxes);
-    const double disagreement = MedianDeviation(inFrame);
-    if (disagreement > 1e-4 * spread && MedianDeviation(alongAxes) < 1e-3 * disagreement)
-    {
-      cache.surfaceFrame = vtkAmbientOcclusionFrame::Frame{};
-      vtkWarningMacro(<< "The surface lies on the volume's iso-surface only with the volume's direction matrix "
-                         "ignored, as vtkContourFilter and ParaView 5.11's Contour extract it: its points, normals "
-                         "and LightDirection are taken along the image's axes.");
-    }
+    cache.surfaceFrame = vtkAmbientOcclusionFrame::Frame{};
+    vtkWarningMacro(<< "The surface lies on the volume's iso-surface only with the volume's direction matrix "
+                       "ignored, as vtkContourFilter and ParaView 5.11's Contour extract it: its points, normals "
+                       "and LightDirection are taken along the image's axes.");
   }
-  const vtkAmbientOcclusionFrame::Frame& frame = cache.surfaceFrame;
-  if (frame.identity)
-  {
-    surface->GetBounds(bounds);
-    return;
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    bounds[2 * a] = std::numeric_limits<double>::infinity();
-    bounds[2 * a + 1] = -bounds[2 * a];
-  }
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    const std::array<double, 3> p = frame.PointToImage(surface->GetPoint(i));
-    for (int a = 0; a < 3; ++a)
-    {
-      bounds[2 * a] = std::min(bounds[2 * a], p[a]);
-      bounds[2 * a + 1] = std::max(bounds[2 * a + 1], p[a]);
-    }
-  }
+  BoundsInFrame(surface, cache.surfaceFrame, bounds);
 }
 
 //------------------------------------------------------------------------------
 bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* output)
 {
   Cache& cache = *this->Pyramid;
-  const vao::SurfaceOcclusionParameters parameters = this->Parameters();
-  const vao::Execution execution = ExecutionOf(this, this->NumberOfThreads);
-  const SurfaceKey key(surface, parameters, this->PyramidBuilds);
+  const Sampling sampling{ cache.scalars.view, cache.origin, cache.spacing, this->Parameters(),
+    ExecutionOf(this, this->NumberOfThreads) };
+  const SurfaceKey key(surface, sampling.parameters, this->PyramidBuilds);
   const bool newOcclusion = !cache.occlusion || !(cache.occlusionKey == key);
-  // The points and normals as the kernels read them, only when a kernel runs (with the AO
-  // kept and shadows off there is nothing to compute): float arrays in place (what
-  // contours give), anything else as a double copy.
-  const vtkIdType n = surface->GetNumberOfPoints();
-  vtkDataArray* givenNormals = vtkAmbientOcclusionArrayInput::GivenNormals(surface);
-  if (givenNormals && givenNormals->GetNumberOfTuples() < n)
+  const vtkAmbientOcclusionFrame::Frame& frame = cache.surfaceFrame; // PlaceSurface's
+  SurfacePoints points;
+  std::string error;
+  if (!vtkAmbientOcclusionArrayInput::ReadSurfacePoints(surface, frame, cache.scalars, cache.origin, cache.spacing,
+        newOcclusion || this->ComputeShadows, points, error))
   {
-    vtkErrorMacro(<< "The surface's normals (\"" << (givenNormals->GetName() ? givenNormals->GetName() : "")
-                  << "\") have " << givenNormals->GetNumberOfTuples() << " tuples for " << n
-                  << " points: give one normal per point, or none (then they come from the volume's gradient).");
+    vtkErrorMacro(<< error);
     return false;
   }
-  vtkFloatArray* floatPoints = vtkFloatArray::SafeDownCast(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr);
-  vtkFloatArray* floatNormals = vtkFloatArray::SafeDownCast(givenNormals);
-  const vtkAmbientOcclusionFrame::Frame& frame = cache.surfaceFrame; // PlaceSurface's
-  const bool inPlace = floatPoints && floatNormals && frame.identity;
-  std::vector<double> points, normals;
-  std::string error;
-  if (!inPlace && (newOcclusion || this->ComputeShadows))
-  {
-    points.resize(static_cast<size_t>(3 * n));
-    for (vtkIdType i = 0; i < n; ++i)
-    {
-      surface->GetPoint(i, &points[3 * i]);
-      if (!frame.identity)
-      {
-        const std::array<double, 3> p = frame.PointToImage(&points[3 * i]);
-        std::copy(p.begin(), p.end(), points.begin() + 3 * i);
-      }
-    }
-    if (!vtkAmbientOcclusionArrayInput::SurfaceNormals(
-          surface, points, frame, cache.scalars, cache.origin, cache.spacing, normals, error))
-    {
-      vtkErrorMacro(<< error);
-      return false;
-    }
-  }
-  // One call for either form of the points.
-  const auto run = [&](auto&& kernel) {
-    return inPlace ? kernel(static_cast<const float*>(floatPoints->GetPointer(0)),
-                       static_cast<const float*>(floatNormals->GetPointer(0)))
-                   : kernel(static_cast<const double*>(points.data()), static_cast<const double*>(normals.data()));
-  };
+  // The serial/MPI decision, made once: UpdatePyramid (one process) built the tiled
+  // pyramid, UpdateDistributedPyramid (MPI) the whole levels of this process's piece.
+  const PyramidKernels kernels =
+    cache.surface.empty() ? Kernels(cache.levels, sampling) : Kernels(cache.surface, sampling);
   vao::Status status = vao::Status::success();
   if (newOcclusion)
   {
     cache.occlusion = nullptr;
     vtkNew<vtkFloatArray> occlusion;
     occlusion->SetName("AmbientOcclusion");
-    vtkAmbientOcclusionMemory::Allocate(occlusion, n, "the AmbientOcclusion output");
-    status = run([&](auto p, auto nn) {
-      return cache.surface.empty()
-        ? vao::surfaceAmbientOcclusion(cache.levels, cache.scalars.view, cache.origin, cache.spacing, p, nn, n,
-            parameters, occlusion->GetPointer(0), execution)
-        : vao::surfaceAmbientOcclusion(cache.surface, cache.scalars.view, cache.origin, cache.spacing, p, nn, n,
-            parameters, occlusion->GetPointer(0), execution);
-    });
+    vtkAmbientOcclusionMemory::Allocate(occlusion, points.count, "the AmbientOcclusion output");
+    status = kernels.occlusion(points, occlusion->GetPointer(0));
     if (status.ok)
     {
       cache.occlusion = occlusion;
@@ -388,15 +416,11 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
   if (status.ok && this->ComputeShadows)
   {
     shadow->SetName("Shadow");
-    vtkAmbientOcclusionMemory::Allocate(shadow, n, "the Shadow output");
-    const std::array<double, 3> l = frame.identity
+    vtkAmbientOcclusionMemory::Allocate(shadow, points.count, "the Shadow output");
+    const std::array<double, 3> light = frame.identity
       ? std::array<double, 3>{ this->LightDirection[0], this->LightDirection[1], this->LightDirection[2] }
       : frame.VectorToImage(this->LightDirection);
-    status = run([&](auto p, auto nn) {
-      return cache.surface.empty()
-        ? vao::surfaceShadow(cache.levels, p, nn, n, { l[0], l[1], l[2] }, parameters, shadow->GetPointer(0), execution)
-        : vao::surfaceShadow(cache.surface, p, nn, n, { l[0], l[1], l[2] }, parameters, shadow->GetPointer(0), execution);
-    });
+    status = kernels.shadow(points, light, shadow->GetPointer(0));
   }
   if (!status.ok)
   {
@@ -414,4 +438,3 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
   }
   return true;
 }
-

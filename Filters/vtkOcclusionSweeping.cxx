@@ -1,6 +1,7 @@
 #include "vtkOcclusionSweeping.h"
 
 #include "vtkAmbientOcclusionMemory.h"
+#include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionCollectives.h"
@@ -226,69 +227,80 @@ void vtkOcclusionSweeping::WarnNoSurface(const std::string& arrayName)
 int vtkOcclusionSweeping::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  // Allocation failure anywhere below is an error and an empty output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, vtkDataObject::GetData(outputVector, 0),
+  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
+  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
+  // output, not an abort.
+  return vtkAmbientOcclusionMemory::Guard(this, output,
     "use more MPI ranks, turn OutputOctantVisibility off, or crop or resample the volume.", [&]() -> int {
-    vtkImageData* input = vtkImageData::GetData(inputVector[0]);
-    vtkImageData* output = vtkImageData::GetData(outputVector);
-    output->Initialize();
-    if (!input)
-    {
-      return 1;
-    }
-    int whole[6], outExt[6];
-    std::string error = vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
-    if (!error.empty() ||
-      !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, whole, outExt, error))
-    {
-      vtkErrorMacro(<< error);
-      return 1;
-    }
-    vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
-    if (this->IsDistributed(whole))
-    {
-      return this->RequestDistributedData(input, output, whole, outExt, chosen);
-    }
-    this->LastRounds = 0;
-    if (!std::equal(whole, whole + 6, input->GetExtent()))
-    {
-      vtkErrorMacro(<< "Occlusion sweeping needs the whole volume; the upstream source delivered only part of it.");
-      return 1;
-    }
-    ScalarVolume scalars;
-    if (!PrepareScalars(this, chosen, input, this->Component, scalars, error))
-    {
-      vtkErrorMacro(<< error);
-      return 1;
-    }
-
-    // Computed on the whole volume; the output is the requested extent.
-    vtkNew<vtkImageData> whole3d;
-    whole3d->ShallowCopy(input);
-    const vao::SweepOutput arrays = AddOutputArrays(whole3d, this->OutputOctantVisibility != 0);
-    const double* spacing = input->GetSpacing();
-    vao::SweepReport report;
-    const vao::Status status = vao::computeOcclusionSweeping(scalars.view, { spacing[0], spacing[1], spacing[2] },
-      this->Parameters(), arrays, ExecutionOf(this, this->NumberOfThreads), &report);
-    if (!status.ok)
-    {
-      error = KernelError(status, scalars, "Occlusion sweeping failed");
-      if (!error.empty())
-      {
-        vtkErrorMacro(<< error);
-      }
-      return 1;
-    }
-    if (!report.surfaceFound)
-    {
-      this->WarnNoSurface(scalars.name);
-    }
-    this->LastPasses = report.passes;
-    this->LastChange = report.lastChange;
-
-    vtkAmbientOcclusionExtents::CopyRequestedExtent(whole3d, output, outExt);
-    return 1;
+    const int result = this->ProduceOutput(inputVector, outputVector);
+    vtkAmbientOcclusionRanges::CacheOutput(output);
+    return result;
   });
+}
+
+//------------------------------------------------------------------------------
+int vtkOcclusionSweeping::ProduceOutput(
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkImageData* input = vtkImageData::GetData(inputVector[0]);
+  vtkImageData* output = vtkImageData::GetData(outputVector);
+  output->Initialize();
+  if (!input)
+  {
+    return 1;
+  }
+  int whole[6], outExt[6];
+  std::string error = vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+  if (!error.empty() ||
+    !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, whole, outExt, error))
+  {
+    vtkErrorMacro(<< error);
+    return 1;
+  }
+  vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
+  if (this->IsDistributed(whole))
+  {
+    return this->RequestDistributedData(input, output, whole, outExt, chosen);
+  }
+  this->LastRounds = 0;
+  if (!std::equal(whole, whole + 6, input->GetExtent()))
+  {
+    vtkErrorMacro(<< "Occlusion sweeping needs the whole volume; the upstream source delivered only part of it.");
+    return 1;
+  }
+  ScalarVolume scalars;
+  if (!PrepareScalars(this, chosen, input, this->Component, scalars, error))
+  {
+    vtkErrorMacro(<< error);
+    return 1;
+  }
+
+  // Computed on the whole volume; the output is the requested extent.
+  vtkNew<vtkImageData> whole3d;
+  whole3d->ShallowCopy(input);
+  const vao::SweepOutput arrays = AddOutputArrays(whole3d, this->OutputOctantVisibility != 0);
+  const double* spacing = input->GetSpacing();
+  vao::SweepReport report;
+  const vao::Status status = vao::computeOcclusionSweeping(scalars.view, { spacing[0], spacing[1], spacing[2] },
+    this->Parameters(), arrays, ExecutionOf(this, this->NumberOfThreads), &report);
+  if (!status.ok)
+  {
+    error = KernelError(status, scalars, "Occlusion sweeping failed");
+    if (!error.empty())
+    {
+      vtkErrorMacro(<< error);
+    }
+    return 1;
+  }
+  if (!report.surfaceFound)
+  {
+    this->WarnNoSurface(scalars.name);
+  }
+  this->LastPasses = report.passes;
+  this->LastChange = report.lastChange;
+
+  vtkAmbientOcclusionExtents::CopyRequestedExtent(whole3d, output, outExt);
+  return 1;
 }
 
 //------------------------------------------------------------------------------

@@ -20,6 +20,12 @@
  * occluders translucent. Sweeping is global: in one process the filter reads the whole
  * volume; under MPI each process sweeps a slab and the slabs exchange their faces until
  * they agree (see SetController).
+ *
+ * Threads: the filter computes on its own pool of threads, NumberOfThreads of them (0,
+ * the default: the cores this process may use; under MPI, its share of the node's cores).
+ * VTK's SMP settings (vtkSMPTools, VTK_SMP_MAX_THREADS, VTK_SMP_BACKEND_IN_USE) do not
+ * apply: the default SMP backend of Debian 12's VTK 9.2 and ParaView 5.11 is Sequential
+ * (one thread), and the kernels the filter runs are a library that builds without VTK.
  */
 #ifndef vtkOcclusionSweeping_h
 #define vtkOcclusionSweeping_h
@@ -180,6 +186,10 @@ private:
 
   vtkOcclusionSweeping(const vtkOcclusionSweeping&) = delete;
   void operator=(const vtkOcclusionSweeping&) = delete;
+
+  /// The swept distance and occlusion of the requested extent (RequestData's body, inside
+  /// its memory guard).
+  int ProduceOutput(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
 };
 
 #endif

@@ -3,6 +3,7 @@
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionExtents.h"
 #include "vtkAmbientOcclusionMemory.h"
+#include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
@@ -234,41 +235,49 @@ int vtkProbeOutsideSurface::RequestData(
     output->Initialize();
     return 1;
   }
-  // Allocation failure (the sample points, the probe's arrays) becomes an error and an
-  // empty output, not an abort.
+  // Allocation failure (the sample points, the probe's arrays, caching the ranges) becomes
+  // an error and an empty output, not an abort.
   return vtkAmbientOcclusionMemory::Guard(this, output,
     "try a surface with fewer points (Decimate), or more MPI ranks.", [&]() -> int {
-    output->ShallowCopy(surface);
-    if (surface->GetNumberOfPoints() == 0)
-      return 1;
-    vtkDataArray* normals = vtkAmbientOcclusionArrayInput::GivenNormals(surface);
-    const double offset = this->Distance * SmallestSpacing(volume->GetSpacing());
-    this->LastSide = this->OutsideSide(surface, normals, volume, offset);
-    this->UpdateProgress(0.4);
-    if (this->GetAbortExecute())
-    {
-      output->Initialize();
-      return 1;
-    }
-    vtkSmartPointer<vtkDataSet> samples =
-      Sample(volume, DisplacedPoints(surface, normals, volume, { this->LastSide * offset }));
-    this->UpdateProgress(0.9);
-
-    // Every sampled array joins the surface's, under its own name; the probe's own mask
-    // and the volume's ghost flags are not fields of the volume.
-    vtkPointData* from = samples->GetPointData();
-    for (int a = 0; a < from->GetNumberOfArrays(); ++a)
-    {
-      vtkDataArray* array = from->GetArray(a);
-      const char* name = array ? array->GetName() : nullptr;
-      if (!name || !strcmp(name, "vtkValidPointMask") || !strcmp(name, vtkDataSetAttributes::GhostArrayName()))
-        continue;
-      output->GetPointData()->RemoveArray(name);
-      output->GetPointData()->AddArray(array);
-    }
-    this->UpdateProgress(1.0);
-    return 1;
+    const int result = this->ProduceOutput(surface, volume, output);
+    vtkAmbientOcclusionRanges::CacheOutput(output);
+    return result;
   });
+}
+
+//------------------------------------------------------------------------------
+int vtkProbeOutsideSurface::ProduceOutput(vtkPolyData* surface, vtkImageData* volume, vtkPolyData* output)
+{
+  output->ShallowCopy(surface);
+  if (surface->GetNumberOfPoints() == 0)
+    return 1;
+  vtkDataArray* normals = vtkAmbientOcclusionArrayInput::GivenNormals(surface);
+  const double offset = this->Distance * SmallestSpacing(volume->GetSpacing());
+  this->LastSide = this->OutsideSide(surface, normals, volume, offset);
+  this->UpdateProgress(0.4);
+  if (this->GetAbortExecute())
+  {
+    output->Initialize();
+    return 1;
+  }
+  vtkSmartPointer<vtkDataSet> samples =
+    Sample(volume, DisplacedPoints(surface, normals, volume, { this->LastSide * offset }));
+  this->UpdateProgress(0.9);
+
+  // Every sampled array joins the surface's, under its own name; the probe's own mask
+  // and the volume's ghost flags are not fields of the volume.
+  vtkPointData* from = samples->GetPointData();
+  for (int a = 0; a < from->GetNumberOfArrays(); ++a)
+  {
+    vtkDataArray* array = from->GetArray(a);
+    const char* name = array ? array->GetName() : nullptr;
+    if (!name || !strcmp(name, "vtkValidPointMask") || !strcmp(name, vtkDataSetAttributes::GhostArrayName()))
+      continue;
+    output->GetPointData()->RemoveArray(name);
+    output->GetPointData()->AddArray(array);
+  }
+  this->UpdateProgress(1.0);
+  return 1;
 }
 
 //------------------------------------------------------------------------------

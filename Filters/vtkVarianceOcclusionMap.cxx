@@ -1,6 +1,7 @@
 #include "vtkVarianceOcclusionMap.h"
 
 #include "vtkAmbientOcclusionMemory.h"
+#include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionExtents.h"
@@ -86,66 +87,77 @@ vao::PyramidParameters vtkVarianceOcclusionMap::Parameters() const
 int vtkVarianceOcclusionMap::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  // Allocation failure anywhere below is an error and an empty output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, vtkDataObject::GetData(outputVector, 0),
+  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
+  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
+  // output, not an abort.
+  return vtkAmbientOcclusionMemory::Guard(this, output,
     "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.", [&]() -> int {
-    vtkImageData* input = vtkImageData::GetData(inputVector[0]);
-    vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector);
-    output->Initialize();
-    std::string error = vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+    const int result = this->ProduceOutput(inputVector, outputVector);
+    vtkAmbientOcclusionRanges::CacheOutput(output);
+    return result;
+  });
+}
+
+//------------------------------------------------------------------------------
+int vtkVarianceOcclusionMap::ProduceOutput(
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkImageData* input = vtkImageData::GetData(inputVector[0]);
+  vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector);
+  output->Initialize();
+  std::string error = vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+  if (!error.empty())
+  {
+    vtkErrorMacro(<< error);
+    return 1;
+  }
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  int whole[6], piece[6], expected[6];
+  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  Extents::RequestedPiece(outInfo, whole, piece);
+  const int levels = std::max(0, this->NumberOfLevels);
+  if (Extents::EmptyExtent(piece))
+  {
+    output->SetNumberOfBlocks(static_cast<unsigned int>(levels)); // an empty piece
+    return 1;
+  }
+  this->InputExtentOf(whole, piece, expected);
+  if (input && !std::equal(expected, expected + 6, input->GetExtent()))
+  {
+    vtkErrorMacro(<< "The variance occlusion map of this piece needs the input extent " << expected[0] << ".."
+                  << expected[1] << ", " << expected[2] << ".." << expected[3] << ", " << expected[4] << ".."
+                  << expected[5] << "; the upstream source delivered another one.");
+    return 1;
+  }
+  std::vector<vao::MomentLevel> pyramid;
+  vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
+  if (!input || !Extents::CheckWholeExtent(whole, error) ||
+    !vtkAmbientOcclusionArrayInput::PrepareScalars(
+      this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error) ||
+    !vtkAmbientOcclusionPyramidImages::BuildPyramid(scalars, input, this->Parameters(),
+      vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads), pyramid, error))
+  {
     if (!error.empty())
     {
       vtkErrorMacro(<< error);
-      return 1;
-    }
-    vtkInformation* outInfo = outputVector->GetInformationObject(0);
-    vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
-    int whole[6], piece[6], expected[6];
-    inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-    Extents::RequestedPiece(outInfo, whole, piece);
-    const int levels = std::max(0, this->NumberOfLevels);
-    if (Extents::EmptyExtent(piece))
-    {
-      output->SetNumberOfBlocks(static_cast<unsigned int>(levels)); // an empty piece
-      return 1;
-    }
-    this->InputExtentOf(whole, piece, expected);
-    if (input && !std::equal(expected, expected + 6, input->GetExtent()))
-    {
-      vtkErrorMacro(<< "The variance occlusion map of this piece needs the input extent " << expected[0] << ".."
-                    << expected[1] << ", " << expected[2] << ".." << expected[3] << ", " << expected[4] << ".."
-                    << expected[5] << "; the upstream source delivered another one.");
-      return 1;
-    }
-    std::vector<vao::MomentLevel> pyramid;
-    vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
-    if (!input || !Extents::CheckWholeExtent(whole, error) ||
-      !vtkAmbientOcclusionArrayInput::PrepareScalars(
-        this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error) ||
-      !vtkAmbientOcclusionPyramidImages::BuildPyramid(scalars, input, this->Parameters(),
-        vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads), pyramid, error))
-    {
-      if (!error.empty())
-      {
-        vtkErrorMacro(<< error);
-      }
-      return 1;
-    }
-    vtkAmbientOcclusionPyramidImages::WarnOfCoarseMeans(this, pyramid);
-    // Level l keeps every step-th input voxel (from the input's first, aligned on it); the
-    // piece's level voxels are those whose input voxel lies in the piece.
-    output->SetNumberOfBlocks(static_cast<unsigned int>(pyramid.size()));
-    int step = this->StartAtHalfResolution ? 2 : 1;
-    for (size_t l = 0; l < pyramid.size(); ++l, step *= 2)
-    {
-      auto part = vtkAmbientOcclusionPyramidImages::LevelPiece(pyramid[l], whole, expected, piece, step);
-      vtkAmbientOcclusionFrame::PlaceInWorld(scalars.frame, part); // where the input's own voxels lie
-      output->SetBlock(static_cast<unsigned int>(l), part);
-      output->GetMetaData(static_cast<unsigned int>(l))
-        ->Set(vtkCompositeDataSet::NAME(), ("Level " + std::to_string(l)).c_str());
     }
     return 1;
-  });
+  }
+  vtkAmbientOcclusionPyramidImages::WarnOfCoarseMeans(this, pyramid);
+  // Level l keeps every step-th input voxel (from the input's first, aligned on it); the
+  // piece's level voxels are those whose input voxel lies in the piece.
+  output->SetNumberOfBlocks(static_cast<unsigned int>(pyramid.size()));
+  int step = this->StartAtHalfResolution ? 2 : 1;
+  for (size_t l = 0; l < pyramid.size(); ++l, step *= 2)
+  {
+    auto part = vtkAmbientOcclusionPyramidImages::LevelPiece(pyramid[l], whole, expected, piece, step);
+    vtkAmbientOcclusionFrame::PlaceInWorld(scalars.frame, part); // where the input's own voxels lie
+    output->SetBlock(static_cast<unsigned int>(l), part);
+    output->GetMetaData(static_cast<unsigned int>(l))
+      ->Set(vtkCompositeDataSet::NAME(), ("Level " + std::to_string(l)).c_str());
+  }
+  return 1;
 }
 
 //------------------------------------------------------------------------------

@@ -10,6 +10,12 @@
  * builds the same pyramid internally and keeps it between updates. Distributed or
  * streamed, a piece reads its extent grown by the pyramid's reach (2^levels input voxels;
  * 2^(levels+1) - 2 from half resolution) and outputs the level voxels of its piece.
+ *
+ * Threads: the filter computes on its own pool of threads, NumberOfThreads of them (0,
+ * the default: the cores this process may use; under MPI, its share of the node's cores).
+ * VTK's SMP settings (vtkSMPTools, VTK_SMP_MAX_THREADS, VTK_SMP_BACKEND_IN_USE) do not
+ * apply: the default SMP backend of Debian 12's VTK 9.2 and ParaView 5.11 is Sequential
+ * (one thread), and the kernels the filter runs are a library that builds without VTK.
  */
 #ifndef vtkVarianceOcclusionMap_h
 #define vtkVarianceOcclusionMap_h
@@ -78,6 +84,10 @@ private:
 
   vtkVarianceOcclusionMap(const vtkVarianceOcclusionMap&) = delete;
   void operator=(const vtkVarianceOcclusionMap&) = delete;
+
+  /// The pyramid's levels of the requested piece (RequestData's body, inside its memory
+  /// guard).
+  int ProduceOutput(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
 };
 
 #endif

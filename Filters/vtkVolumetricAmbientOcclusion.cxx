@@ -9,7 +9,6 @@
 
 #include "vao/AmbientOcclusion.h"
 #include "vao/Cuda.h"
-#include "vao/HistogramCdf.h"
 #include "vao/Validation.h"
 
 #include "vtkDataArray.h"
@@ -30,7 +29,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <vector>
 
 vtkStandardNewMacro(vtkVolumetricAmbientOcclusion);
@@ -90,6 +88,22 @@ vtkSmartPointer<vtkFloatArray> NewFloatArray(const char* name, vtkIdType values)
 
 } // namespace
 
+/// One RequestData's state, filled by its steps in turn.
+struct vtkVolumetricAmbientOcclusion::Run
+{
+  int whole[6] = {};       // the data set's whole extent
+  int outExt[6] = {};      // the extent to produce
+  int radius[3] = {};      // the box's half-widths in voxels
+  bool emptyPiece = false; // this process's piece of a distributed data set has no voxel
+  vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
+  vao::ValueScan scan; // Histogram CDF without given thresholds: the values' range
+  std::vector<double> thresholds;
+  vao::AmbientOcclusionParameters parameters; // the kernel's, the thresholds moved in
+  vtkSmartPointer<vtkFloatArray> openness;
+  vtkSmartPointer<vtkFloatArray> variance;
+  vao::OutputRange range; // kept by the pass, so that the range cache need not scan
+};
+
 //------------------------------------------------------------------------------
 vtkVolumetricAmbientOcclusion::vtkVolumetricAmbientOcclusion()
   : Controller(vtkMultiProcessController::GetGlobalController())
@@ -143,51 +157,6 @@ void vtkVolumetricAmbientOcclusion::ComputeReach(const double spacing[3], int re
     for (int a = 0; a < 3; ++a)
       reach[a] = std::max(reach[a], window);
   }
-}
-
-//------------------------------------------------------------------------------
-bool vtkVolumetricAmbientOcclusion::CheckParameters()
-{
-  // The VTK side: enums, names, the radius before it becomes voxels. The kernel's own
-  // checks (finiteness) keep its wording, with the property's name.
-  std::ostringstream why;
-  const vao::Status iso = this->QueryMode == ISO_VALUE ? vao::checkFiniteParameter(this->IsoValue, "IsoValue")
-                                                       : vao::Status::success();
-  if (!std::isfinite(this->Radius) || this->Radius < 0.0)
-    why << "Radius must be a finite, non-negative number (got " << this->Radius << ").";
-  else if (this->Method < CDF_RECONSTRUCTION || this->Method > HISTOGRAM_CDF)
-    why << "Unknown Method " << this->Method
-        << " (0 CDF Reconstruction, 1 Gaussian CDF, 2 Chebyshev, 3 Exact Box, 4 Exact Sphere, 5 Histogram CDF).";
-  else if (this->Method == HISTOGRAM_CDF && !vao::checkHistogramBins(this->NumberOfBins).empty())
-    why << vao::checkHistogramBins(this->NumberOfBins) << ".";
-  else if (this->RadiusUnits != VOXELS && this->RadiusUnits != WORLD)
-    why << "Unknown RadiusUnits " << this->RadiusUnits << " (0 Voxels, 1 World).";
-  else if (this->QueryMode < VOXEL_VALUE || this->QueryMode > SMOOTHED_VALUE)
-    why << "Unknown QueryMode " << this->QueryMode << " (0 Voxel Value, 1 Iso Value, 2 Smoothed Voxel Value).";
-  else if (this->QueryMode == SMOOTHED_VALUE && !vao::checkQuerySmoothing(this->QuerySmoothing).empty())
-    why << vao::checkQuerySmoothing(this->QuerySmoothing) << ".";
-  else if (!iso.ok)
-    why << iso.message << ".";
-  else if (this->ErfApproximation != ERF_EXACT && this->ErfApproximation != ERF_WINITZKI)
-    why << "Unknown ErfApproximation " << this->ErfApproximation << " (0 Exact, 1 Winitzki).";
-  else if (this->Backend < BACKEND_AUTO || this->Backend > BACKEND_CUDA)
-    why << "Unknown Backend " << this->Backend << " (0 Auto, 1 CPU, 2 CUDA).";
-  else if (this->Device < -1)
-    why << "Device must be -1 (each MPI rank takes its node-local rank modulo the devices) or a device index, got "
-        << this->Device << ".";
-  else if (this->NumberOfThreads < 0)
-    why << vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
-  else if (this->OutputArrayName.empty())
-    why << "OutputArrayName must not be empty.";
-  else if (this->ComputeVariance && this->OutputArrayName == "Variance")
-    why << "OutputArrayName 'Variance' is the name of the variance output (ComputeVariance), which would replace "
-           "it: choose another name.";
-  if (why.tellp() == 0)
-  {
-    return true;
-  }
-  vtkErrorMacro(<< why.str());
-  return false;
 }
 
 //------------------------------------------------------------------------------
@@ -251,16 +220,84 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumetricAmbientOcclusion::CheckInputCovers(vtkImageData* input, const int outExt[6])
+int vtkVolumetricAmbientOcclusion::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  const int* inExt = input->GetExtent();
-  for (int a = 0; a < 3; ++a)
+  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
+  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
+  // output, not an abort.
+  return vtkAmbientOcclusionMemory::Guard(this, output,
+    "compute it in pieces (streaming or more MPI ranks), on a smaller extent, or without ComputeVariance.", [&]() -> int {
+    const int result = this->ProduceOutput(inputVector, outputVector);
+    vtkAmbientOcclusionRanges::CacheOutput(output);
+    return result;
+  });
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumetricAmbientOcclusion::ProduceOutput(
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkImageData* input = vtkImageData::GetData(inputVector[0]);
+  vtkImageData* output = vtkImageData::GetData(outputVector);
+  output->Initialize();
+  this->LastBackend.clear();
+  this->LastDevice.clear();
+  if (!this->CheckParameters()) // the same on every process
   {
-    if (outExt[2 * a] < inExt[2 * a] || outExt[2 * a + 1] > inExt[2 * a + 1] || outExt[2 * a] > outExt[2 * a + 1])
+    return 1;
+  }
+  Run run;
+  std::string error;
+  if (input &&
+    !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, run.whole, run.outExt, error))
+  {
+    vtkErrorMacro(<< error);
+    return 1; // the whole extent is the same on every process
+  }
+  const bool ok = this->ReadInput(input, inputVector, run);
+  // Collective in a distributed run: every process takes part, also one that failed above
+  // (it says so, and every process then stops) or holds an empty piece.
+  if (this->Method == HISTOGRAM_CDF && (ok || this->IsDistributed()) &&
+    !this->Thresholds(input, ok ? &run.scalars.view : nullptr, run.scan, run.outExt, run.whole,
+      !ok && !run.emptyPiece, run.thresholds))
+  {
+    return 1;
+  }
+  if (ok && this->ComputeArrays(input, run))
+  {
+    this->AssembleOutput(input, output, run);
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumetricAmbientOcclusion::ReadInput(vtkImageData* input, vtkInformationVector** inputVector, Run& run)
+{
+  // An empty piece of a distributed data set (e.g. MetaImage on rank > 0) has nothing
+  // to compute, but still takes part in the thresholds of Histogram CDF.
+  run.emptyPiece = input && input->GetNumberOfPoints() == 0;
+  if (!input || run.emptyPiece || !this->CheckInputCovers(input, run.outExt) ||
+    !this->CheckVoxelRadius(input, run.whole, run.radius))
+  {
+    return false;
+  }
+  std::string error;
+  if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
+        this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, run.scalars, error))
+  {
+    vtkErrorMacro(<< error);
+    return false;
+  }
+  if (this->Method == HISTOGRAM_CDF && !this->HistogramThresholds)
+  {
+    // One pass for the thresholds' value range and, before them (they count finite
+    // values only), the kernel's own message for NaN and infinite voxels.
+    run.scan = vao::scanValues(run.scalars.view);
+    const vao::Status finite = vao::finiteStatus(run.scan);
+    if (!finite.ok)
     {
-      vtkErrorMacro(<< "The input extent (" << inExt[0] << ".." << inExt[1] << ", " << inExt[2] << ".."
-                    << inExt[3] << ", " << inExt[4] << ".." << inExt[5]
-                    << ") does not cover the requested extent: the upstream source ignored the request.");
+      vtkErrorMacro(<< vtkAmbientOcclusionArrayInput::KernelError(finite, run.scalars, "Ambient occlusion failed"));
       return false;
     }
   }
@@ -268,153 +305,73 @@ bool vtkVolumetricAmbientOcclusion::CheckInputCovers(vtkImageData* input, const 
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumetricAmbientOcclusion::CheckVoxelRadius(vtkImageData* input, const int whole[6], int radius[3])
+bool vtkVolumetricAmbientOcclusion::ComputeArrays(vtkImageData* input, Run& run)
 {
-  const int wholeDims[3] = { whole[1] - whole[0] + 1, whole[3] - whole[2] + 1, whole[5] - whole[4] + 1 };
-  const double* h = input->GetSpacing();
-  if (this->RadiusUnits == WORLD &&
-    !(std::isfinite(h[0]) && h[0] > 0.0 && std::isfinite(h[1]) && h[1] > 0.0 && std::isfinite(h[2]) && h[2] > 0.0))
+  vao::Region region;
+  for (int a = 0; a < 3; ++a)
   {
-    vtkErrorMacro(<< "A radius in world units needs a finite, positive spacing on every axis; the input's is "
-                  << h[0] << ", " << h[1] << ", " << h[2]
-                  << ". Fix the spacing (e.g. with Change Spacing) or give the radius in voxels.");
-    return false;
+    region.begin[a] = run.outExt[2 * a] - input->GetExtent()[2 * a];
+    region.size[a] = run.outExt[2 * a + 1] - run.outExt[2 * a] + 1;
   }
-  this->ComputeVoxelRadius(h, radius);
-  if (radius[0] == 0 && radius[1] == 0 && radius[2] == 0)
+  run.openness = NewFloatArray(this->OutputArrayName.c_str(), region.voxelCount());
+  run.variance = this->ComputeVariance ? NewFloatArray("Variance", region.voxelCount()) : nullptr;
+  run.parameters = this->Parameters(run.radius);
+  run.parameters.thresholds = std::move(run.thresholds);
+  const vao::Status status = this->Compute(run.scalars.view, region, run.parameters,
+    { run.openness->GetPointer(0), run.variance ? run.variance->GetPointer(0) : nullptr, &run.range });
+  if (!status.ok)
   {
-    vtkErrorMacro(<< "Radius " << this->Radius << (this->RadiusUnits == WORLD ? " (world units)" : "")
-                  << " rounds to 0 voxels on every axis: the neighbourhood would be the voxel alone "
-                     "and the ambient occlusion 1 everywhere. Use at least one voxel.");
-    return false;
-  }
-  if (radius[0] >= wholeDims[0] - 1 && radius[1] >= wholeDims[1] - 1 && radius[2] >= wholeDims[2] - 1)
-  {
-    vtkErrorMacro(<< "Radius " << this->Radius << " (" << radius[0] << " x " << radius[1] << " x "
-                  << radius[2] << " voxels) covers the whole " << wholeDims[0] << " x " << wholeDims[1]
-                  << " x " << wholeDims[2] << " volume from every voxel: every neighbourhood "
-                  << "would be the whole volume. Use a smaller radius.");
+    const std::string error =
+      vtkAmbientOcclusionArrayInput::KernelError(status, run.scalars, "Ambient occlusion failed");
+    if (!error.empty())
+    {
+      vtkErrorMacro(<< error);
+    }
     return false;
   }
   return true;
 }
 
 //------------------------------------------------------------------------------
-int vtkVolumetricAmbientOcclusion::RequestData(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+void vtkVolumetricAmbientOcclusion::AssembleOutput(vtkImageData* input, vtkImageData* output, const Run& run)
 {
-  // Allocation failure anywhere below is an error and an empty output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, vtkDataObject::GetData(outputVector, 0),
-    "compute it in pieces (streaming or more MPI ranks), on a smaller extent, or without ComputeVariance.", [&]() -> int {
-    vtkImageData* input = vtkImageData::GetData(inputVector[0]);
-    vtkImageData* output = vtkImageData::GetData(outputVector);
-    output->Initialize();
-    this->LastBackend.clear();
-    this->LastDevice.clear();
-    if (!this->CheckParameters()) // the same on every process
-    {
-      return 1;
-    }
-    int whole[6], outExt[6], radius[3];
-    std::string error;
-    bool ok = input != nullptr;
-    if (ok && !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, whole, outExt, error))
-    {
-      vtkErrorMacro(<< error);
-      return 1; // the whole extent is the same on every process
-    }
-    // An empty piece of a distributed data set (e.g. MetaImage on rank > 0) has nothing
-    // to compute, but still takes part in the thresholds of Histogram CDF.
-    const bool emptyPiece = ok && input->GetNumberOfPoints() == 0;
-    ok = ok && !emptyPiece && this->CheckInputCovers(input, outExt) && this->CheckVoxelRadius(input, whole, radius);
-    vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
-    if (ok &&
-      !vtkAmbientOcclusionArrayInput::PrepareScalars(
-        this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error))
-    {
-      vtkErrorMacro(<< error);
-      ok = false;
-    }
-    vao::ValueScan scan;
-    if (ok && this->Method == HISTOGRAM_CDF && !this->HistogramThresholds)
-    {
-      // One pass for the thresholds' value range and, before them (they count finite
-      // values only), the kernel's own message for NaN and infinite voxels.
-      scan = vao::scanValues(scalars.view);
-      const vao::Status finite = vao::finiteStatus(scan);
-      if (!finite.ok)
-      {
-        vtkErrorMacro(<< vtkAmbientOcclusionArrayInput::KernelError(finite, scalars, "Ambient occlusion failed"));
-        ok = false;
-      }
-    }
-    std::vector<double> thresholds;
-    if (this->Method == HISTOGRAM_CDF && (ok || this->IsDistributed()) &&
-      !this->Thresholds(input, ok ? &scalars.view : nullptr, scan, outExt, whole, !ok && !emptyPiece, thresholds))
-    {
-      return 1;
-    }
-    if (!ok)
-    {
-      return 1;
-    }
+  // The output is exactly the requested extent: the input's arrays cropped to it.
+  vtkAmbientOcclusionExtents::CopyRequestedExtent(input, output, run.outExt);
+  output->GetPointData()->AddArray(run.openness);
+  if (run.range.known)
+    vtkAmbientOcclusionRanges::CacheKnown(run.openness, run.range.lowest, run.range.highest);
+  if (run.variance)
+  {
+    output->GetPointData()->AddArray(run.variance);
+  }
+  this->RecordRun(output, run.parameters.thresholds);
+}
 
-    vao::Region region;
-    for (int a = 0; a < 3; ++a)
-    {
-      region.begin[a] = outExt[2 * a] - input->GetExtent()[2 * a];
-      region.size[a] = outExt[2 * a + 1] - outExt[2 * a] + 1;
-    }
-    auto openness = NewFloatArray(this->OutputArrayName.c_str(), region.voxelCount());
-    auto variance = this->ComputeVariance ? NewFloatArray("Variance", region.voxelCount()) : nullptr;
-    vao::AmbientOcclusionParameters parameters = this->Parameters(radius);
-    parameters.thresholds = std::move(thresholds);
-    vao::OutputRange range; // kept by the pass, so that the range cache need not scan
-    const vao::Status status = this->Compute(scalars.view, region, parameters,
-      { openness->GetPointer(0), variance ? variance->GetPointer(0) : nullptr, &range });
-    if (!status.ok)
-    {
-      error = vtkAmbientOcclusionArrayInput::KernelError(status, scalars, "Ambient occlusion failed");
-      if (!error.empty())
-      {
-        vtkErrorMacro(<< error);
-      }
-      return 1;
-    }
-
-    // The output is exactly the requested extent: the input's arrays cropped to it.
-    vtkAmbientOcclusionExtents::CopyRequestedExtent(input, output, outExt);
-    output->GetPointData()->AddArray(openness);
-    if (range.known)
-      vtkAmbientOcclusionRanges::CacheKnown(openness, range.lowest, range.highest);
-    if (variance)
-    {
-      output->GetPointData()->AddArray(variance);
-    }
-    if (this->Method == HISTOGRAM_CDF)
-    {
-      vtkNew<vtkDoubleArray> used; // for a later run to reuse, e.g. on other pieces
-      used->SetName("HistogramThresholds");
-      for (const double t : parameters.thresholds)
-        used->InsertNextValue(t);
-      output->GetFieldData()->AddArray(used);
-    }
-    vtkNew<vtkStringArray> backend;
-    backend->SetName("AmbientOcclusionBackend");
-    backend->InsertNextValue(this->LastBackend);
-    output->GetFieldData()->AddArray(backend);
-    vtkNew<vtkStringArray> device;
-    device->SetName("AmbientOcclusionDevice");
-    device->InsertNextValue(this->LastDevice);
-    output->GetFieldData()->AddArray(device);
-    // The CPU threads this process used (or would have used, on the GPU backend): under
-    // MPI the cores are shared among the node's ranks.
-    vtkNew<vtkIntArray> threads;
-    threads->SetName("AmbientOcclusionThreads");
-    threads->InsertNextValue(vao::threadCount(this->NumberOfThreads));
-    output->GetFieldData()->AddArray(threads);
-    return 1;
-  });
+//------------------------------------------------------------------------------
+void vtkVolumetricAmbientOcclusion::RecordRun(vtkImageData* output, const std::vector<double>& thresholds)
+{
+  if (this->Method == HISTOGRAM_CDF)
+  {
+    vtkNew<vtkDoubleArray> used; // for a later run to reuse, e.g. on other pieces
+    used->SetName("HistogramThresholds");
+    for (const double t : thresholds)
+      used->InsertNextValue(t);
+    output->GetFieldData()->AddArray(used);
+  }
+  vtkNew<vtkStringArray> backend;
+  backend->SetName("AmbientOcclusionBackend");
+  backend->InsertNextValue(this->LastBackend);
+  output->GetFieldData()->AddArray(backend);
+  vtkNew<vtkStringArray> device;
+  device->SetName("AmbientOcclusionDevice");
+  device->InsertNextValue(this->LastDevice);
+  output->GetFieldData()->AddArray(device);
+  // The CPU threads this process used (or would have used, on the GPU backend): under
+  // MPI the cores are shared among the node's ranks.
+  vtkNew<vtkIntArray> threads;
+  threads->SetName("AmbientOcclusionThreads");
+  threads->InsertNextValue(vao::threadCount(this->NumberOfThreads));
+  output->GetFieldData()->AddArray(threads);
 }
 
 //------------------------------------------------------------------------------

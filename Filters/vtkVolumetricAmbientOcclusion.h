@@ -33,6 +33,12 @@
  * cumulative distribution: replace them first), empty, 1-voxel or 2-D images, a radius
  * below one voxel on every axis, a negative or non-finite radius, a box that covers the
  * whole volume on every axis (every voxel would get the same neighbourhood).
+ *
+ * Threads: the filter computes on its own pool of threads, NumberOfThreads of them (0,
+ * the default: the cores this process may use; under MPI, its share of the node's cores).
+ * VTK's SMP settings (vtkSMPTools, VTK_SMP_MAX_THREADS, VTK_SMP_BACKEND_IN_USE) do not
+ * apply: the default SMP backend of Debian 12's VTK 9.2 and ParaView 5.11 is Sequential
+ * (one thread), and the kernels the filter runs are a library that builds without VTK.
  */
 #ifndef vtkVolumetricAmbientOcclusion_h
 #define vtkVolumetricAmbientOcclusion_h
@@ -249,6 +255,24 @@ private:
   vtkVolumetricAmbientOcclusion(const vtkVolumetricAmbientOcclusion&) = delete;
   void operator=(const vtkVolumetricAmbientOcclusion&) = delete;
 
+  /// One RequestData's state, filled by its steps in turn (defined in the .cxx).
+  struct Run;
+  /// RequestData's body, inside its memory guard: the steps below in turn.
+  int ProduceOutput(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
+  /// Checks this process's input against the request and reads its scalars (scanned for
+  /// Histogram CDF's value range): false, with the error, when this process has nothing
+  /// to compute (also an empty piece, which still takes part in the thresholds).
+  bool ReadInput(vtkImageData* input, vtkInformationVector** inputVector, Run& run);
+  /// Runs the kernel on the requested extent into new output arrays, on the backend
+  /// Compute chooses; false, with the kernel's error, when it fails.
+  bool ComputeArrays(vtkImageData* input, Run& run);
+  /// The output: the input's arrays cropped to the requested extent (the output is exactly
+  /// that extent), the computed arrays, and the run's record (RecordRun).
+  void AssembleOutput(vtkImageData* input, vtkImageData* output, const Run& run);
+  /// The run in the output's field data, for the user and for later runs: Histogram CDF's
+  /// thresholds (to reuse on other pieces), the backend and device that ran, the threads.
+  void RecordRun(vtkImageData* output, const std::vector<double>& thresholds);
+
   bool CheckParameters();
   /// The kernel's parameters for a radius in voxels (CheckParameters passed).
   vao::AmbientOcclusionParameters Parameters(const int radius[3]) const;
@@ -258,7 +282,7 @@ private:
   /// Histogram CDF in a distributed run: the thresholds come from every process's piece.
   bool IsDistributed() const;
   /// Histogram CDF's thresholds for this run: the given ones, or the whole data set's
-  /// (collective in a distributed run; see RequestData).
+  /// (collective in a distributed run; see ProduceOutput).
   bool Thresholds(vtkImageData* input, const vao::VolumeView* volume, const vao::ValueScan& scan,
     const int outExt[6], const int whole[6], bool failed, std::vector<double>& thresholds);
   /// The input covers the requested extent `outExt`.

@@ -100,9 +100,15 @@ bool vtkVolumetricAmbientOcclusion::Thresholds(vtkImageData* input, const vao::V
     // Distributed: each process counts its output piece (together they tile the data
     // set); one process counts its input, which is the whole extent.
     const bool distributed = this->IsDistributed();
-    const bool computed = vtkAmbientOcclusionThresholds::Compute(distributed ? this->Controller.Get() : nullptr,
-      volume, scan, volume ? input->GetExtent() : outExt, distributed || !volume ? outExt : input->GetExtent(), whole,
-      this->NumberOfBins, failed, thresholds, error);
+    vtkAmbientOcclusionThresholds::Piece piece;
+    piece.volume = volume;
+    piece.scan = &scan;
+    piece.inExt = volume ? input->GetExtent() : outExt;
+    piece.outExt = distributed || !volume ? outExt : input->GetExtent();
+    piece.whole = whole;
+    piece.failed = failed;
+    const bool computed = vtkAmbientOcclusionThresholds::Compute(
+      distributed ? this->Controller.Get() : nullptr, piece, this->NumberOfBins, thresholds, error);
     if (!computed && error.empty())
       return false; // aborted, or this process failed and said why before
   }

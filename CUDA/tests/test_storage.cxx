@@ -45,7 +45,7 @@ TEST(Storage, ResizeKeepsTheBlockOfTheSameSizeAndCopiesAreDeep)
   int* owned = c.release();
   EXPECT_TRUE(c.empty());
   EXPECT_EQ(owned[1], 7);
-  vao::detail::freeStorage(owned);
+  vao::freeStorage(owned);
   c.resize(0);
   EXPECT_EQ(c.data(), nullptr);
 }
@@ -60,7 +60,7 @@ TEST(Storage, SizesBeyondMemoryThrowAndLeaveTheArray)
   EXPECT_THROW(a.resize(std::numeric_limits<std::size_t>::max() / 4), std::bad_alloc);
   ASSERT_EQ(a.size(), 4u);
   EXPECT_EQ(a[3], 1.5);
-  EXPECT_EQ(vao::detail::allocateStorage(std::numeric_limits<std::size_t>::max() - 4096), nullptr);
+  EXPECT_EQ(vao::allocateStorage(std::numeric_limits<std::size_t>::max() - 4096), nullptr);
 }
 
 #if defined(__linux__)

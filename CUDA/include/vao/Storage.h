@@ -12,12 +12,21 @@
 
 namespace vao
 {
+/// A block of at least `bytes` bytes for a large array, uninitialised (first touched by
+/// whoever writes it first: the workers, in parallel), or nullptr when it cannot be had;
+/// it never throws. Below 2 MiB the block comes from std::malloc (aligned for any scalar
+/// type; 64 bytes on Windows). From 2 MiB it is aligned to 2 MiB and, on Linux, rounded up
+/// to whole 2 MiB pages and advised to use transparent huge pages (advice the kernel may
+/// ignore, e.g. where THP is off). 0 bytes give a block of 1. Sizes within 2 MiB of
+/// SIZE_MAX, which the rounding would wrap, give nullptr. Free it with freeStorage.
+void* allocateStorage(std::size_t bytes);
+/// Frees a block of allocateStorage (nullptr: nothing). Its signature is that of a VTK
+/// array's free function (vtkAbstractArray::SetArrayFreeFunction), so a VTK array can own
+/// such a block without a copy.
+void freeStorage(void* block) noexcept;
+
 namespace detail
 {
-/// A block of `bytes` (nullptr when it cannot be had), freed with freeStorage. The block
-/// is uninitialised: first touched by whoever writes it first (the workers, in parallel).
-void* allocateStorage(std::size_t bytes);
-void freeStorage(void* block) noexcept;
 /// A zero-filled reservation of `bytes` whose 4 KiB pages take memory only once written
 /// (nullptr when it cannot be had): for data kept sparsely at fixed places, such as the
 /// tiles of a level built on demand. Never backed by huge pages, which would fill in 2 MiB
@@ -34,7 +43,7 @@ bool prepareSparseStorage(void* at, std::size_t bytes) noexcept;
 /// An array of T in storage. resize leaves the elements uninitialised: the kernels write
 /// every one, in parallel, so a fresh array is first touched by the threads that fill it
 /// instead of by one serial zero-fill. release() hands the block to a new owner (a VTK
-/// array, without a copy), who frees it with detail::freeStorage.
+/// array, without a copy), who frees it with freeStorage.
 template <class T>
 class StorageArray
 {
@@ -44,7 +53,7 @@ public:
   StorageArray() = default;
   StorageArray(const StorageArray& other) { *this = other; }
   StorageArray(StorageArray&& other) noexcept { this->swap(other); }
-  ~StorageArray() { detail::freeStorage(this->Data); }
+  ~StorageArray() { freeStorage(this->Data); }
   StorageArray& operator=(const StorageArray& other)
   {
     if (this != &other)
@@ -76,12 +85,12 @@ public:
     if (n > 0)
     {
       block = n <= static_cast<std::size_t>(-1) / sizeof(T)
-        ? static_cast<T*>(detail::allocateStorage(n * sizeof(T)))
+        ? static_cast<T*>(allocateStorage(n * sizeof(T)))
         : nullptr;
       if (!block)
         throw std::bad_alloc();
     }
-    detail::freeStorage(this->Data);
+    freeStorage(this->Data);
     this->Data = block;
     this->Size = n;
   }

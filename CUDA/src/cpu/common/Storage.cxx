@@ -15,8 +15,6 @@
 
 namespace vao
 {
-namespace detail
-{
 
 void* allocateStorage(std::size_t bytes)
 {
@@ -52,6 +50,9 @@ void freeStorage(void* block) noexcept
   std::free(block);
 #endif
 }
+
+namespace detail
+{
 
 void* allocateSparseStorage(std::size_t bytes)
 {
