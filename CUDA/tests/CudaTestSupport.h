@@ -2,6 +2,7 @@
 // reference) and the skip where there is no device.
 #pragma once
 
+#include "ResultComparison.h"
 #include "TestVolumes.h"
 
 #include "vao/Cuda.h"
@@ -30,11 +31,6 @@ namespace vaotest
 
 constexpr double kStatsTolerance = 1e-5;    // relative, for mean and variance
 constexpr double kOpennessTolerance = 1e-5; // absolute
-
-inline bool closeRelative(double a, double b, double tolerance)
-{
-  return std::abs(a - b) <= tolerance * std::max(1.0, std::abs(b));
-}
 
 inline std::string describe(const vao::Radius& r)
 {
@@ -82,19 +78,6 @@ inline vao::Index3 voxelOf(const vao::Region& region, std::int64_t k)
   const std::int64_t z = k / (region.size[0] * region.size[1]);
   return { region.begin[0] + x, region.begin[1] + y, region.begin[2] + z };
 }
-
-struct StatsArrays
-{
-  std::vector<double> count, mean, variance, minimum, maximum;
-  explicit StatsArrays(std::int64_t n, double fill)
-    : count(n, fill), mean(n, fill), variance(n, fill), minimum(n, fill), maximum(n, fill)
-  {
-  }
-  vao::BoxStatisticsOutput output()
-  {
-    return { count.data(), mean.data(), variance.data(), minimum.data(), maximum.data() };
-  }
-};
 
 /// GPU box statistics of the region against the CPU's: count, minimum and maximum
 /// exactly, mean and variance to kStatsTolerance (relative).

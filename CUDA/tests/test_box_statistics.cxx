@@ -1,4 +1,5 @@
 // The separable box statistics against a brute-force reference.
+#include "ResultComparison.h"
 #include "TestVolumes.h"
 
 #include <gtest/gtest.h>
@@ -7,24 +8,6 @@ using namespace vaotest;
 
 namespace
 {
-
-struct StatsArrays
-{
-  std::vector<double> count, mean, variance, minimum, maximum;
-  explicit StatsArrays(std::int64_t n)
-    : count(n), mean(n), variance(n), minimum(n), maximum(n)
-  {
-  }
-  vao::BoxStatisticsOutput output()
-  {
-    return { count.data(), mean.data(), variance.data(), minimum.data(), maximum.data() };
-  }
-};
-
-bool closeRelative(double a, double b, double tolerance)
-{
-  return std::abs(a - b) <= tolerance * std::max(1.0, std::abs(b));
-}
 
 /// Checks every voxel of `region` against brute force: min/max exact, the rest to 1e-9.
 template <class T>

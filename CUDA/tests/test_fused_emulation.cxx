@@ -6,13 +6,13 @@
 // against the CPU library are in test_pipeline_emulation.cxx, and test_cuda.cxx checks the
 // real device where there is one.
 #include "PipelineEmulation.h"
+#include "ResultComparison.h"
 
 #include "vao/AmbientOcclusion.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 
 using namespace vaotest;
 using vao::gpu::Index;
@@ -21,12 +21,6 @@ namespace
 {
 
 const vao::gpu::EstimatorSetting kStatistics{ vao::Method::GaussianCdf, vao::QueryMode::VoxelValue, 0, vao::ErfMode::Exact };
-
-template <class U>
-bool sameBits(const std::vector<U>& a, const std::vector<U>& b)
-{
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(U)) == 0);
-}
 
 } // namespace
 

@@ -5,6 +5,7 @@
 // the integer loops to bit equality). On a processor without AVX2 or AVX-512 the higher
 // tiers fall back to the ones below, and the comparisons still run.
 #include "PyramidTestSupport.h"
+#include "ResultComparison.h"
 
 #include "cpu/simd/CpuDispatch.h"
 #include "cpu/box_statistics/RunningTotals.h"
@@ -13,7 +14,6 @@
 
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <random>
 
 using namespace vaotest;
@@ -30,12 +30,6 @@ struct TierCap
   explicit TierCap(SimdTier limit) { vao::detail::limitSimdTier(limit); }
   ~TierCap() { vao::detail::limitSimdTier(SimdTier::Avx512); }
 };
-
-template <class T>
-bool sameBits(const std::vector<T>& a, const std::vector<T>& b)
-{
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
 
 template <class T>
 std::vector<vao::MomentLevel> pyramidAtTier(SimdTier tier, const std::vector<T>& v, const vao::Index3& d, bool half)

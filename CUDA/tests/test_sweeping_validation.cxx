@@ -1,5 +1,6 @@
 // Occlusion sweeping against Monte-Carlo ray-traced ambient occlusion on the validation
 // scene of the paper's Fig. 3 (a floor with boxes and spheres, 100^3), generated here.
+#include "MonteCarloOcclusion.h"
 #include "SweepScene.h"
 #include "vao/OcclusionSweeping.h"
 
@@ -34,47 +35,22 @@ std::array<double, 3> SceneNormal(double x, double y, double z)
   return n;
 }
 
-/// Fraction of `rays` cosine-weighted rays from the point (just off the surface) that
-/// leave the volume without entering the scene: the ambient occlusion of Eq. 2 / pi.
-double MonteCarloAO(double x, double y, double z, int rays, std::mt19937& rng)
+/// Whether the ray from (x, y, z) + n / 2 (just off the surface) along d enters the scene
+/// before it leaves the volume.
+bool Blocked(double x, double y, double z, const std::array<double, 3>& n, const double d[3])
 {
-  const auto n = SceneNormal(x, y, z);
-  // An orthonormal frame around n.
-  const std::array<double, 3> helper = std::abs(n[0]) < 0.9 ? std::array<double, 3>{ 1, 0, 0 } : std::array<double, 3>{ 0, 1, 0 };
-  std::array<double, 3> t = { n[1] * helper[2] - n[2] * helper[1], n[2] * helper[0] - n[0] * helper[2],
-    n[0] * helper[1] - n[1] * helper[0] };
-  const double tl = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-  for (double& c : t)
-    c /= tl;
-  const std::array<double, 3> b = { n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0] };
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  int open = 0;
-  for (int ray = 0; ray < rays; ++ray)
+  double px = x + 0.5 * n[0], py = y + 0.5 * n[1], pz = z + 0.5 * n[2];
+  while (px >= 0 && py >= 0 && pz >= 0 && px <= kSize - 1 && py <= kSize - 1 && pz <= kSize - 1)
   {
-    // Cosine-weighted: uniform on the disk, lifted to the hemisphere.
-    const double u1 = uniform(rng), u2 = uniform(rng);
-    const double r = std::sqrt(u1), phi = 2 * M_PI * u2;
-    const double a = r * std::cos(phi), c = r * std::sin(phi), h = std::sqrt(std::max(0.0, 1 - u1));
-    const std::array<double, 3> d = { a * t[0] + c * b[0] + h * n[0], a * t[1] + c * b[1] + h * n[1],
-      a * t[2] + c * b[2] + h * n[2] };
-    double px = x + 0.5 * n[0], py = y + 0.5 * n[1], pz = z + 0.5 * n[2];
-    bool blocked = false;
-    while (px >= 0 && py >= 0 && pz >= 0 && px <= kSize - 1 && py <= kSize - 1 && pz <= kSize - 1)
-    {
-      const double distance = SceneDistance(px, py, pz);
-      if (distance < 0)
-      {
-        blocked = true;
-        break;
-      }
-      const double step = std::max(0.25, distance); // sphere tracing: never steps over the scene
-      px += step * d[0];
-      py += step * d[1];
-      pz += step * d[2];
-    }
-    open += blocked ? 0 : 1;
+    const double distance = SceneDistance(px, py, pz);
+    if (distance < 0)
+      return true;
+    const double step = std::max(0.25, distance); // sphere tracing: never steps over the scene
+    px += step * d[0];
+    py += step * d[1];
+    pz += step * d[2];
   }
-  return static_cast<double>(open) / rays;
+  return false;
 }
 
 TEST(SweepValidation, AgreesWithMonteCarloRayTracedAmbientOcclusionOnTheFig3Scene)
@@ -108,26 +84,13 @@ TEST(SweepValidation, AgreesWithMonteCarloRayTracedAmbientOcclusionOnTheFig3Scen
         if (d <= 0.0 || d >= 1.0)
           continue;
         swept.push_back(ao[(z * kSize + y) * kSize + x]);
-        traced.push_back(MonteCarloAO(x, y, z, 128, rng));
+        const auto normal = SceneNormal(x, y, z);
+        traced.push_back(vaotest::MonteCarloAO(normal.data(), 128, rng,
+          [&](const double direction[3]) { return Blocked(x, y, z, normal, direction); }));
       }
   ASSERT_GT(swept.size(), 3000u);
-  const double n = static_cast<double>(swept.size());
-  double ms = 0, mt = 0;
-  for (size_t i = 0; i < swept.size(); ++i)
-  {
-    ms += swept[i];
-    mt += traced[i];
-  }
-  ms /= n;
-  mt /= n;
-  double sst = 0, sss = 0, stt = 0;
-  for (size_t i = 0; i < swept.size(); ++i)
-  {
-    sst += (swept[i] - ms) * (traced[i] - mt);
-    sss += (swept[i] - ms) * (swept[i] - ms);
-    stt += (traced[i] - mt) * (traced[i] - mt);
-  }
-  const double correlation = sst / std::sqrt(sss * stt);
+  const vaotest::Agreement agreement = vaotest::AgreementOf(swept, traced);
+  const double correlation = agreement.correlation, ms = agreement.meanEstimate, mt = agreement.meanReference;
   std::cout << swept.size() << " surface voxels: correlation " << correlation << ", mean sweeping " << ms
             << ", mean Monte Carlo " << mt << ", mean difference " << ms - mt << std::endl;
   EXPECT_GT(correlation, kMinimumCorrelation);

@@ -2,6 +2,7 @@
 // from docs/methods.md section 10 with its own piecewise-linear opacity (the library's
 // evaluation of VTK's curves is checked against vtkPiecewiseFunction itself in
 // Testing/Cxx/TestTransferFunctionAO.cxx).
+#include "ResultComparison.h"
 #include "TestVolumes.h"
 
 #include "vao/AmbientOcclusion.h"
@@ -129,10 +130,7 @@ void checkStepIsExactBox(double lo, double hi, double c)
   ob.openness = b.data();
   ASSERT_TRUE(vao::computeAmbientOcclusion(view, region, tf, oa).ok);
   ASSERT_TRUE(vao::computeAmbientOcclusion(view, region, box, ob).ok);
-  std::int64_t differing = 0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    differing += std::memcmp(&a[i], &b[i], sizeof(float)) != 0;
-  EXPECT_EQ(differing, 0);
+  EXPECT_TRUE(vaotest::sameBits(a, b));
 }
 
 TEST(TransferFunction, StepEqualsExactBoxIsoQueryBitForBit)
@@ -164,7 +162,7 @@ TEST(TransferFunction, SameBitsOnAnyThreadCount)
     results.push_back(out);
   }
   for (std::size_t k = 1; k < results.size(); ++k)
-    EXPECT_EQ(0, std::memcmp(results[0].data(), results[k].data(), results[0].size() * sizeof(float)));
+    EXPECT_TRUE(vaotest::sameBits(results[0], results[k])) << "threads differ";
 }
 
 TEST(TransferFunction, RefusesBadFunctions)

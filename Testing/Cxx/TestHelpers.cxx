@@ -6,6 +6,7 @@
 #include "vtkPointData.h"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -59,6 +60,18 @@ void SetDensity(vtkImageData* image, vtkDataArray* values, const std::function<d
       for (int i = 0; i < d[0]; ++i, ++id)
         values->SetComponent(id, 0, f(i, j, k));
   image->GetPointData()->SetScalars(values);
+}
+
+vtkSmartPointer<vtkImageData> Ball(vtkDataArray* values, const std::array<int, 3>& dims,
+  const std::array<double, 3>& centre, double radius, const std::function<double(bool, int, int, int)>& value)
+{
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(dims[0], dims[1], dims[2]);
+  SetDensity(image, values, [&](int i, int j, int k) {
+    const double dx = i - centre[0], dy = j - centre[1], dz = k - centre[2];
+    return value(std::sqrt(dx * dx + dy * dy + dz * dz) < radius, i, j, k);
+  });
+  return image;
 }
 
 vtkSmartPointer<vtkDataSet> WithPointArrayResized(vtkDataSet* data, const char* name, vtkIdType tuples)

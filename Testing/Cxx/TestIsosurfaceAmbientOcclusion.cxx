@@ -1,5 +1,6 @@
 // Variance Occlusion Map and Isosurface Ambient Occlusion filters: the pyramid as a
 // multiblock, the cache, shadows, bad input, and Monte-Carlo AO on the CT head's bone.
+#include "MonteCarloOcclusion.h"
 #include "TestHelpers.h"
 
 #include "vtkAmbientOcclusionPhantom.h"
@@ -396,46 +397,23 @@ double Trilinear(vtkImageData* volume, const double p[3])
   return sum;
 }
 
-/// Fraction of cosine-weighted rays from p (outward normal n) that travel `reach`
-/// without entering material above `iso`, or leave the volume.
-double MonteCarloAO(vtkImageData* volume, double iso, const double p[3], const double n[3], double reach, int rays,
-  std::mt19937& rng)
+/// Whether the ray from p along d meets material above `iso` within `reach` (marched in
+/// half-voxel steps from one voxel out) before it leaves the volume.
+bool Blocked(vtkImageData* volume, double iso, const double p[3], const double d[3], double reach)
 {
   const double h = volume->GetSpacing()[0];
   double bounds[6];
   volume->GetBounds(bounds);
-  const double helper[3] = { std::abs(n[0]) < 0.9 ? 1.0 : 0.0, std::abs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0 };
-  double t[3] = { n[1] * helper[2] - n[2] * helper[1], n[2] * helper[0] - n[0] * helper[2],
-    n[0] * helper[1] - n[1] * helper[0] };
-  const double tl = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-  for (double& c : t)
-    c /= tl;
-  const double b[3] = { n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0] };
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  int open = 0;
-  for (int ray = 0; ray < rays; ++ray)
+  for (double s = h; s <= reach; s += 0.5 * h)
   {
-    const double u1 = uniform(rng), phi = 2 * M_PI * uniform(rng);
-    const double r = std::sqrt(u1), up = std::sqrt(std::max(0.0, 1 - u1));
-    double d[3];
-    for (int a = 0; a < 3; ++a)
-      d[a] = r * std::cos(phi) * t[a] + r * std::sin(phi) * b[a] + up * n[a];
-    bool blocked = false;
-    for (double s = h; s <= reach; s += 0.5 * h)
-    {
-      const double q[3] = { p[0] + s * d[0], p[1] + s * d[1], p[2] + s * d[2] };
-      if (q[0] < bounds[0] || q[0] > bounds[1] || q[1] < bounds[2] || q[1] > bounds[3] || q[2] < bounds[4] ||
-        q[2] > bounds[5])
-        break;
-      if (Trilinear(volume, q) > iso)
-      {
-        blocked = true;
-        break;
-      }
-    }
-    open += blocked ? 0 : 1;
+    const double q[3] = { p[0] + s * d[0], p[1] + s * d[1], p[2] + s * d[2] };
+    if (q[0] < bounds[0] || q[0] > bounds[1] || q[1] < bounds[2] || q[1] > bounds[3] || q[2] < bounds[4] ||
+      q[2] > bounds[5])
+      return false;
+    if (Trilinear(volume, q) > iso)
+      return true;
   }
-  return static_cast<double>(open) / rays;
+  return false;
 }
 
 TEST(IsosurfaceAmbientOcclusionFilter, FollowsMonteCarloAmbientOcclusionOnTheCtBoneSurface)
@@ -458,24 +436,11 @@ TEST(IsosurfaceAmbientOcclusionFilter, FollowsMonteCarloAmbientOcclusionOnTheCtB
     bone->GetPoint(i, p);
     normals->GetTuple(i, n);
     penner.push_back(ao->GetComponent(i, 0));
-    traced.push_back(MonteCarloAO(ct, iso, p, n, reach, 128, rng));
+    traced.push_back(
+      MonteCarloAO(n, 128, rng, [&](const double d[3]) { return Blocked(ct, iso, p, d, reach); }));
   }
-  double mp = 0, mt = 0;
-  for (size_t i = 0; i < penner.size(); ++i)
-  {
-    mp += penner[i];
-    mt += traced[i];
-  }
-  mp /= penner.size();
-  mt /= penner.size();
-  double spt = 0, spp = 0, stt = 0;
-  for (size_t i = 0; i < penner.size(); ++i)
-  {
-    spt += (penner[i] - mp) * (traced[i] - mt);
-    spp += (penner[i] - mp) * (penner[i] - mp);
-    stt += (traced[i] - mt) * (traced[i] - mt);
-  }
-  const double correlation = spt / std::sqrt(spp * stt);
+  const Agreement agreement = AgreementOf(penner, traced);
+  const double correlation = agreement.correlation, mp = agreement.meanEstimate, mt = agreement.meanReference;
   std::cout << penner.size() << " bone surface points: correlation " << correlation << ", mean AO " << mp
             << ", Monte Carlo (reach " << reach << " mm) " << mt << std::endl;
   EXPECT_GT(correlation, kMinimumBoneCorrelation);

@@ -24,22 +24,14 @@ using namespace vaotest;
 namespace
 {
 
-/// A ball of radius r voxels (value 100 inside, 0 outside) in an n^3 image.
-vtkSmartPointer<vtkImageData> Ball(int n, double r)
+/// A ball of radius r voxels about the centre of an n^3 short image of spacing 0.5: 100
+/// inside, 0 outside.
+vtkSmartPointer<vtkImageData> CentredBall(int n, double r)
 {
-  auto image = vtkSmartPointer<vtkImageData>::New();
-  image->SetDimensions(n, n, n);
-  image->SetSpacing(0.5, 0.5, 0.5);
-  vtkNew<vtkShortArray> values;
-  values->SetName("Density");
-  values->SetNumberOfTuples(image->GetNumberOfPoints());
   const double c = 0.5 * (n - 1);
-  vtkIdType id = 0;
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i, ++id)
-        values->SetValue(id, std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c)) < r ? 100 : 0);
-  image->GetPointData()->SetScalars(values);
+  auto image = Ball(vtkNew<vtkShortArray>(), { n, n, n }, { c, c, c }, r,
+    [](bool inside, int, int, int) { return inside ? 100 : 0; });
+  image->SetSpacing(0.5, 0.5, 0.5);
   return image;
 }
 
@@ -63,7 +55,7 @@ SweepRun Sweep(vtkImageData* input, const std::function<void(vtkOcclusionSweepin
 
 TEST(OcclusionSweepingFilter, OutputsDistanceOcclusionAndOctants)
 {
-  auto ball = Ball(25, 7.3);
+  auto ball = CentredBall(25, 7.3);
   const SweepRun run = Sweep(ball, [](vtkOcclusionSweeping* f) { f->OutputOctantVisibilityOn(); });
   ASSERT_TRUE(run.errors.empty()) << run.errors[0];
   auto* distance = vtkFloatArray::SafeDownCast(run.output->GetPointData()->GetArray("SignedDistance"));
@@ -118,7 +110,7 @@ TEST(OcclusionSweepingFilter, PiecesEqualTheWholeResult)
 
 TEST(OcclusionSweepingFilter, AnIsoValueOffTheDataWarnsAndGivesAnOpenField)
 {
-  const SweepRun run = Sweep(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(1000); });
+  const SweepRun run = Sweep(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(1000); });
   EXPECT_TRUE(run.errors.empty());
   ASSERT_EQ(run.warnings.size(), 1u);
   EXPECT_NE(run.warnings[0].find("does not cross"), std::string::npos);
@@ -146,13 +138,13 @@ TEST(OcclusionSweepingFilter, RejectsBadInputWithAClearError)
   noArray->SetDimensions(5, 5, 5);
   ExpectRejected(noArray, none, "No numeric point array");
   vtkNew<vtkImageData> flat;
-  flat->DeepCopy(Ball(9, 3));
+  flat->DeepCopy(CentredBall(9, 3));
   flat->SetDimensions(9, 81, 1);
   ExpectRejected(flat, none, "needs a 3-D volume");
   for (vtkIdType tuples : { 7, 728, 730 })
-    ExpectRejected(vtkImageData::SafeDownCast(WithPointArrayResized(Ball(9, 3), "Density", tuples)), none,
+    ExpectRejected(vtkImageData::SafeDownCast(WithPointArrayResized(CentredBall(9, 3), "Density", tuples)), none,
       "Array 'Density' has " + std::to_string(tuples) + " tuples for the input's 729 points");
-  auto nan = Ball(9, 3);
+  auto nan = CentredBall(9, 3);
   vtkNew<vtkFloatArray> values;
   values->DeepCopy(nan->GetPointData()->GetScalars());
   values->SetName("Density");
@@ -160,16 +152,16 @@ TEST(OcclusionSweepingFilter, RejectsBadInputWithAClearError)
   nan->GetPointData()->SetScalars(values);
   ExpectRejected(nan, none, "NaN");
   ExpectRejected(nan, none, "NaN or infinite values (the first at voxel 4, 4, 0)");
-  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(std::nan("")); }, "iso");
-  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfIterations(0); }, "iteration");
-  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetGamma(0); }, "gamma");
-  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetOpacity(1.5); }, "opacity");
-  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetConvergenceTolerance(-1); }, "tolerance");
-  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) {
+  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(std::nan("")); }, "iso");
+  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfIterations(0); }, "iteration");
+  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetGamma(0); }, "gamma");
+  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetOpacity(1.5); }, "opacity");
+  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetConvergenceTolerance(-1); }, "tolerance");
+  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) {
     int none8[8] = { 0, 0, 0, 0, 0, 0, 0, 0 };
     f->SetOctantMask(none8);
   }, "octant");
-  ExpectRejected(Ball(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfThreads(-1); }, "NumberOfThreads");
+  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfThreads(-1); }, "NumberOfThreads");
 }
 
 } // namespace

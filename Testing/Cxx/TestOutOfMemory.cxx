@@ -57,24 +57,11 @@ void LimitAddressSpace(double headroomMb)
 }
 
 /// A 2-valued ball of `n`^3 unsigned chars (small: it exists before the limit).
-vtkSmartPointer<vtkImageData> Ball(int n)
+vtkSmartPointer<vtkImageData> TwoValuedBall(int n)
 {
-  auto image = vtkSmartPointer<vtkImageData>::New();
-  image->SetDimensions(n, n, n);
-  vtkNew<vtkUnsignedCharArray> values;
-  values->SetName("Density");
-  values->SetNumberOfTuples(static_cast<vtkIdType>(n) * n * n);
-  vtkIdType i = 0;
-  for (int z = 0; z < n; ++z)
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x, ++i)
-      {
-        const double r = std::sqrt((x - n / 2.0) * (x - n / 2.0) + (y - n / 2.0) * (y - n / 2.0) +
-          (z - n / 2.0) * (z - n / 2.0));
-        values->SetValue(i, r < n / 3.0 ? 200 : 10);
-      }
-  image->GetPointData()->SetScalars(values);
-  return image;
+  const double c = n / 2.0;
+  return vaotest::Ball(vtkNew<vtkUnsignedCharArray>(), { n, n, n }, { c, c, c }, n / 3.0,
+    [](bool inside, int, int, int) { return inside ? 200 : 10; });
 }
 
 /// Runs the filter (configured by `set`, which gives it an input), expecting an error
@@ -108,7 +95,7 @@ TEST(OutOfMemory, PhantomSource)
 
 TEST(OutOfMemory, VolumetricAmbientOcclusion)
 {
-  const auto large = Ball(400), small = Ball(24); // 64 MB of input; 256 MB of output
+  const auto large = TwoValuedBall(400), small = TwoValuedBall(24); // 64 MB of input; 256 MB of output
   vtkNew<vtkVolumetricAmbientOcclusion> filter;
   filter->SetRadius(2);
   LimitAddressSpace(160);
@@ -121,7 +108,7 @@ TEST(OutOfMemory, VolumetricAmbientOcclusionSmoothedQuery)
 {
   // The output (108 MB) fits; the smoothed query's own buffer, a double per voxel
   // (216 MB), does not: the kernel's shortage, not the output's.
-  const auto large = Ball(300), small = Ball(24);
+  const auto large = TwoValuedBall(300), small = TwoValuedBall(24);
   vtkNew<vtkVolumetricAmbientOcclusion> filter;
   filter->SetRadius(2);
   filter->SetQueryMode(vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE);
@@ -133,7 +120,7 @@ TEST(OutOfMemory, VolumetricAmbientOcclusionSmoothedQuery)
 
 TEST(OutOfMemory, OcclusionSweeping)
 {
-  const auto large = Ball(300), small = Ball(24); // 27 MB of input; 4 B + 32 B a voxel more
+  const auto large = TwoValuedBall(300), small = TwoValuedBall(24); // 27 MB of input; 4 B + 32 B a voxel more
   vtkNew<vtkOcclusionSweeping> filter;
   filter->SetIsoValue(100);
   filter->SetOutputOctantVisibility(true);
@@ -145,7 +132,7 @@ TEST(OutOfMemory, OcclusionSweeping)
 
 TEST(OutOfMemory, VarianceOcclusionMap)
 {
-  const auto large = Ball(400), small = Ball(24); // level 0 alone: 512 MB
+  const auto large = TwoValuedBall(400), small = TwoValuedBall(24); // level 0 alone: 512 MB
   vtkNew<vtkVarianceOcclusionMap> filter;
   LimitAddressSpace(300);
   ExpectShortageThenSuccess(
@@ -158,9 +145,9 @@ TEST(OutOfMemory, VarianceOcclusionMap)
 
 TEST(OutOfMemory, IsosurfaceAmbientOcclusion)
 {
-  const auto large = Ball(400), small = Ball(24);
+  const auto large = TwoValuedBall(400), small = TwoValuedBall(24);
   vtkNew<vtkContourFilter> bigContour, smallContour;
-  bigContour->SetInputData(Ball(24)); // the surface itself is small; the pyramid is not
+  bigContour->SetInputData(TwoValuedBall(24)); // the surface itself is small; the pyramid is not
   bigContour->SetValue(0, 100);
   bigContour->Update();
   smallContour->SetInputData(small);
@@ -182,7 +169,7 @@ TEST(OutOfMemory, AmbientOcclusionShading)
 {
   // The input carries an AmbientOcclusion array; the RGBA output needs 4 B a voxel more.
   auto withAo = [](int n) {
-    auto image = Ball(n);
+    auto image = TwoValuedBall(n);
     vtkNew<vtkFloatArray> ao;
     ao->SetName("AmbientOcclusion");
     ao->SetNumberOfTuples(image->GetNumberOfPoints());
@@ -220,7 +207,7 @@ TEST(OutOfMemory, ProbeOutsideSurface)
     return surface;
   };
   const auto large = surfaceOf(10000000), small = surfaceOf(500);
-  const auto volume = Ball(24);
+  const auto volume = TwoValuedBall(24);
   vtkNew<vtkFloatArray> distance;
   distance->SetName("SignedDistance");
   distance->SetNumberOfTuples(volume->GetNumberOfPoints());

@@ -25,24 +25,13 @@ namespace
 {
 
 /// A ball of 1000 in 0 with a ripple of +-7, scaled by `scale` and shifted by `offset`.
-vtkSmartPointer<vtkImageData> Ball(double scale, double offset)
+vtkSmartPointer<vtkImageData> RippledBall(double scale, double offset)
 {
-  auto image = vtkSmartPointer<vtkImageData>::New();
-  image->SetDimensions(24, 22, 20);
-  vtkNew<vtkDoubleArray> values;
-  values->SetName("Density");
-  values->SetNumberOfTuples(image->GetNumberOfPoints());
-  vtkIdType id = 0;
-  for (int k = 0; k < 20; ++k)
-    for (int j = 0; j < 22; ++j)
-      for (int i = 0; i < 24; ++i, ++id)
-      {
-        const double r2 = (i - 11.5) * (i - 11.5) + (j - 10.2) * (j - 10.2) + (k - 9.7) * (k - 9.7);
-        const double v = (r2 < 36.0 ? 1000.0 : 0.0) + 7.0 * ((i * 7 + j * 3 + k * 5) % 3 - 1);
-        values->SetValue(id, v * scale + offset);
-      }
-  image->GetPointData()->SetScalars(values);
-  return image;
+  return Ball(vtkNew<vtkDoubleArray>(), { 24, 22, 20 }, { 11.5, 10.2, 9.7 }, 6.0,
+    [=](bool inside, int i, int j, int k) {
+      const double v = (inside ? 1000.0 : 0.0) + 7.0 * ((i * 7 + j * 3 + k * 5) % 3 - 1);
+      return v * scale + offset;
+    });
 }
 
 struct Messages
@@ -87,7 +76,7 @@ bool Warned(const Messages& m)
 
 TEST(PyramidMagnitudes, RefusedSpansWarnedOffsetsAndQuietOrdinaryValues)
 {
-  auto unit = Ball(1.0, 0.0);
+  auto unit = RippledBall(1.0, 0.0);
   vtkNew<vtkFlyingEdges3D> contour;
   contour->SetInputData(unit);
   contour->SetValue(0, 500.0);
@@ -97,21 +86,21 @@ TEST(PyramidMagnitudes, RefusedSpansWarnedOffsetsAndQuietOrdinaryValues)
   ASSERT_GT(surface->GetNumberOfPoints(), 100);
 
   // Ordinary values, the same at an offset the float32 means still resolve, and in small units.
-  for (auto volume : { unit, Ball(1.0, 1e5), Ball(1e-12, 0.0) })
+  for (auto volume : { unit, RippledBall(1.0, 1e5), RippledBall(1e-12, 0.0) })
     for (const Messages& m : { VarianceMap(volume), SurfaceAO(volume, surface) })
     {
       EXPECT_TRUE(m.output) << m.errors;
       EXPECT_FALSE(Warned(m));
     }
   // An offset of 1e7 against a spread of 1000: AO and Shadow 7e-3 off; the user is told.
-  for (const Messages& m : { VarianceMap(Ball(1.0, 1e7)), SurfaceAO(Ball(1.0, 1e7), surface) })
+  for (const Messages& m : { VarianceMap(RippledBall(1.0, 1e7)), SurfaceAO(RippledBall(1.0, 1e7), surface) })
   {
     EXPECT_TRUE(m.output) << m.errors;
     EXPECT_TRUE(Warned(m));
   }
   // Spans whose variances leave float32: refused with a reason, no output.
   for (const double scale : { 1e-25, 1e17 })
-    for (const Messages& m : { VarianceMap(Ball(scale, 0.0)), SurfaceAO(Ball(scale, 0.0), surface) })
+    for (const Messages& m : { VarianceMap(RippledBall(scale, 0.0)), SurfaceAO(RippledBall(scale, 0.0), surface) })
     {
       EXPECT_FALSE(m.output);
       EXPECT_NE(m.errors.find("rescale the data"), std::string::npos) << m.errors;

@@ -9,13 +9,17 @@ properties table (a table whose header starts with "| Property |"), written as
 the proxy does not have (a renamed or removed one). It also checks that the images the
 pages show exist, and that no file of the repository refers to the reference text outside
 it (the string built in OUTSIDE_REFERENCE), and that every relative link of README.md,
-Data/README.md, CUDA/README.md and docs/ names a file that exists. It prints one line per failure and ends with
-"N passed, M failed"; the exit status is 1 when anything failed.
+Data/README.md, CUDA/README.md and docs/ names a file that exists. It prints "ok: ..." or
+"FAILED: ..." per check (vao_test_utils.check) and ends with "N passed, M failed"; the exit
+status is 1 when anything failed.
 """
 import os
 import re
 import sys
 import xml.etree.ElementTree as ET
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from vao_test_utils import check, finish, summary  # noqa: E402
 
 # Proxy name (the SourceProxy's name attribute) -> its page, relative to the repository.
 PAGES = {
@@ -43,19 +47,6 @@ PROPERTY_CELL = re.compile(r"^`([A-Za-z_][A-Za-z0-9_]*)`$")
 IMAGE_LINK = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
 
 
-class Results:
-    def __init__(self):
-        self.passed = 0
-        self.failures = []
-
-    def check(self, ok, message):
-        if ok:
-            self.passed += 1
-        else:
-            self.failures.append(message)
-        return ok
-
-
 def proxy_properties(proxy):
     """The names of the proxy's properties, in the XML's order (references excluded)."""
     names = []
@@ -74,17 +65,17 @@ def proxy_properties(proxy):
     return names
 
 
-def source_proxies(plugin_dir, results):
+def source_proxies(plugin_dir):
     """(proxy name, xml file, property names) for every SourceProxy of Plugin/*.xml."""
     proxies = []
     files = sorted(f for f in os.listdir(plugin_dir) if f.endswith(".xml")) if os.path.isdir(plugin_dir) else []
-    results.check(bool(files), "no Plugin/*.xml found under %s" % plugin_dir)
+    check(bool(files), "Plugin/*.xml found under %s" % plugin_dir)
     for name in files:
         path = os.path.join(plugin_dir, name)
         try:
             root = ET.parse(path).getroot()
         except ET.ParseError as error:
-            results.check(False, "Plugin/%s does not parse: %s" % (name, error))
+            check(False, "Plugin/%s does not parse: %s" % (name, error))
             continue
         for proxy in root.iter("SourceProxy"):
             proxies.append((proxy.get("name"), name, proxy_properties(proxy)))
@@ -115,33 +106,33 @@ def documented_properties(text):
     return rows
 
 
-def check_pages(root, results):
-    for proxy, xml_file, properties in source_proxies(os.path.join(root, "Plugin"), results):
+def check_pages(root):
+    for proxy, xml_file, properties in source_proxies(os.path.join(root, "Plugin")):
         page = PAGES.get(proxy)
-        if not results.check(page is not None,
-                             "proxy %s (Plugin/%s) has no page in docs/filters: add it to PAGES" % (proxy, xml_file)):
+        if not check(page is not None,
+                     "proxy %s (Plugin/%s) has a page in docs/filters (PAGES names it)" % (proxy, xml_file)):
             continue
         path = os.path.join(root, page)
-        if not results.check(os.path.isfile(path), "proxy %s: its page %s does not exist" % (proxy, page)):
+        if not check(os.path.isfile(path), "proxy %s: its page %s exists" % (proxy, page)):
             continue
         with open(path, encoding="utf-8") as f:
             text = f.read()
         rows = documented_properties(text)
-        if not results.check(bool(rows), "%s: no properties table (a header '| Property | Default | ...')" % page):
+        if not check(bool(rows), "%s: a properties table (a header '| Property | Default | ...')" % page):
             continue
         for name in properties:
-            results.check(name in rows, "%s: property `%s` of proxy %s (Plugin/%s) is not a row of the "
-                          "properties table" % (page, name, proxy, xml_file))
+            check(name in rows, "%s: property `%s` of proxy %s (Plugin/%s) is a row of the properties table"
+                  % (page, name, proxy, xml_file))
         known = set(properties)
         for name, line in sorted(rows.items(), key=lambda item: item[1]):
-            results.check(name in known, "%s:%d: documents `%s`, which proxy %s (Plugin/%s) does not have "
-                          "(renamed or removed?)" % (page, line, name, proxy, xml_file))
+            check(name in known, "%s:%d: documents `%s`, a property of proxy %s (Plugin/%s) (not renamed or "
+                  "removed)" % (page, line, name, proxy, xml_file))
         for line_number, line in enumerate(text.splitlines(), start=1):
             for target in IMAGE_LINK.findall(line):
                 if "://" in target:
                     continue
                 image = os.path.normpath(os.path.join(os.path.dirname(path), target))
-                results.check(os.path.isfile(image), "%s:%d: image %s does not exist" % (page, line_number, target))
+                check(os.path.isfile(image), "%s:%d: image %s exists" % (page, line_number, target))
 
 
 def searched_files(root):
@@ -156,7 +147,7 @@ def searched_files(root):
                     yield os.path.join(directory, name)
 
 
-def check_outside_references(root, results):
+def check_outside_references(root):
     needle = OUTSIDE_REFERENCE.encode()
     found = False
     for path in searched_files(root):
@@ -169,14 +160,14 @@ def check_outside_references(root, results):
         while start >= 0:
             found = True
             line = data.count(b"\n", 0, start) + 1
-            results.check(False, "%s:%d: refers to %s, outside the repository" %
-                          (os.path.relpath(path, root), line, OUTSIDE_REFERENCE))
+            check(False, "%s:%d: refers to %s, outside the repository" %
+                  (os.path.relpath(path, root), line, OUTSIDE_REFERENCE))
             start = data.find(needle, start + len(needle))
     if not found:
-        results.check(True, "")
+        check(True, "no file refers to %s" % OUTSIDE_REFERENCE)
 
 
-def check_links(root, results):
+def check_links(root):
     """Every relative link of the README and the manual names a file of the repository."""
     pages = [os.path.join(root, "README.md"), os.path.join(root, "Data", "README.md"),
              os.path.join(root, "CUDA", "README.md")]
@@ -192,8 +183,8 @@ def check_links(root, results):
                 continue
             resolved = os.path.normpath(os.path.join(os.path.dirname(page), target))
             line = text.count("\n", 0, match.start()) + 1
-            results.check(os.path.exists(resolved), "%s:%d: link to %s, which does not exist"
-                          % (os.path.relpath(page, root), line, target))
+            check(os.path.exists(resolved), "%s:%d: link to %s, which exists"
+                  % (os.path.relpath(page, root), line, target))
 
 
 def main(argv):
@@ -201,14 +192,11 @@ def main(argv):
         sys.stderr.write("usage: python3 %s REPO_ROOT\n" % argv[0])
         return 2
     root = os.path.abspath(argv[1])
-    results = Results()
-    check_pages(root, results)
-    check_outside_references(root, results)
-    check_links(root, results)
-    for failure in results.failures:
-        print("FAILED: " + failure)
-    print("%d passed, %d failed" % (results.passed, len(results.failures)))
-    return 1 if results.failures else 0
+    check_pages(root)
+    check_outside_references(root)
+    check_links(root)
+    print(summary())
+    finish("the manual matches the plugin")
 
 
 if __name__ == "__main__":

@@ -17,7 +17,7 @@ sys.path.insert(0, site)
 import volumetricao  # noqa: E402
 from volumetricao import _common, numpy_helpers, surfaces, volumes  # noqa: E402
 
-from vao_test_utils import failures, finish, record as check, same  # noqa: E402,F401
+from vao_test_utils import check, finish  # noqa: E402
 
 
 # pvpython's sys.stdout has no encoding, which doctest reads: print to the process's own.

@@ -20,6 +20,7 @@ import numpy as np  # noqa: E402
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy  # noqa: E402
 from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
 from volumetricao import VolumetricAOFilters  # noqa: E402
+from vao_test_utils import check, finish, summary  # noqa: E402
 
 F = VolumetricAOFilters.vtkVolumetricAmbientOcclusion
 seed = int(sys.argv[2]) if len(sys.argv) > 2 else 20261205
@@ -28,7 +29,6 @@ rng = np.random.default_rng(seed)
 
 TYPES = [np.uint8, np.int8, np.uint16, np.int16, np.uint32, np.int32, np.int64, np.uint64, np.float32, np.float64]
 METHODS = ["GAUSSIAN_CDF", "CHEBYSHEV", "CDF_RECONSTRUCTION", "EXACT_BOX", "EXACT_SPHERE", "HISTOGRAM_CDF"]
-failures = []
 
 
 def draw_values(dt, n):
@@ -172,19 +172,18 @@ for k in range(cases):
     want, want_variance = reference(v, radii, method, iso, bins)
     label = "case %d: %s %s radii %s %s iso %s extent from %s bins %d" % (
         k, np.dtype(dt).name, shape, radii, method, iso, extent0, bins)
-    if got is None:
-        failures.append("no output, " + label)
+    if not check(got is not None, "an output, " + label):
         continue
     compared_cases += 1
     decided = ~np.isnan(want)
     error = np.abs(got - want)[decided].max() if decided.any() else 0.0
-    if error > 5e-6:
-        failures.append("openness off by %.3g, %s" % (error, label))
+    check(error <= 5e-6, "openness off by %.3g (at most 5e-6), %s" % (error, label))
     # The variance to float32 precision (infinite where it overflows float32).
     big = want_variance > float(np.finfo(np.float32).max)
     relative = np.abs(got_variance - want_variance) / np.maximum(want_variance, float(np.finfo(np.float32).tiny))
-    if (big & ~np.isinf(got_variance)).any() or (relative[~big] > 1e-5).any():
-        failures.append("variance off by %.3g (relative), %s" % (relative[~big].max(), label))
+    check(not ((big & ~np.isinf(got_variance)).any() or (relative[~big] > 1e-5).any()),
+          "variance off by %.3g (relative, at most 1e-5; infinite beyond float32), %s"
+          % (relative[~big].max() if (~big).any() else 0.0, label))
 
 # Invariance: a soft-tissue-like field at offsets and in units far from 1.
 base = np.asarray(1000 + rng.integers(-20, 21, (9, 10, 11)), dtype=np.int16)
@@ -199,11 +198,10 @@ for method, smoothing in (("GAUSSIAN_CDF", None), ("CHEBYSHEV", None), ("CDF_REC
         if smoothing is not None and name == "int64 - 1e12":
             continue  # a double query there resolves 1e-4: one near an integer may round to it
         got, _ = run(values, method, 2.0, False, (1.0, 1.0, 1.0), (0, 0, 0), None, 64, smoothing)
-        if got is None or np.abs(got - expected).max() > 1e-5:
-            failures.append("%s (smoothed query %s) of %s differs from the int16 field's by %s" % (
-                method, smoothing, name, "no output" if got is None else "%.3g" % np.abs(got - expected).max()))
+        check(got is not None and not np.abs(got - expected).max() > 1e-5,
+              "%s (smoothed query %s) of %s differs from the int16 field's by %s (at most 1e-5)" % (
+                  method, smoothing, name, "no output" if got is None else "%.3g" % np.abs(got - expected).max()))
 
-print("%d cases against the exact reference (seed %d), %d failures" % (compared_cases, seed, len(failures)))
-for failure in failures:
-    print("FAILED", failure)
-sys.exit(1 if failures or compared_cases < cases // 2 else 0)
+check(compared_cases >= cases // 2, "%d of %d cases compared with the reference (at least half)" % (compared_cases, cases))
+print("%d cases against the exact reference (seed %d): %s" % (compared_cases, seed, summary()))
+finish("every case agreed with the exact reference")

@@ -31,11 +31,11 @@ from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
 from scipy.spatial import cKDTree  # noqa: E402
 from vtkmodules.vtkFiltersCore import vtkFlyingEdges3D  # noqa: E402
 from volumetricao import VolumetricAOFilters as V  # noqa: E402
+from vao_test_utils import check, finish, summary  # noqa: E402
 
 seed = int(sys.argv[2]) if len(sys.argv) > 2 else 20261205
 cases = int(sys.argv[3]) if len(sys.argv) > 3 else 30
 rng = np.random.default_rng(seed)
-failures = []
 
 
 SPACING = np.array([0.5, 1.0, 1.5])
@@ -132,10 +132,9 @@ def differs(a, b, tolerance):
     return None
 
 
-def check(what, message):
-    if message:
-        failures.append("%s: %s" % (what, message))
-        print("FAILED: %s: %s" % (what, message), flush=True)
+def agree(what, difference):
+    """Checks that two outputs agree: `difference` is differs()'s answer for them."""
+    check(difference is None, "%s: %s" % (what, difference or "the same"))
 
 
 def draw():
@@ -209,24 +208,24 @@ for case in range(cases):
         if not base:
             continue
         for threads in (2, 3, 7):
-            check("%s, %d threads" % (what, threads), differs(base, volume_run(make, values, threads), with_threads))
-        check("%s, extent from (5, -3, 7)" % what, differs(base, volume_run(make, values, first=(5, -3, 7)), 0.0))
+            agree("%s, %d threads" % (what, threads), differs(base, volume_run(make, values, threads), with_threads))
+        agree("%s, extent from (5, -3, 7)" % what, differs(base, volume_run(make, values, first=(5, -3, 7)), 0.0))
         if symmetric is None:
             continue
         for axis in range(3):
             flipped = volume_run(make, np.flip(values, 2 - axis).copy())
             flipped = {k: np.flip(a, 2 - axis) for k, a in flipped.items()}
-            check("%s, flipped along axis %d" % (what, axis), differs(base, flipped, 0.0 if symmetric else 2e-5))
+            agree("%s, flipped along axis %d" % (what, axis), differs(base, flipped, 0.0 if symmetric else 2e-5))
     if values.dtype in (np.int16, np.float32) and values.min() < iso < values.max():
         shadows = bool(case % 2)
         base = surface_run(values, iso, shadows)
         what = "%s, isosurface AO%s" % (label, " + shadows" if shadows else "")
         for threads in (2, 7):
-            check("%s, %d threads" % (what, threads), differs(base, surface_run(values, iso, shadows, threads), 0.0))
-        check("%s, extent from (5, -3, 7)" % what,
+            agree("%s, %d threads" % (what, threads), differs(base, surface_run(values, iso, shadows, threads), 0.0))
+        agree("%s, extent from (5, -3, 7)" % what,
               differs(base, surface_run(values, iso, shadows, first=(5, -3, 7)), 1e-5))
         for unit in (3.7, 1e-3):  # spacing and origin in other units: the same scene
-            check("%s, spacing and origin x %g" % (what, unit),
+            agree("%s, spacing and origin x %g" % (what, unit),
                   differs(base, surface_run(values, iso, shadows, unit=unit), 1e-5))
         one = surface_run(values, iso, True, levels=1)
         extent = (np.array(values.shape[::-1]) - 1) * SPACING
@@ -241,7 +240,7 @@ for case in range(cases):
             if "Normals" in flipped:
                 flipped["Normals"] = flipped["Normals"] * np.where(np.arange(3) == axis, -1.0, 1.0)
             flipped["points"] = one["points"] if distance.max() < 1e-5 else points[nearest]
-            check("%s, one level, flipped along axis %d" % (what, axis), differs(one, flipped, 1e-5))
+            agree("%s, one level, flipped along axis %d" % (what, axis), differs(one, flipped, 1e-5))
 # Isosurface AO and shadows of smooth random fields (whose surfaces the coarse levels and
 # the long marches see) at a spacing and origin that binary fractions do not hold, then
 # the same scene in other units: the march's levels change at t / r0 + 1 = 2^l whatever
@@ -255,7 +254,7 @@ for case in range(40):
     unit = float(rng.choice([1e-3, 3.7, 1e4]))
     one, other = (arrays(isosurface(image(field.astype(np.float32), unit=u, spacing=spacing, origin=origin), 0.2, True),
                          None) for u in (1.0, unit))
-    check("smooth field %d %s, isosurface AO + shadows, spacing and origin x %g" % (case, shape, unit),
+    agree("smooth field %d %s, isosurface AO + shadows, spacing and origin x %g" % (case, shape, unit),
           differs({k: one[k] for k in ("AmbientOcclusion", "Shadow")},
                   {k: other[k] for k in ("AmbientOcclusion", "Shadow")}, 1e-5))
 # A radius in world units over a spacing whose ratio is a half-integer (5.5 x 1.3 over 1.3)
@@ -271,7 +270,6 @@ for h, ratio, unit in [(1.3, 5.5, 1e-3), (0.15, 1.5, 25.4), (0.15, 4.5, 10.0), (
         f.SetInputData(volume)
         f.Update()
         outputs.append(arrays(f.GetOutput(), values.shape))
-    check("world radius %g x %g in units x %g" % (ratio, h, unit), differs(outputs[0], outputs[1], 0.0))
-print("%d cases, %d failures" % (cases, len(failures)))
-print("FAILED" if failures else "every filter gave the same answer where it must")
-sys.exit(1 if failures else 0)
+    agree("world radius %g x %g in units x %g" % (ratio, h, unit), differs(outputs[0], outputs[1], 0.0))
+print("%d cases: %s" % (cases, summary()))
+finish("every filter gave the same answer where it must")

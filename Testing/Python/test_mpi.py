@@ -11,7 +11,7 @@ import sys
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from vao_test_utils import array_of, check, fail, logged_extent, read_image  # noqa: E402
+from vao_test_utils import array_of, check, finish, logged_extent, read_image  # noqa: E402
 
 import numpy as np  # noqa: E402
 from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
@@ -99,7 +99,7 @@ for input_path in (source, partitioned):
                             WHOLE[2 * a:2 * a + 2]) if slab and slab != WHOLE else None
             check(thickness is not None and thickness <= 136 // ranks + 3,
                   "%s np %d rank %d: occlusion sweeping received the slab %s (its own and one ghost layer)"
-                  % (kind, ranks, rank, slab))
+                  % (kind, ranks, rank, slab), stop=slab is None)
             # The local chain feeds the sweeping: it was asked for the slab, so it needs the
             # slab grown by the radii.
             local = received.get(("local", rank))
@@ -184,7 +184,8 @@ serial_path = run(1, "mpi_surface_run.py", "pvtp")
 serial_surface = shaded_points(serial_path)
 serial_levels, serial_read = pyramid_pieces(serial_path, 1)
 check(sorted(serial_levels) == [0, 1, 2, 3] and all(len(p) == 1 and p[0][0][0] == 0 for p in serial_levels.values())
-      and serial_read[0] == WHOLE, "serial pyramid: 4 levels %s" % [serial_levels[l][0][1].shape for l in range(4)])
+      and serial_read[0] == WHOLE, "serial pyramid: 4 levels %s" % [serial_levels[l][0][1].shape for l in range(4)],
+      stop=True)
 check(len(serial_surface) > 10000, "serial bone surface: %d points" % len(serial_surface))
 whole_voxels = 128 * 128 * 136
 for ranks in rank_counts:
@@ -214,7 +215,7 @@ for ranks in rank_counts:
     distributed = shaded_points(distributed_path)
     matched = [key for key in distributed if key in serial_surface]
     check(len(matched) >= 0.999 * len(distributed), "np %d: %d of %d surface points found in the serial surface"
-          % (ranks, len(matched), len(distributed)))
+          % (ranks, len(matched), len(distributed)), stop=not matched)
     worst = max(max(abs(distributed[k][0] - serial_surface[k][0]), abs(distributed[k][1] - serial_surface[k][1]))
                 for k in matched)
     # The pieces' pyramids differ from the whole one by float rounding (their moments are
@@ -226,7 +227,7 @@ for ranks in rank_counts:
     serial_probe, probe = (probed_points(p[:-len(".pvtp")] + "_probe.pvtp") for p in (serial_path, distributed_path))
     same = [k for k in probe if k in serial_probe and np.abs(probe[k][1] - serial_probe[k][1]).max() <= 1e-6]
     check(len(same) >= 0.95 * len(serial_probe), "np %d: %d of %d probed points have the serial normals"
-          % (ranks, len(same), len(serial_probe)))
+          % (ranks, len(same), len(serial_probe)), stop=not same)
     worst = max(abs(probe[k][0] - serial_probe[k][0]) for k in same)
     check(worst == 0.0, "np %d: Probe Outside Surface equals serial where the normals do (max difference %.3g)"
           % (ranks, worst))
@@ -291,8 +292,8 @@ try:
     output = result.stdout + result.stderr
 except subprocess.TimeoutExpired:
     output = None
-check(output is not None, "a NaN in one rank's slab: the MPI run finished (no rank waits forever)")
+check(output is not None, "a NaN in one rank's slab: the MPI run finished (no rank waits forever)", stop=True)
 check("finished" in output and "NaN or infinite values" in output and
       "another process failed" in output,
       "the rank with the NaN names it, the other says another process failed")
-print("all MPI checks passed")
+finish("all MPI checks passed")

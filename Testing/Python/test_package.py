@@ -20,7 +20,7 @@ from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy  # noqa: E4
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData  # noqa: E402
 from vtkmodules.vtkFiltersCore import vtkFlyingEdges3D  # noqa: E402
 
-from vao_test_utils import failures, finish, record as check, same  # noqa: E402,F401
+from vao_test_utils import check, finish, same  # noqa: E402
 
 
 check(os.path.realpath(volumetricao.__file__).startswith(os.path.realpath(site)),

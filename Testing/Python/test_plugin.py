@@ -6,7 +6,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from vao_test_utils import METHODS, array_of, check, fail, read_image  # noqa: E402
+from vao_test_utils import METHODS, array_of, check, finish, read_image  # noqa: E402
 
 from paraview.simple import *  # noqa: E402,F401,F403
 from paraview import servermanager  # noqa: E402
@@ -14,7 +14,7 @@ import numpy as np  # noqa: E402
 
 plugin, data_dir, out_dir = sys.argv[1:4]
 LoadPlugin(plugin, ns=globals())
-check("VolumetricAmbientOcclusion" in globals(), "the plugin defines VolumetricAmbientOcclusion")
+check("VolumetricAmbientOcclusion" in globals(), "the plugin defines VolumetricAmbientOcclusion", stop=True)
 
 # One version everywhere a user looks: the plugin (Manage Plugins), the CMake package,
 # CITATION.cff and the newest CHANGELOG entry.
@@ -54,7 +54,7 @@ for name in ["Scalars", "Method", "NumberOfBins", "Radius", "RadiusUnits", "Quer
              "QuerySmoothing", "ErfApproximation", "ComputeVariance", "Backend", "Device", "OutputArrayName",
              "Component", "NumberOfThreads"]:
     prop = ao.GetProperty(name)
-    check(prop is not None, "property %s exists" % name)
+    check(prop is not None, "property %s exists" % name, stop=True)
     doc = prop.SMProperty.GetDocumentation()
     check(doc is not None and len(doc.GetDescription().strip()) > 20, "property %s is documented" % name)
 
@@ -177,7 +177,7 @@ check(vom.NumberOfThreads == 0 and
       len(vom.GetProperty("NumberOfThreads").SMProperty.GetDocumentation().GetDescription().strip()) > 20,
       "VarianceOcclusionMap property NumberOfThreads exists, defaults to 0 and is documented")
 levels = servermanager.Fetch(vom)
-check(levels.GetNumberOfBlocks() == 4, "VarianceOcclusionMap: 4 levels")
+check(levels.GetNumberOfBlocks() == 4, "VarianceOcclusionMap: 4 levels", stop=True)
 level1 = levels.GetBlock(1)
 check(level1.GetDimensions() == (64, 64, 68) and abs(level1.GetSpacing()[0] - 2 * 1.953125) < 1e-9,
       "VarianceOcclusionMap: level 1 halves the resolution (%s)" % (level1.GetDimensions(),))
@@ -284,11 +284,12 @@ replay = {}
 exec(trace, replay)
 replayed = {proxy.GetXMLName(): proxy for proxy in GetSources().values()}
 check(set(["VolumetricAmbientOcclusion", "OcclusionSweeping", "VarianceOcclusionMap", "IsosurfaceAmbientOcclusion",
-           "AmbientOcclusionShading"]) <= set(replayed), "the replayed trace created every filter (%s)" % sorted(replayed))
+           "AmbientOcclusionShading"]) <= set(replayed), "the replayed trace created every filter (%s)" % sorted(replayed),
+      stop=True)
 check(np.array_equal(array_of(servermanager.Fetch(replayed["VolumetricAmbientOcclusion"]), "AmbientOcclusion"),
                      expected["AmbientOcclusion"]), "the replayed Volumetric AO equals the traced one")
 check(np.array_equal(array_of(servermanager.Fetch(replayed["AmbientOcclusionShading"]), "ShadedRGBA"), expected_rgba),
       "the replayed shading equals the traced one")
 check(np.array_equal(array_of(servermanager.Fetch(replayed["IsosurfaceAmbientOcclusion"]), "AmbientOcclusion"),
                      expected_shadow), "the replayed isosurface AO equals the traced one")
-print("all plugin checks passed")
+finish("all plugin checks passed")

@@ -22,7 +22,7 @@ from vtkmodules.util.numpy_support import numpy_to_vtk  # noqa: E402
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData  # noqa: E402
 from vtkmodules.vtkImagingCore import vtkImageCast  # noqa: E402
 
-from vao_test_utils import failures, finish, record as check, same  # noqa: E402,F401
+from vao_test_utils import check, finish, same  # noqa: E402
 
 
 # pvpython's sys.executable names a vtkpython that is not installed: run pvpython itself.

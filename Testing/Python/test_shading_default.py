@@ -20,16 +20,12 @@ from paraview import servermanager
 from vtkmodules.util.numpy_support import vtk_to_numpy
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from vao_test_utils import check, finish  # noqa: E402
+
 plugin, data_dir = sys.argv[1:3]
 volume_proxies = sys.argv[3:]
 LoadPlugin(plugin, ns=globals())
-failures = []
-
-
-def check(condition, what):
-    print(("ok: " if condition else "FAILED: ") + what, flush=True)
-    if not condition:
-        failures.append(what)
 
 
 def point_arrays(proxy):
@@ -85,5 +81,4 @@ for name in volume_proxies:
               % (name, chosen))
         Delete(proxy)
 
-print("FAILED" if failures else "all Shading default checks passed")
-sys.exit(1 if failures else 0)
+finish("all Shading default checks passed")

@@ -1,8 +1,7 @@
-"""Shared helpers of the pvpython / pvbatch tests (no VolumetricAO code here)."""
+"""Shared helpers of the Python test scripts (no VolumetricAO code here). Standard library
+only at import, so that test_docs.py runs without numpy or VTK."""
 import os
 import sys
-
-import numpy as np
 
 # In the order the Method menu lists them (the default first).
 METHODS = ["Histogram CDF", "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box", "Exact Sphere"]
@@ -15,36 +14,46 @@ METHODS = ["Histogram CDF", "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "
 XML_OPTIONS = dict(DataMode="Binary")
 
 
-# The collecting idiom of the Python package's tests: every check prints ok or FAILED and
-# the run goes on; the script ends with finish(), which exits non-zero on a failure.
+# The one check idiom of the test scripts: check() prints "ok: what" or "FAILED: what" and
+# records a failure, and the run goes on; finish() ends it, with exit status 1 after a
+# failure. A check whose failure leaves nothing for the rest to test (a missing plugin, an
+# unreadable file) passes stop=True, and the run ends there with status 1 (fail() is
+# check(False, message, stop=True)). ctest reads "FAILED" in the output as well.
 failures = []
+_passed = 0
 
 
-def record(condition, what):
+def check(condition, what, stop=False):
+    """Prints and records one check; returns whether it passed."""
+    global _passed
     print(("ok: " if condition else "FAILED: ") + what, flush=True)
-    if not condition:
-        failures.append(what)
+    if condition:
+        _passed += 1
+        return True
+    failures.append(what)
+    if stop:
+        sys.exit(1)
+    return False
+
+
+def fail(message):
+    check(False, message, stop=True)
+
+
+def summary():
+    """The count of the checks so far, as "N passed, M failed"."""
+    return "%d passed, %d failed" % (_passed, len(failures))
+
+
+def finish(passed_line):
+    print("FAILED" if failures else passed_line, flush=True)
+    sys.exit(1 if failures else 0)
 
 
 def same(a, b):
     """Equal bit for bit: the same dtype, shape and values."""
+    import numpy as np
     return a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b)
-
-
-def finish(passed_line):
-    print("FAILED" if failures else passed_line)
-    sys.exit(1 if failures else 0)
-
-
-def fail(message):
-    print("FAILED: " + message)
-    sys.exit(1)
-
-
-def check(condition, message):
-    if not condition:
-        fail(message)
-    print("ok: " + message)
 
 
 def array_of(data_object, name):
