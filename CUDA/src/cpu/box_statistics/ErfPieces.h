@@ -2,6 +2,7 @@
 // piece k a polynomial of degree 12 in u = x - kErfOrigins[k]: the greatest difference
 // from erf, of the polynomials as rounded to doubles, is 6.0e-17 (before the rounding of
 // their evaluation).
+// clang-format off
 #pragma once
 
 namespace vao
