@@ -51,7 +51,8 @@ inline std::string ScanPath(const std::string& extra, const std::string& relativ
 
 inline int ResolvedThreads(int requested)
 {
-  return requested > 0 ? requested : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return requested > 0 ? requested
+                       : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 }
 
 inline double Seconds(const std::chrono::steady_clock::time_point& start)

@@ -192,11 +192,12 @@ int RunBytesWorkload(const std::string& name)
 
 void BenchmarkBytes()
 {
-  std::printf("\nBytes moved per voxel (valgrind's cache simulation of %s): 'memory', a\n"
-              "  64-byte line per last-level miss and per dirty line written back; 'L1', a line per L1d\n"
-              "  miss; 'must', the input read once and each output written once (a cache that allocates\n"
-              "  lines for writes reads each output line first: the floor's 1.6x). Int16 workloads on the\n"
-              "  %d x %d x %d generated phantom, the sweeping on the %d^3 Fig. 3 scene\n",
+  std::printf(
+    "\nBytes moved per voxel (valgrind's cache simulation of %s): 'memory', a\n"
+    "  64-byte line per last-level miss and per dirty line written back; 'L1', a line per L1d\n"
+    "  miss; 'must', the input read once and each output written once (a cache that allocates\n"
+    "  lines for writes reads each output line first: the floor's 1.6x). Int16 workloads on the\n"
+    "  %d x %d x %d generated phantom, the sweeping on the %d^3 Fig. 3 scene\n",
     kCacheModel, kPhantom[0], kPhantom[1], kPhantom[2], kScene);
   if (!VAO_HAVE_CALLGRIND)
   {
@@ -212,9 +213,10 @@ void BenchmarkBytes()
   std::printf("  %-32s %8s %10s %8s %10s\n", "workload", "must", "memory", "x must", "L1");
   for (const Workload& w : kWorkloads)
   {
-    const std::string command = std::string("valgrind --tool=callgrind --cache-sim=yes --simulate-wb=yes ") +
-      "--instr-atstart=no " + kCacheModel + " --callgrind-out-file=/dev/null '" + self + "' --bytes-of " + w.name +
-      " 2>&1";
+    const std::string command =
+      std::string("valgrind --tool=callgrind --cache-sim=yes --simulate-wb=yes ") +
+      "--instr-atstart=no " + kCacheModel + " --callgrind-out-file=/dev/null '" + self +
+      "' --bytes-of " + w.name + " 2>&1";
     std::string text;
     if (FILE* pipe = popen(command.c_str(), "r"))
     {
@@ -224,8 +226,9 @@ void BenchmarkBytes()
       if (pclose(pipe) != 0)
         text.clear();
     }
-    const double voxels = std::string(w.name) == "sweeping" ? double(kScene) * kScene * kScene
-                                                            : double(kPhantom[0]) * kPhantom[1] * kPhantom[2];
+    const double voxels = std::string(w.name) == "sweeping"
+      ? double(kScene) * kScene * kScene
+      : double(kPhantom[0]) * kPhantom[1] * kPhantom[2];
     std::map<std::string, double> e = CollectedEvents(text);
     if (!e.count("DLmr") || !e.count("DLdmw"))
     {
@@ -234,8 +237,8 @@ void BenchmarkBytes()
     }
     const double lines = e["DLmr"] + e["DLmw"] + e["ILmr"] + e["DLdmr"] + e["DLdmw"] + e["ILdmr"];
     const double memory = 64.0 * lines / voxels;
-    std::printf("  %-32s %8.1f %10.1f %7.2fx %10.1f\n", w.what, w.mustMove, memory, memory / w.mustMove,
-      64.0 * (e["D1mr"] + e["D1mw"]) / voxels);
+    std::printf("  %-32s %8.1f %10.1f %7.2fx %10.1f\n", w.what, w.mustMove, memory,
+      memory / w.mustMove, 64.0 * (e["D1mr"] + e["D1mw"]) / voxels);
     std::fflush(stdout);
   }
 }

@@ -27,14 +27,15 @@ namespace
 /// The floor of a pyramid build: one pass, on the same threads, that reads the int16
 /// volume once and writes as many floats as the levels hold (mean and variance of each)
 /// into arrays kept from one repeat to the next, as the pyramid's storage is.
-double TimePyramidFloor(const short* in, std::int64_t n, const std::vector<vao::MomentLevel>& levels, int repeat,
-  int threads)
+double TimePyramidFloor(const short* in, std::int64_t n,
+  const std::vector<vao::MomentLevel>& levels, int repeat, int threads)
 {
   std::int64_t coarse = 0; // voxels of the levels after the first
   for (std::size_t l = 1; l < levels.size(); ++l)
     coarse += levels[l].dims[0] * levels[l].dims[1] * levels[l].dims[2];
   std::vector<float> mean(static_cast<std::size_t>(n)), variance(mean.size());
-  std::vector<float> coarseMean(static_cast<std::size_t>(coarse)), coarseVariance(coarseMean.size());
+  std::vector<float> coarseMean(static_cast<std::size_t>(coarse)),
+    coarseVariance(coarseMean.size());
   const int team = ResolvedThreads(threads);
   double best = 1e300;
   for (int r = 0; r < repeat; ++r)
@@ -43,20 +44,22 @@ double TimePyramidFloor(const short* in, std::int64_t n, const std::vector<vao::
     std::vector<std::thread> workers;
     for (int t = 0; t < team; ++t)
     {
-      workers.emplace_back([&, t] {
-        const std::int64_t begin = n * t / team, end = n * (t + 1) / team;
-        for (std::int64_t i = begin; i < end; ++i)
+      workers.emplace_back(
+        [&, t]
         {
-          const float v = static_cast<float>(in[i]);
-          mean[i] = v;
-          variance[i] = v * v;
-          if (i < coarse)
+          const std::int64_t begin = n * t / team, end = n * (t + 1) / team;
+          for (std::int64_t i = begin; i < end; ++i)
           {
-            coarseMean[i] = v;
-            coarseVariance[i] = v * v;
+            const float v = static_cast<float>(in[i]);
+            mean[i] = v;
+            variance[i] = v * v;
+            if (i < coarse)
+            {
+              coarseMean[i] = v;
+              coarseVariance[i] = v * v;
+            }
           }
-        }
-      });
+        });
     }
     for (auto& w : workers)
       w.join();
@@ -88,10 +91,12 @@ double RunScipyBlur(const Options& options, const std::string& volumeFile)
 /// each against its floor, and on 256^3 against scipy.ndimage's level-0 blur.
 void BenchmarkPyramid(const Options& options)
 {
-  std::printf("\nVariance occlusion maps: pyramid build (4 levels, best of %d, ms; paper Table 1: 170 / 678 / "
+  std::printf("\nVariance occlusion maps: pyramid build (4 levels, best of %d, ms; paper Table 1: "
+              "170 / 678 / "
               "1524 ms CPU); the floor reads the volume once and writes the levels' floats once\n",
     options.repeat);
-  std::printf("  %-22s %8s %10s %8s %14s\n", "volume", "build", "floor", "x floor", "scipy level 0");
+  std::printf(
+    "  %-22s %8s %10s %8s %14s\n", "volume", "build", "floor", "x floor", "scipy level 0");
   const int sizes[][3] = { { 256, 256, 256 }, { 512, 512, 256 }, { 512, 512, 512 } };
   for (const auto& size : sizes)
   {
@@ -112,19 +117,21 @@ void BenchmarkPyramid(const Options& options)
       vao::buildMomentPyramid(view, { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid, execution);
       best = std::min(best, Seconds(start));
     }
-    const double floor = TimePyramidFloor(static_cast<const short*>(view.data), view.voxelCount(), pyramid,
-      std::max(3, options.repeat), options.threads);
-    std::printf("  %4d x %4d x %4d int16 %8.1f %10.1f %7.1fx", size[0], size[1], size[2], 1e3 * best, 1e3 * floor,
-      best / floor);
+    const double floor = TimePyramidFloor(static_cast<const short*>(view.data), view.voxelCount(),
+      pyramid, std::max(3, options.repeat), options.threads);
+    std::printf("  %4d x %4d x %4d int16 %8.1f %10.1f %7.1fx", size[0], size[1], size[2],
+      1e3 * best, 1e3 * floor, best / floor);
     if (size[2] == 256 && size[0] == 256)
     {
       const std::string raw = "/tmp/vao_pyramid_256x256x256_int16.raw";
       std::ofstream(raw, std::ios::binary)
-        .write(static_cast<const char*>(view.data), static_cast<std::streamsize>(2 * view.voxelCount()));
+        .write(
+          static_cast<const char*>(view.data), static_cast<std::streamsize>(2 * view.voxelCount()));
       const double peer = RunScipyBlur(options, raw);
       std::remove(raw.c_str());
       if (peer > 0)
-        std::printf(" %9.1f: ours %.1fx faster, the floor %.1fx", 1e3 * peer, peer / best, peer / floor);
+        std::printf(
+          " %9.1f: ours %.1fx faster, the floor %.1fx", 1e3 * peer, peer / best, peer / floor);
       else
         std::printf("   (scipy blur peer could not run)");
     }
@@ -165,21 +172,22 @@ void BenchmarkRelighting(const Options& options, const char* name, vtkImageData*
   vao::buildSurfacePyramid(view, origin, spacing, {}, surface, execution);
   std::vector<float> ao(n), shadow(n);
   // The best of `repeat` runs of AO, shadows or both, on either pyramid, in M points/s.
-  auto rate = [&](bool tiled, bool occlusion, bool shadows) {
+  auto rate = [&](bool tiled, bool occlusion, bool shadows)
+  {
     double best = 1e300;
     for (int r = 0; r < options.repeat; ++r)
     {
       const auto start = std::chrono::steady_clock::now();
       if (occlusion)
-        tiled ? vao::surfaceAmbientOcclusion(
-                  surface, view, origin, spacing, points.data(), normals.data(), n, {}, ao.data(), execution)
-              : vao::surfaceAmbientOcclusion(
-                  pyramid, view, origin, spacing, points.data(), normals.data(), n, {}, ao.data(), execution);
+        tiled ? vao::surfaceAmbientOcclusion(surface, view, origin, spacing, points.data(),
+                  normals.data(), n, {}, ao.data(), execution)
+              : vao::surfaceAmbientOcclusion(pyramid, view, origin, spacing, points.data(),
+                  normals.data(), n, {}, ao.data(), execution);
       if (shadows)
-        tiled ? vao::surfaceShadow(surface, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 }, {}, shadow.data(),
-                  execution)
-              : vao::surfaceShadow(pyramid, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 }, {}, shadow.data(),
-                  execution);
+        tiled ? vao::surfaceShadow(surface, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 },
+                  {}, shadow.data(), execution)
+              : vao::surfaceShadow(pyramid, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 },
+                  {}, shadow.data(), execution);
       best = std::min(best, Seconds(start));
     }
     return n / best / 1e6;
@@ -190,17 +198,22 @@ void BenchmarkRelighting(const Options& options, const char* name, vtkImageData*
   {
     vao::buildSurfacePyramid(view, origin, spacing, {}, surface, execution);
     const auto start = std::chrono::steady_clock::now();
-    vao::surfaceAmbientOcclusion(surface, view, origin, spacing, points.data(), normals.data(), n, {}, ao.data(), execution);
-    vao::surfaceShadow(surface, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 }, {}, shadow.data(), execution);
+    vao::surfaceAmbientOcclusion(
+      surface, view, origin, spacing, points.data(), normals.data(), n, {}, ao.data(), execution);
+    vao::surfaceShadow(
+      surface, points.data(), normals.data(), n, { 0.0, -1.0, 1.0 }, {}, shadow.data(), execution);
     first = std::min(first, Seconds(start));
   }
-  std::printf("  %s bone surface (400 HU, %lld points), M points/s:\n", name, static_cast<long long>(n));
-  std::printf("    whole pyramid:     AO %.1f, shadows %.1f, AO + shadows %.1f\n", rate(false, true, false),
-    rate(false, false, true), rate(false, true, true));
-  std::printf("    surface pyramid:   AO %.1f, shadows %.1f, AO + shadows %.1f (%.1f the first time, tiles built: "
+  std::printf(
+    "  %s bone surface (400 HU, %lld points), M points/s:\n", name, static_cast<long long>(n));
+  std::printf("    whole pyramid:     AO %.1f, shadows %.1f, AO + shadows %.1f\n",
+    rate(false, true, false), rate(false, false, true), rate(false, true, true));
+  std::printf("    surface pyramid:   AO %.1f, shadows %.1f, AO + shadows %.1f (%.1f the first "
+              "time, tiles built: "
               "%.1f%% of level 0, %.1f%% of level 1)\n",
     rate(true, true, false), rate(true, false, true), rate(true, true, true), n / first / 1e6,
-    100.0 * surface.builtTiles(0) / surface.tileCount(0), 100.0 * surface.builtTiles(1) / surface.tileCount(1));
+    100.0 * surface.builtTiles(0) / surface.tileCount(0),
+    100.0 * surface.builtTiles(1) / surface.tileCount(1));
 }
 
 } // namespace vaobench

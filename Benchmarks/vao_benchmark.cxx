@@ -7,9 +7,9 @@
 // scipy.ndimage.distance_transform_edt in the same run.
 //
 // Usage: vao_benchmark [--data DIR] [--scipy PATH/TO/scipy_peer.py] [--repeat N]
-//                      [--exact] [--threads N] [--volumetric | --sweeping | --penner | --relight | --bytes]
-//                      (one table only; --relight: the surface query rates alone; --bytes: the
-//                      bytes per voxel each kernel moves, under valgrind, BytesPerVoxel.cxx)
+//                      [--exact] [--threads N] [--volumetric | --sweeping | --penner | --relight |
+//                      --bytes] (one table only; --relight: the surface query rates alone; --bytes:
+//                      the bytes per voxel each kernel moves, under valgrind, BytesPerVoxel.cxx)
 // Last, the variance occlusion maps (PennerRows.cxx): pyramid builds against their floor
 // and scipy's level-0 blur, and the surface query rates (AO, soft shadows) on the CT heads'
 // bone surfaces.
@@ -26,7 +26,6 @@
 #include "vao/AmbientOcclusion.h"
 #include "vao/OcclusionSweeping.h"
 #include "vao/Storage.h"
-
 
 #include "vtkExtractVOI.h"
 #include "vtkImageData.h"
@@ -114,11 +113,13 @@ double TimeFloor(vtkImageData* image, int repeat, int threads)
     std::vector<std::thread> workers;
     for (int t = 0; t < team; ++t)
     {
-      workers.emplace_back([&, t] {
-        const std::int64_t begin = n * t / team, end = n * (t + 1) / team;
-        for (std::int64_t i = begin; i < end; ++i)
-          out[i] = static_cast<float>(in[i]);
-      });
+      workers.emplace_back(
+        [&, t]
+        {
+          const std::int64_t begin = n * t / team, end = n * (t + 1) / team;
+          for (std::int64_t i = begin; i < end; ++i)
+            out[i] = static_cast<float>(in[i]);
+        });
     }
     for (auto& w : workers)
       w.join();
@@ -162,16 +163,18 @@ void Benchmark(const std::string& label, vtkImageData* image, const std::string&
     d[2], voxels / 1e6, ResolvedThreads(options.threads));
   const double floor = TimeFloor(image, std::max(3, options.repeat), options.threads);
   // Bytes one pass must move: the int16 input read once, the float32 output written once.
-  std::printf("  floor (read int16 once, write float32 once): %.1f ms, %.1f GB/s; each method below as\n"
-              "  time [ms] and (x floor)\n",
+  std::printf(
+    "  floor (read int16 once, write float32 once): %.1f ms, %.1f GB/s; each method below as\n"
+    "  time [ms] and (x floor)\n",
     1e3 * floor, 6.0 * voxels / floor / 1e9);
   std::printf("  %-20s %17s %17s\n", "method", "R = 5", "R = 10");
   // Histogram CDF (the default) first; the peers it is measured against follow.
-  const int methods[] = { vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF, vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION,
-    vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, vtkVolumetricAmbientOcclusion::CHEBYSHEV,
-    vtkVolumetricAmbientOcclusion::EXACT_BOX, vtkVolumetricAmbientOcclusion::EXACT_SPHERE };
-  const char* names[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box", "Exact Sphere",
-    "Histogram CDF (64)" };
+  const int methods[] = { vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF,
+    vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION, vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF,
+    vtkVolumetricAmbientOcclusion::CHEBYSHEV, vtkVolumetricAmbientOcclusion::EXACT_BOX,
+    vtkVolumetricAmbientOcclusion::EXACT_SPHERE };
+  const char* names[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box",
+    "Exact Sphere", "Histogram CDF (64)" };
   std::map<int, std::map<int, double>> seconds; // method -> radius -> time
   for (const int method : methods)
   {
@@ -190,12 +193,15 @@ void Benchmark(const std::string& label, vtkImageData* image, const std::string&
         slab->Update();
         const double t = TimeFilter(slab->GetOutput(), method, radius, 1, options.threads);
         seconds[method][radius] = t * voxels / slab->GetOutput()->GetNumberOfPoints();
-        std::printf(" %8.0f~ (%4.0fx)", 1e3 * seconds[method][radius], seconds[method][radius] / floor);
+        std::printf(
+          " %8.0f~ (%4.0fx)", 1e3 * seconds[method][radius], seconds[method][radius] / floor);
       }
       else
       {
-        seconds[method][radius] = TimeFilter(image, method, radius, options.repeat, options.threads);
-        std::printf(" %8.1f (%5.1fx)", 1e3 * seconds[method][radius], seconds[method][radius] / floor);
+        seconds[method][radius] =
+          TimeFilter(image, method, radius, options.repeat, options.threads);
+        std::printf(
+          " %8.1f (%5.1fx)", 1e3 * seconds[method][radius], seconds[method][radius] / floor);
       }
       std::fflush(stdout);
     }
@@ -204,8 +210,8 @@ void Benchmark(const std::string& label, vtkImageData* image, const std::string&
   const auto& histogram = seconds[vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF];
   const auto& gaussian = seconds[vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF];
   const auto& exactBox = seconds[vtkVolumetricAmbientOcclusion::EXACT_BOX];
-  std::printf("  %-20s %11.2fx %11.2fx   (bar: at most 4x)\n", "Histogram / Gaussian", histogram.at(5) / gaussian.at(5),
-    histogram.at(10) / gaussian.at(10));
+  std::printf("  %-20s %11.2fx %11.2fx   (bar: at most 4x)\n", "Histogram / Gaussian",
+    histogram.at(5) / gaussian.at(5), histogram.at(10) / gaussian.at(10));
   std::printf("  %-20s %11.0fx %11.0fx   (bar: at least 20x at R = 5)\n", "Exact Box / Histogram",
     exactBox.at(5) / histogram.at(5), exactBox.at(10) / histogram.at(10));
   const double stats5 = TimeStatistics(image, 5, options.repeat, options.threads);
@@ -215,11 +221,13 @@ void Benchmark(const std::string& label, vtkImageData* image, const std::string&
   if (scipy.size() == 2)
   {
     std::printf("  %-20s %12.1f %12.1f\n", "scipy.ndimage", 1e3 * scipy.at(5), 1e3 * scipy.at(10));
-    std::printf("  %-20s %11.1fx %11.1fx\n", "speed-up", scipy.at(5) / stats5, scipy.at(10) / stats10);
+    std::printf(
+      "  %-20s %11.1fx %11.1fx\n", "speed-up", scipy.at(5) / stats5, scipy.at(10) / stats10);
   }
   else
   {
-    std::printf("  scipy.ndimage: could not run %s (python3-scipy missing?)\n", options.scipy.c_str());
+    std::printf(
+      "  scipy.ndimage: could not run %s (python3-scipy missing?)\n", options.scipy.c_str());
   }
 }
 
@@ -253,7 +261,8 @@ struct EdtPeer
 /// Runs the scipy EDT peer on a raw float32 volume.
 EdtPeer RunScipyEdt(const Options& options, const std::string& volumeFile, double iso)
 {
-  const std::string command = "/usr/bin/python3 '" + options.scipyEdt + "' '" + volumeFile + "' " + std::to_string(iso);
+  const std::string command =
+    "/usr/bin/python3 '" + options.scipyEdt + "' '" + volumeFile + "' " + std::to_string(iso);
   FILE* pipe = popen(command.c_str(), "r");
   EdtPeer peer;
   char line[256];
@@ -271,8 +280,9 @@ EdtPeer RunScipyEdt(const Options& options, const std::string& volumeFile, doubl
 
 /// Best of `repeat` runs of the sweeping kernel: distance only, with the combined
 /// occlusion, or with the 8 octants written out.
-double TimeSweeping(const vao::VolumeView& view, const std::array<double, 3>& spacing, double iso, int outputs,
-  int repeat, std::vector<float>& distance, std::vector<float>& ao, std::vector<float>& octants)
+double TimeSweeping(const vao::VolumeView& view, const std::array<double, 3>& spacing, double iso,
+  int outputs, int repeat, std::vector<float>& distance, std::vector<float>& ao,
+  std::vector<float>& octants)
 {
   vao::SweepParameters parameters;
   parameters.isoValue = iso;
@@ -293,45 +303,51 @@ double TimeSweeping(const vao::VolumeView& view, const std::array<double, 3>& sp
   return best;
 }
 
-void SweepRow(const std::string& label, const vao::VolumeView& view, const std::array<double, 3>& spacing, double iso,
-  const std::string& rawForPeer, const Options& options)
+void SweepRow(const std::string& label, const vao::VolumeView& view,
+  const std::array<double, 3>& spacing, double iso, const std::string& rawForPeer,
+  const Options& options)
 {
   const size_t n = static_cast<size_t>(view.voxelCount());
   std::vector<float> distance(n), ao(n), octants(8 * n);
   const double sdf = TimeSweeping(view, spacing, iso, 0, options.repeat, distance, ao, octants);
-  const double combined = TimeSweeping(view, spacing, iso, 1, options.repeat, distance, ao, octants);
+  const double combined =
+    TimeSweeping(view, spacing, iso, 1, options.repeat, distance, ao, octants);
   const double eight = TimeSweeping(view, spacing, iso, 2, options.repeat, distance, ao, octants);
   const EdtPeer edt = rawForPeer.empty() ? EdtPeer{} : RunScipyEdt(options, rawForPeer, iso);
-  std::printf("  %-28s %10.0f %10.0f %10.0f %10.0f %10.0f %9.1fx\n", label.c_str(), 1e3 * sdf, 1e3 * combined,
-    1e3 * eight, edt.unsignedSeconds > 0 ? 1e3 * edt.unsignedSeconds : -1.0,
-    edt.signedSeconds > 0 ? 1e3 * edt.signedSeconds : -1.0, edt.signedSeconds > 0 ? edt.signedSeconds / eight : -1.0);
+  std::printf("  %-28s %10.0f %10.0f %10.0f %10.0f %10.0f %9.1fx\n", label.c_str(), 1e3 * sdf,
+    1e3 * combined, 1e3 * eight, edt.unsignedSeconds > 0 ? 1e3 * edt.unsignedSeconds : -1.0,
+    edt.signedSeconds > 0 ? 1e3 * edt.signedSeconds : -1.0,
+    edt.signedSeconds > 0 ? edt.signedSeconds / eight : -1.0);
 }
 
 /// The sweeping table: the sizes of Singh et al.'s Table 2 (generated Fig. 3 scenes) and
 /// the CT head phantom's skin.
 void BenchmarkSweeping(const Options& options, vtkImageData* ct)
 {
-  std::printf("\nOcclusion sweeping (one pass; best of %d; ms) and scipy.ndimage.distance_transform_edt: unsigned\n"
-              "  (one EDT) and signed (two EDTs and their difference, what SignedDistance holds); signed/8: the\n"
+  std::printf("\nOcclusion sweeping (one pass; best of %d; ms) and "
+              "scipy.ndimage.distance_transform_edt: unsigned\n"
+              "  (one EDT) and signed (two EDTs and their difference, what SignedDistance holds); "
+              "signed/8: the\n"
               "  signed EDT over the 8-octant sweep (issue 14's bar: at least 8x on 250^3)\n",
     options.repeat);
-  std::printf("  %-28s %10s %10s %10s %10s %10s %10s\n", "volume", "SDF only", "SDF+AO", "8 octants", "scipy EDT",
-    "signed EDT", "signed/8");
-  const int sizes[][3] = { { 101, 101, 61 }, { 100, 100, 100 }, { 150, 150, 150 }, { 200, 200, 200 },
-    { 250, 250, 250 } };
+  std::printf("  %-28s %10s %10s %10s %10s %10s %10s\n", "volume", "SDF only", "SDF+AO",
+    "8 octants", "scipy EDT", "signed EDT", "signed/8");
+  const int sizes[][3] = { { 101, 101, 61 }, { 100, 100, 100 }, { 150, 150, 150 },
+    { 200, 200, 200 }, { 250, 250, 250 } };
   for (const auto& size : sizes)
   {
     const int nx = size[0], ny = size[1], nz = size[2];
     const std::vector<float> volume = vaotest::SceneVolume(nx, ny, nz);
-    const std::string raw = "/tmp/vao_sweep_" + std::to_string(nx) + "x" + std::to_string(ny) + "x" +
-      std::to_string(nz) + "_float32.raw";
-    std::ofstream(raw, std::ios::binary).write(reinterpret_cast<const char*>(volume.data()), volume.size() * sizeof(float));
+    const std::string raw = "/tmp/vao_sweep_" + std::to_string(nx) + "x" + std::to_string(ny) +
+      "x" + std::to_string(nz) + "_float32.raw";
+    std::ofstream(raw, std::ios::binary)
+      .write(reinterpret_cast<const char*>(volume.data()), volume.size() * sizeof(float));
     vao::VolumeView view;
     view.data = volume.data();
     view.type = vao::ScalarType::Float32;
     view.dims = { nx, ny, nz };
-    SweepRow(std::to_string(nx) + "x" + std::to_string(ny) + "x" + std::to_string(nz) + " scene", view,
-      { 1.0, 1.0, 1.0 }, 0.5, raw, options);
+    SweepRow(std::to_string(nx) + "x" + std::to_string(ny) + "x" + std::to_string(nz) + " scene",
+      view, { 1.0, 1.0, 1.0 }, 0.5, raw, options);
     std::remove(raw.c_str());
   }
   vao::VolumeView view;
@@ -344,9 +360,10 @@ void BenchmarkSweeping(const Options& options, vtkImageData* ct)
   std::vector<float> asFloat(static_cast<size_t>(view.voxelCount()));
   const short* values = static_cast<const short*>(view.data);
   std::copy(values, values + asFloat.size(), asFloat.begin());
-  const std::string raw = "/tmp/vao_sweep_ct_" + std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" +
-    std::to_string(d[2]) + "_float32.raw";
-  std::ofstream(raw, std::ios::binary).write(reinterpret_cast<const char*>(asFloat.data()), asFloat.size() * sizeof(float));
+  const std::string raw = "/tmp/vao_sweep_ct_" + std::to_string(d[0]) + "x" + std::to_string(d[1]) +
+    "x" + std::to_string(d[2]) + "_float32.raw";
+  std::ofstream(raw, std::ios::binary)
+    .write(reinterpret_cast<const char*>(asFloat.data()), asFloat.size() * sizeof(float));
   SweepRow("CT head skin (-300 HU)", view, { h[0], h[1], h[2] }, -300.0, raw, options);
   std::remove(raw.c_str());
 }
@@ -386,11 +403,15 @@ int main(int argc, char* argv[])
       return RunBytesWorkload(argv[i + 1]);
     else
     {
-      std::fprintf(stderr, "usage: %s [--data DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--volumetric | --sweeping | --penner | --relight | --bytes]\n", argv[0]);
+      std::fprintf(stderr,
+        "usage: %s [--data DIR] [--scipy FILE] [--repeat N] [--threads N] [--exact] [--volumetric "
+        "| --sweeping | --penner | --relight | --bytes]\n",
+        argv[0]);
       return 2;
     }
   }
-  std::printf("VolumetricAO benchmark: best of %d runs of the filter (wall clock, input in memory)\n",
+  std::printf(
+    "VolumetricAO benchmark: best of %d runs of the filter (wall clock, input in memory)\n",
     options.repeat);
 
   if (!options.sweepingOnly && !options.pennerOnly)
@@ -406,14 +427,16 @@ int main(int argc, char* argv[])
     Benchmark("generated phantom", phantom->GetOutput(), raw, options);
     std::remove(raw.c_str());
 
-    const std::string ct = ScanPath(options.data, "ct_head_phantom/ct_head_phantom_512x512x209_int16.mha");
+    const std::string ct =
+      ScanPath(options.data, "ct_head_phantom/ct_head_phantom_512x512x209_int16.mha");
     Benchmark("ct_head_phantom_512x512x209_int16.mha", ReadScanOrExit(ct), ct, options);
   }
   if (options.volumetricOnly)
   {
     return 0;
   }
-  const auto head = ReadScanOrExit(ScanPath(options.data, "ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));
+  const auto head =
+    ReadScanOrExit(ScanPath(options.data, "ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));
   if (!options.pennerOnly)
   {
     BenchmarkSweeping(options, head);
@@ -422,11 +445,13 @@ int main(int argc, char* argv[])
   {
     if (!options.relightOnly)
       BenchmarkPyramid(options);
-    std::printf("\nVariance occlusion maps: relighting, AO and soft shadows from a cached pyramid (best of %d)\n",
+    std::printf("\nVariance occlusion maps: relighting, AO and soft shadows from a cached pyramid "
+                "(best of %d)\n",
       options.repeat);
     BenchmarkRelighting(options, "CT head 128x128x136", head);
     BenchmarkRelighting(options, "CT head 512x512x209",
-      ReadScanOrExit(ScanPath(options.data, "ct_head_phantom/ct_head_phantom_512x512x209_int16.mha")));
+      ReadScanOrExit(
+        ScanPath(options.data, "ct_head_phantom/ct_head_phantom_512x512x209_int16.mha")));
   }
   return 0;
 }

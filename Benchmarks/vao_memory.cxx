@@ -53,7 +53,8 @@ using vao_bench::StatusBytes;
 long long NewArrayBytes(vtkDataObject* data, const std::set<vtkDataArray*>& known)
 {
   long long bytes = 0;
-  auto add = [&](vtkDataSet* set) {
+  auto add = [&](vtkDataSet* set)
+  {
     vtkPointData* pd = set->GetPointData();
     for (int a = 0; a < pd->GetNumberOfArrays(); ++a)
     {
@@ -91,17 +92,14 @@ struct Case
 };
 
 const Case kCases[] = {
-  { "Histogram CDF", "AmbientOcclusion" },
-  { "Gaussian CDF", "AmbientOcclusion" },
-  { "CDF Reconstruction", "AmbientOcclusion" },
-  { "Chebyshev", "AmbientOcclusion" },
+  { "Histogram CDF", "AmbientOcclusion" }, { "Gaussian CDF", "AmbientOcclusion" },
+  { "CDF Reconstruction", "AmbientOcclusion" }, { "Chebyshev", "AmbientOcclusion" },
   { "Gaussian CDF + variance", "AmbientOcclusion, Variance" },
   { "Occlusion Sweeping", "AmbientOcclusion, SignedDistance" },
-  { "Variance Occlusion Map", "4 levels of Mean, Variance" },
-  { "Shading (RGBA)", "ShadedRGBA" },
+  { "Variance Occlusion Map", "4 levels of Mean, Variance" }, { "Shading (RGBA)", "ShadedRGBA" },
   { "Isosurface AO + shadows", "AmbientOcclusion, Shadow (bone)", 50.0 },
   { "Isosurface AO, half res.", "AmbientOcclusion, Shadow (bone)", 50.0 },
-  { "Exact Box", "AmbientOcclusion" },   // only with --exact (minutes: O(R^3))
+  { "Exact Box", "AmbientOcclusion" },    // only with --exact (minutes: O(R^3))
   { "Exact Sphere", "AmbientOcclusion" }, // only with --exact
 };
 constexpr int kFirstExactCase = 10;
@@ -204,8 +202,8 @@ int RunChild(int c, const std::string& path, double radius, int threads)
   filter->Update();
   const long long peak = StatusBytes("VmHWM:");
   const long long outputBytes = NewArrayBytes(filter->GetOutputDataObject(0), known);
-  std::printf("%lld %lld %lld %lld\n", inputBytes, outputBytes, peak - before,
-    peak - before - outputBytes);
+  std::printf(
+    "%lld %lld %lld %lld\n", inputBytes, outputBytes, peak - before, peak - before - outputBytes);
   return 0;
 }
 
@@ -220,7 +218,8 @@ std::string Mb(long long bytes)
 
 int main(int argc, char* argv[])
 {
-  std::string path = vaobench::ScanPath(VAO_EXTRA_DATA_DIR, "ct_head_phantom/ct_head_phantom_512x512x209_int16.mha");
+  std::string path =
+    vaobench::ScanPath(VAO_EXTRA_DATA_DIR, "ct_head_phantom/ct_head_phantom_512x512x209_int16.mha");
   double radius = 10.0;
   int threads = 0;
   int child = -1;
@@ -270,7 +269,8 @@ int main(int argc, char* argv[])
         << threads << " '" << path << "'";
     FILE* pipe = popen(run.str().c_str(), "r");
     long long input = 0, output = 0, peak = 0, extra = 0;
-    const bool ok = pipe && std::fscanf(pipe, "%lld %lld %lld %lld", &input, &output, &peak, &extra) == 4;
+    const bool ok =
+      pipe && std::fscanf(pipe, "%lld %lld %lld %lld", &input, &output, &peak, &extra) == 4;
     if (pipe)
       pclose(pipe);
     if (!ok)

@@ -5,7 +5,8 @@
 //
 //   vao_stream generate OUT.mhd NX NY NZ
 //       the project's head phantom (int16), generated and written slab by slab
-//   vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method gaussian|cdf|chebyshev|histogram]
+//   vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method
+//   gaussian|cdf|chebyshev|histogram]
 //       float32 AmbientOcclusion of an uncompressed MetaImage (.mhd + raw data file);
 //       histogram: Histogram CDF, whose thresholds are first read from the slabs
 //   vao_stream check IN.mhd AO.mhd [--radius R] [--method ...]
@@ -24,8 +25,8 @@
 #include <vtkDoubleArray.h>
 #include <vtkImageData.h>
 #include <vtkImageReader.h>
-#include <vtkMetaImageReader.h>
 #include <vtkInformation.h>
+#include <vtkMetaImageReader.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkSmartPointer.h>
@@ -51,16 +52,16 @@ struct Header
   int dims[3] = { 0, 0, 0 };
   double spacing[3] = { 1, 1, 1 };
   double origin[3] = { 0, 0, 0 };
-  int type = VTK_VOID; // VTK scalar type
+  int type = VTK_VOID;  // VTK scalar type
   std::string dataFile; // absolute or relative to the header's folder
   bool bigEndian = false;
   long headerSize = 0;
 };
 
 const std::map<std::string, int> kMetTypes = { { "MET_CHAR", VTK_SIGNED_CHAR },
-  { "MET_UCHAR", VTK_UNSIGNED_CHAR }, { "MET_SHORT", VTK_SHORT }, { "MET_USHORT", VTK_UNSIGNED_SHORT },
-  { "MET_INT", VTK_INT }, { "MET_UINT", VTK_UNSIGNED_INT }, { "MET_FLOAT", VTK_FLOAT },
-  { "MET_DOUBLE", VTK_DOUBLE } };
+  { "MET_UCHAR", VTK_UNSIGNED_CHAR }, { "MET_SHORT", VTK_SHORT },
+  { "MET_USHORT", VTK_UNSIGNED_SHORT }, { "MET_INT", VTK_INT }, { "MET_UINT", VTK_UNSIGNED_INT },
+  { "MET_FLOAT", VTK_FLOAT }, { "MET_DOUBLE", VTK_DOUBLE } };
 
 std::string Folder(const std::string& path)
 {
@@ -167,9 +168,9 @@ bool WriteHeader(const std::string& path, const Header& h, const char* metType)
 {
   std::ofstream out(path);
   out << "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n"
-      << "CompressedData = False\nOffset = " << h.origin[0] << " " << h.origin[1] << " " << h.origin[2]
-      << "\nElementSpacing = " << h.spacing[0] << " " << h.spacing[1] << " " << h.spacing[2]
-      << "\nDimSize = " << h.dims[0] << " " << h.dims[1] << " " << h.dims[2]
+      << "CompressedData = False\nOffset = " << h.origin[0] << " " << h.origin[1] << " "
+      << h.origin[2] << "\nElementSpacing = " << h.spacing[0] << " " << h.spacing[1] << " "
+      << h.spacing[2] << "\nDimSize = " << h.dims[0] << " " << h.dims[1] << " " << h.dims[2]
       << "\nElementType = " << metType << "\nElementDataFile = " << BaseName(h.dataFile) << "\n";
   return static_cast<bool>(out);
 }
@@ -232,14 +233,14 @@ int Generate(const std::string& path, const int dims[3])
       return 1;
     }
   }
-  std::printf("generated %s: %d x %d x %d int16 (%.0f MB) in %d slabs, %.1f s\n", path.c_str(), dims[0],
-    dims[1], dims[2], plane * dims[2] * 2 / 1048576.0, pieces, Seconds(start));
+  std::printf("generated %s: %d x %d x %d int16 (%.0f MB) in %d slabs, %.1f s\n", path.c_str(),
+    dims[0], dims[1], dims[2], plane * dims[2] * 2 / 1048576.0, pieces, Seconds(start));
   PrintMemory();
   return 0;
 }
 
-int AmbientOcclusion(const std::string& inPath, const std::string& outPath, int pieces, double radius,
-  int method)
+int AmbientOcclusion(
+  const std::string& inPath, const std::string& outPath, int pieces, double radius, int method)
 {
   const auto start = std::chrono::steady_clock::now();
   Header in;
@@ -266,11 +267,13 @@ int AmbientOcclusion(const std::string& inPath, const std::string& outPath, int 
   int mostSlicesRead = 0;
   vtkNew<vtkCallbackCommand> watch;
   watch->SetClientData(&mostSlicesRead);
-  watch->SetCallback([](vtkObject* caller, unsigned long, void* most, void*) {
-    const int* read = static_cast<vtkImageReader*>(caller)->GetOutput()->GetExtent();
-    int& slices = *static_cast<int*>(most);
-    slices = std::max(slices, read[5] - read[4] + 1);
-  });
+  watch->SetCallback(
+    [](vtkObject* caller, unsigned long, void* most, void*)
+    {
+      const int* read = static_cast<vtkImageReader*>(caller)->GetOutput()->GetExtent();
+      int& slices = *static_cast<int*>(most);
+      slices = std::max(slices, read[5] - read[4] + 1);
+    });
   reader->AddObserver(vtkCommand::EndEvent, watch);
 
   vtkNew<vtkVolumetricAmbientOcclusion> filter;
@@ -284,7 +287,8 @@ int AmbientOcclusion(const std::string& inPath, const std::string& outPath, int 
     vtkSmartPointer<vtkDoubleArray> thresholds = filter->ComputeHistogramThresholds(pieces);
     if (!thresholds)
     {
-      std::fprintf(stderr, "vao_stream: the thresholds of %s could not be computed\n", inPath.c_str());
+      std::fprintf(
+        stderr, "vao_stream: the thresholds of %s could not be computed\n", inPath.c_str());
       return 1;
     }
     filter->SetHistogramThresholds(thresholds);
@@ -322,8 +326,9 @@ int AmbientOcclusion(const std::string& inPath, const std::string& outPath, int 
   }
   const double mb = static_cast<double>(in.dims[0]) * in.dims[1] * in.dims[2] *
     reader->GetOutput()->GetPointData()->GetScalars()->GetDataTypeSize() / 1048576.0;
-  std::printf("streamed %s (%d x %d x %d, %.0f MB) -> %s in %d pieces, R = %g: %.1f s\n", inPath.c_str(),
-    in.dims[0], in.dims[1], in.dims[2], mb, outPath.c_str(), pieces, radius, Seconds(start));
+  std::printf("streamed %s (%d x %d x %d, %.0f MB) -> %s in %d pieces, R = %g: %.1f s\n",
+    inPath.c_str(), in.dims[0], in.dims[1], in.dims[2], mb, outPath.c_str(), pieces, radius,
+    Seconds(start));
   std::printf("most slices read at once: %d of %d\n", mostSlicesRead, in.dims[2]);
   PrintMemory();
   return 0;
@@ -333,8 +338,10 @@ int Usage()
 {
   std::fprintf(stderr,
     "usage: vao_stream generate OUT.mhd NX NY NZ\n"
-    "       vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method gaussian|cdf|chebyshev|histogram]\n"
-    "       vao_stream check IN.mhd AO.mhd [--radius R] [--method gaussian|cdf|chebyshev|histogram]\n");
+    "       vao_stream ao IN.mhd OUT.mhd [--pieces N] [--radius R] [--method "
+    "gaussian|cdf|chebyshev|histogram]\n"
+    "       vao_stream check IN.mhd AO.mhd [--radius R] [--method "
+    "gaussian|cdf|chebyshev|histogram]\n");
   return 2;
 }
 
@@ -371,7 +378,8 @@ int Check(const std::string& inPath, const std::string& aoPath, double radius, i
   if (!want || !got || want->GetNumberOfTuples() != got->GetNumberOfTuples() ||
     !std::equal(input->GetDimensions(), input->GetDimensions() + 3, streamed->GetDimensions()))
   {
-    std::fprintf(stderr, "vao_stream: %s does not match %s in size\n", aoPath.c_str(), inPath.c_str());
+    std::fprintf(
+      stderr, "vao_stream: %s does not match %s in size\n", aoPath.c_str(), inPath.c_str());
     return 1;
   }
   double worst = 0.0;
@@ -383,7 +391,8 @@ int Check(const std::string& inPath, const std::string& aoPath, double radius, i
 }
 
 /// --radius and --method (and --pieces where allowed) from argv[first..]; false on a bad one.
-bool ParseOptions(int argc, char* argv[], int first, bool piecesAllowed, int& pieces, double& radius, int& method)
+bool ParseOptions(
+  int argc, char* argv[], int first, bool piecesAllowed, int& pieces, double& radius, int& method)
 {
   for (int i = first; i < argc; ++i)
   {

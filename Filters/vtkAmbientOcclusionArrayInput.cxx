@@ -102,8 +102,8 @@ void ViewComponent(vtkDataArray* scalars, int picked, ScalarVolume& volume)
 
 } // namespace
 
-bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input, int component,
-  ScalarVolume& volume, std::string& error)
+bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input,
+  int component, ScalarVolume& volume, std::string& error)
 {
   vtkDataArray* scalars = ChosenArray(algorithm, chosen, input);
   if (!scalars)
@@ -115,7 +115,8 @@ bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData*
   volume.name = scalars->GetName() ? scalars->GetName() : "";
   if (input->GetPointData()->GetAbstractArray(scalars->GetName()) != scalars)
   {
-    error = "Array '" + volume.name + "' is not a point-data array; the filter works on points (voxels).";
+    error =
+      "Array '" + volume.name + "' is not a point-data array; the filter works on points (voxels).";
     return false;
   }
   error = PointCountError(scalars, input->GetNumberOfPoints());
@@ -128,14 +129,16 @@ bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData*
   if (picked < 0 || picked >= components)
   {
     std::ostringstream why;
-    why << "Array '" << volume.name << "' has " << components << " components; set Component to one of 0.."
-        << components - 1 << " (got " << component << ").";
+    why << "Array '" << volume.name << "' has " << components
+        << " components; set Component to one of 0.." << components - 1 << " (got " << component
+        << ").";
     error = why.str();
     return false;
   }
   if (!ToKernelType(scalars->GetDataType(), volume.view.type))
   {
-    error = "Array '" + volume.name + "' has unsupported type " + scalars->GetDataTypeAsString() + ".";
+    error =
+      "Array '" + volume.name + "' has unsupported type " + scalars->GetDataTypeAsString() + ".";
     return false;
   }
   const int* dims = input->GetDimensions();
@@ -151,8 +154,9 @@ std::string PointCountError(vtkDataArray* array, vtkIdType points)
   if (!array || array->GetNumberOfTuples() == points)
     return std::string();
   std::ostringstream why;
-  why << "Array '" << (array->GetName() ? array->GetName() : "") << "' has " << array->GetNumberOfTuples()
-      << " tuples for the input's " << points << " points: a point array needs one tuple a point.";
+  why << "Array '" << (array->GetName() ? array->GetName() : "") << "' has "
+      << array->GetNumberOfTuples() << " tuples for the input's " << points
+      << " points: a point array needs one tuple a point.";
   return why.str();
 }
 
@@ -166,8 +170,9 @@ vtkDataArray* GivenNormals(vtkPolyData* surface)
   return given && given->GetNumberOfComponents() == 3 ? given : nullptr;
 }
 
-bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points, const vtkAmbientOcclusionFrame::Frame& frame,
-  const ScalarVolume& volume, const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
+bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points,
+  const vtkAmbientOcclusionFrame::Frame& frame, const ScalarVolume& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
   std::vector<double>& normals, std::string& error)
 {
   const vtkIdType n = surface->GetNumberOfPoints();
@@ -216,20 +221,22 @@ bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points, con
 }
 
 bool ReadSurfacePoints(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Frame& frame,
-  const ScalarVolume& volume, const std::array<double, 3>& origin, const std::array<double, 3>& spacing, bool needed,
-  SurfacePoints& out, std::string& error)
+  const ScalarVolume& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, bool needed, SurfacePoints& out, std::string& error)
 {
   const vtkIdType n = surface->GetNumberOfPoints();
   out.count = n;
   vtkDataArray* givenNormals = GivenNormals(surface);
   if (givenNormals && givenNormals->GetNumberOfTuples() < n)
   {
-    error = std::string("The surface's normals (\"") + (givenNormals->GetName() ? givenNormals->GetName() : "") +
-      "\") have " + std::to_string(givenNormals->GetNumberOfTuples()) + " tuples for " + std::to_string(n) +
+    error = std::string("The surface's normals (\"") +
+      (givenNormals->GetName() ? givenNormals->GetName() : "") + "\") have " +
+      std::to_string(givenNormals->GetNumberOfTuples()) + " tuples for " + std::to_string(n) +
       " points: give one normal per point, or none (then they come from the volume's gradient).";
     return false;
   }
-  vtkFloatArray* floatPoints = vtkFloatArray::SafeDownCast(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr);
+  vtkFloatArray* floatPoints =
+    vtkFloatArray::SafeDownCast(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr);
   vtkFloatArray* floatNormals = vtkFloatArray::SafeDownCast(givenNormals);
   out.inPlace = floatPoints && floatNormals && frame.identity;
   if (out.inPlace)
@@ -271,7 +278,8 @@ std::string NumberOfThreadsError(int threads)
     return {};
   }
   std::ostringstream why;
-  why << "NumberOfThreads must be 0 (the cores available, divided among the MPI ranks of the node) or "
+  why << "NumberOfThreads must be 0 (the cores available, divided among the MPI ranks of the node) "
+         "or "
          "positive (got "
       << threads << ").";
   return why.str();
@@ -290,8 +298,9 @@ std::string NonFiniteError(vtkDataArray* array)
     for (vtkIdType i = 0; i < array->GetNumberOfTuples(); ++i)
       for (int c = 0; c < array->GetNumberOfComponents(); ++c)
         if (!std::isfinite(array->GetComponent(i, c)))
-          return "Array '" + std::string(array->GetName() ? array->GetName() : "") + "' has NaN or infinite values (the first at point " +
-            std::to_string(i) + "): replace them (e.g. with the Calculator or Threshold filters) first.";
+          return "Array '" + std::string(array->GetName() ? array->GetName() : "") +
+            "' has NaN or infinite values (the first at point " + std::to_string(i) +
+            "): replace them (e.g. with the Calculator or Threshold filters) first.";
     return {};
   }
   // Every component: each point's values, read in place as one long line of voxels.
@@ -304,13 +313,16 @@ std::string NonFiniteError(vtkDataArray* array)
   }
   std::ostringstream why;
   why << "Array '" << (array->GetName() ? array->GetName() : "") << "' has " << scan.nonFiniteCount
-      << " NaN or infinite values (the first at point " << scan.firstNonFinite / array->GetNumberOfComponents()
-      << "): they have no colour, opacity or shade; replace them (e.g. with the Calculator or Threshold "
+      << " NaN or infinite values (the first at point "
+      << scan.firstNonFinite / array->GetNumberOfComponents()
+      << "): they have no colour, opacity or shade; replace them (e.g. with the Calculator or "
+         "Threshold "
          "filters) first.";
   return why.str();
 }
 
-std::string KernelError(const vao::Status& status, const ScalarVolume& scalars, const std::string& failed)
+std::string KernelError(
+  const vao::Status& status, const ScalarVolume& scalars, const std::string& failed)
 {
   if (status.ok || status.aborted)
   {
@@ -337,11 +349,13 @@ std::string KernelError(const vao::Status& status, const ScalarVolume& scalars, 
   const std::int64_t first = status.firstNonFinite;
   const std::int64_t plane = dims[0] * dims[1];
   std::ostringstream why;
-  why << "Array '" << scalars.name << "' has " << status.nonFiniteCount
-      << " NaN or infinite values (the first at voxel " << first % dims[0] + scalars.firstVoxel[0] << ", "
-      << (first / dims[0]) % dims[1] + scalars.firstVoxel[1] << ", " << first / plane + scalars.firstVoxel[2]
-      << "). A non-finite value has no place in a cumulative distribution or an isosurface: replace "
-         "them (e.g. with the Calculator or Threshold filters) first.";
+  why
+    << "Array '" << scalars.name << "' has " << status.nonFiniteCount
+    << " NaN or infinite values (the first at voxel " << first % dims[0] + scalars.firstVoxel[0]
+    << ", " << (first / dims[0]) % dims[1] + scalars.firstVoxel[1] << ", "
+    << first / plane + scalars.firstVoxel[2]
+    << "). A non-finite value has no place in a cumulative distribution or an isosurface: replace "
+       "them (e.g. with the Calculator or Threshold filters) first.";
   return why.str();
 }
 

@@ -43,8 +43,8 @@ struct ScalarVolume
 /// rotation) and fills volume, its frame included. On failure returns false and says why in
 /// `error`. NaN and infinite values are not looked for here: the kernels find them in
 /// their first pass over the data, and KernelError names them.
-bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input, int component,
-  ScalarVolume& volume, std::string& error);
+bool PrepareScalars(vtkAlgorithm* algorithm, vtkDataArray* chosen, vtkImageData* input,
+  int component, ScalarVolume& volume, std::string& error);
 
 /// The surface's own point normals: its active normals, else a 3-component point array
 /// named "Normals"; nullptr when it has neither.
@@ -55,8 +55,9 @@ vtkDataArray* GivenNormals(vtkPolyData* surface);
 /// them the gradient of `volume` (voxel 0 at `origin`) at `points` (3 doubles a point,
 /// already in the image's frame), pointing towards lower values. On failure (no normals
 /// and a zero gradient) returns false and says why in `error`.
-bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points, const vtkAmbientOcclusionFrame::Frame& frame,
-  const ScalarVolume& volume, const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
+bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points,
+  const vtkAmbientOcclusionFrame::Frame& frame, const ScalarVolume& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
   std::vector<double>& normals, std::string& error);
 
 /// A surface's points and normals as the surface kernels read them: its float arrays in
@@ -86,8 +87,8 @@ struct SurfacePoints
 /// with the reason in `error`, when the given normals are fewer than the points or
 /// SurfaceNormals fails.
 bool ReadSurfacePoints(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Frame& frame,
-  const ScalarVolume& volume, const std::array<double, 3>& origin, const std::array<double, 3>& spacing, bool needed,
-  SurfacePoints& out, std::string& error);
+  const ScalarVolume& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, bool needed, SurfacePoints& out, std::string& error);
 
 /// The kernels' execution hooks for an algorithm: its progress, its abort flag, and
 /// `threads` (the filter's NumberOfThreads; 0: the kernels' default).
@@ -109,7 +110,8 @@ std::string NonFiniteError(vtkDataArray* array);
 /// input, the array, how many such values it has and the first one's voxel in the input's
 /// coordinates; otherwise "<failed>: <the kernel's reason>.". Empty when the call
 /// succeeded or the user aborted it.
-std::string KernelError(const vao::Status& status, const ScalarVolume& scalars, const std::string& failed);
+std::string KernelError(
+  const vao::Status& status, const ScalarVolume& scalars, const std::string& failed);
 
 } // namespace vtkAmbientOcclusionArrayInput
 

@@ -51,8 +51,10 @@ void PasteExtent(vtkImageData* piece, const int pieceExt[6], vtkImageData* outpu
       for (int j = pieceExt[2]; j <= pieceExt[3]; ++j)
       {
         const vtkIdType src = ((k - pieceExt[4]) * pny + (j - pieceExt[2])) * pnx;
-        const vtkIdType dst = ((k - outExt[4]) * ony + (j - outExt[2])) * onx + (pieceExt[0] - outExt[0]);
-        std::copy(from + src * tupleBytes, from + (src + pnx) * tupleBytes, into + dst * tupleBytes);
+        const vtkIdType dst =
+          ((k - outExt[4]) * ony + (j - outExt[2])) * onx + (pieceExt[0] - outExt[0]);
+        std::copy(
+          from + src * tupleBytes, from + (src + pnx) * tupleBytes, into + dst * tupleBytes);
       }
   }
 }
@@ -76,7 +78,8 @@ void AllocateWanted(vtkImageData* held, const int wanted[6], vtkImageData* outpu
     copy.TakeReference(array->NewInstance());
     copy->SetName(array->GetName());
     copy->SetNumberOfComponents(array->GetNumberOfComponents());
-    vtkAmbientOcclusionMemory::Allocate(copy, points, std::string("the redistributed array ") + array->GetName());
+    vtkAmbientOcclusionMemory::Allocate(
+      copy, points, std::string("the redistributed array ") + array->GetName());
     output->GetPointData()->AddArray(copy);
   }
   if (from->GetScalars())
@@ -153,7 +156,8 @@ void RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
       if (rank != a && rank != b)
         continue;
       const int other = rank == a ? b : a;
-      auto send = [&] {
+      auto send = [&]
+      {
         int part[6];
         if (IntersectExtents(held->GetExtent(), &wantedExtents[6 * other], part))
         {
@@ -162,7 +166,8 @@ void RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
           controller->Send(piece.Get(), other, kPieceTag);
         }
       };
-      auto receive = [&] {
+      auto receive = [&]
+      {
         int part[6];
         if (wantsSomething && IntersectExtents(&heldExtents[6 * other], wanted, part))
         {
@@ -202,8 +207,8 @@ void GatherLevel(vtkMultiProcessController* controller, vtkImageData* part, vao:
   controller->AllGather(ext, extents.data(), 6);
   GatheredLayout layout = LayoutOf(extents, 2);
   std::vector<float> all(static_cast<size_t>(std::max<vtkIdType>(layout.total, 1)));
-  controller->AllGatherV(
-    mine.data(), all.data(), static_cast<vtkIdType>(mine.size()), layout.lengths.data(), layout.offsets.data());
+  controller->AllGatherV(mine.data(), all.data(), static_cast<vtkIdType>(mine.size()),
+    layout.lengths.data(), layout.offsets.data());
 
   const vtkIdType nx = level.dims[0], ny = level.dims[1];
   level.mean.resize(static_cast<size_t>(nx * ny * level.dims[2]));

@@ -33,7 +33,8 @@ void RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
 /// (`part`: float arrays "Mean" and "Variance", its extent in the whole level's grid;
 /// null or empty for none) and receives the mean and variance of the whole level in
 /// `level`, whose dims the caller sets. Where pieces overlap they hold the same values.
-void GatherLevel(vtkMultiProcessController* controller, vtkImageData* part, vao::MomentLevel& level);
+void GatherLevel(
+  vtkMultiProcessController* controller, vtkImageData* part, vao::MomentLevel& level);
 
 } // namespace vtkAmbientOcclusionCollectives
 

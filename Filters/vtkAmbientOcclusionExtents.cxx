@@ -26,16 +26,18 @@ bool CheckWholeExtent(const int whole[6], std::string& error)
   }
   std::ostringstream why;
   why << "The filter needs a 3-D volume; the input is " << std::max(dims[0], 0) << " x "
-      << std::max(dims[1], 0) << " x " << std::max(dims[2], 0) << " voxels (empty, a single voxel, or 2-D).";
+      << std::max(dims[1], 0) << " x " << std::max(dims[2], 0)
+      << " voxels (empty, a single voxel, or 2-D).";
   error = why.str();
   return false;
 }
 
-bool WholeAndRequestedExtent(vtkInformationVector* inputs, vtkInformationVector* outputs, int whole[6],
-  int requested[6], std::string& error)
+bool WholeAndRequestedExtent(vtkInformationVector* inputs, vtkInformationVector* outputs,
+  int whole[6], int requested[6], std::string& error)
 {
   inputs->GetInformationObject(0)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  outputs->GetInformationObject(0)->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), requested);
+  outputs->GetInformationObject(0)->Get(
+    vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), requested);
   return CheckWholeExtent(whole, error);
 }
 
@@ -46,9 +48,9 @@ bool EmptyExtent(const int ext[6])
 
 vtkIdType ExtentPoints(const int ext[6])
 {
-  return EmptyExtent(ext) ? 0
-                          : static_cast<vtkIdType>(ext[1] - ext[0] + 1) * (ext[3] - ext[2] + 1) *
-      (ext[5] - ext[4] + 1);
+  return EmptyExtent(ext)
+    ? 0
+    : static_cast<vtkIdType>(ext[1] - ext[0] + 1) * (ext[3] - ext[2] + 1) * (ext[5] - ext[4] + 1);
 }
 
 bool IntersectExtents(const int a[6], const int b[6], int common[6])
@@ -91,7 +93,8 @@ void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int ou
   for (int a = 0; a < input->GetPointData()->GetNumberOfArrays(); ++a)
   {
     if (vtkAbstractArray* array = input->GetPointData()->GetAbstractArray(a))
-      bytes += static_cast<double>(points) * array->GetNumberOfComponents() * array->GetDataTypeSize();
+      bytes +=
+        static_cast<double>(points) * array->GetNumberOfComponents() * array->GetDataTypeSize();
   }
   vtkAmbientOcclusionMemory::Reserve(bytes, "the input's arrays cropped to the requested extent");
   output->GetPointData()->CopyAllocate(input->GetPointData(), points);
@@ -102,8 +105,8 @@ void CopyRequestedExtent(vtkImageData* input, vtkImageData* output, const int ou
 void PieceOfWhole(int piece, int pieces, const int whole[6], int ext[6])
 {
   vtkNew<vtkExtentTranslator> translator;
-  if (!translator->PieceToExtentThreadSafe(
-        piece, std::max(pieces, 1), 0, const_cast<int*>(whole), ext, vtkExtentTranslator::BLOCK_MODE, 0))
+  if (!translator->PieceToExtentThreadSafe(piece, std::max(pieces, 1), 0, const_cast<int*>(whole),
+        ext, vtkExtentTranslator::BLOCK_MODE, 0))
   {
     ext[0] = ext[2] = ext[4] = 0; // more pieces than voxels: an empty piece
     ext[1] = ext[3] = ext[5] = -1;
@@ -138,7 +141,8 @@ int PyramidAlignment(int levels, bool half)
   return 1 << (std::max(levels, 1) - 1 + (half ? 1 : 0));
 }
 
-void GrowForPyramid(const int whole[6], const int piece[6], const int reach[3], int alignment, int ext[6])
+void GrowForPyramid(
+  const int whole[6], const int piece[6], const int reach[3], int alignment, int ext[6])
 {
   for (int a = 0; a < 3; ++a)
   {
@@ -148,8 +152,8 @@ void GrowForPyramid(const int whole[6], const int piece[6], const int reach[3], 
   }
 }
 
-void GrowForSurfaceQueries(const int whole[6], const int piece[6], const double spacing[3], int levels,
-  bool half, double offsetFactor, int slack, int ext[6])
+void GrowForSurfaceQueries(const int whole[6], const int piece[6], const double spacing[3],
+  int levels, bool half, double offsetFactor, int slack, int ext[6])
 {
   // How far from a surface point the finer levels (0 .. L-2) are sampled: AO at
   // k * r_l along the normal, shadows from r_0 out to r_0 * 2^(l+1) (where level l + 1

@@ -20,8 +20,8 @@ bool CheckWholeExtent(const int whole[6], std::string& error);
 
 /// The whole extent of an image algorithm's first input and the extent requested of its
 /// output; false, with the reason in `error`, when the whole extent is not 3-D.
-bool WholeAndRequestedExtent(vtkInformationVector* inputs, vtkInformationVector* outputs, int whole[6],
-  int requested[6], std::string& error);
+bool WholeAndRequestedExtent(vtkInformationVector* inputs, vtkInformationVector* outputs,
+  int whole[6], int requested[6], std::string& error);
 
 /// True when the extent holds no point (some max below its min).
 bool EmptyExtent(const int ext[6]);
@@ -56,15 +56,16 @@ int PyramidAlignment(int levels, bool half);
 
 /// The piece grown by reach[a] voxels per axis, clipped to the whole extent, its lower end
 /// moved down to a multiple of `alignment` from the whole extent's start.
-void GrowForPyramid(const int whole[6], const int piece[6], const int reach[3], int alignment, int ext[6]);
+void GrowForPyramid(
+  const int whole[6], const int piece[6], const int reach[3], int alignment, int ext[6]);
 
 /// The input extent from which a process samples the finer levels (0 .. levels - 2) of a
 /// pyramid near the surface points of its piece, for surface queries at `offsetFactor`
 /// times each level's kernel radius (and soft shadows): the piece grown by how far those
 /// queries reach plus `slack` voxels (a surface piece's ghost cells) plus the levels'
 /// own reach in the input, aligned like GrowForPyramid.
-void GrowForSurfaceQueries(const int whole[6], const int piece[6], const double spacing[3], int levels,
-  bool half, double offsetFactor, int slack, int ext[6]);
+void GrowForSurfaceQueries(const int whole[6], const int piece[6], const double spacing[3],
+  int levels, bool half, double offsetFactor, int slack, int ext[6]);
 
 /// Asks the input for exactly `extent`, as one piece without ghost levels.
 void RequestExactExtent(vtkInformation* inputInformation, const int extent[6]);

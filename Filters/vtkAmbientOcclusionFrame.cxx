@@ -53,9 +53,10 @@ bool FrameOf(vtkImageData* image, Frame& frame, std::string& error)
   if (!(worst <= 1e-5))
   {
     std::ostringstream why;
-    why << "The image's direction matrix (" << m[0] << " " << m[1] << " " << m[2] << ", " << m[3] << " " << m[4]
-        << " " << m[5] << ", " << m[6] << " " << m[7] << " " << m[8]
-        << ") is not a rotation: its columns must be orthogonal unit vectors (resample the image onto such a grid "
+    why << "The image's direction matrix (" << m[0] << " " << m[1] << " " << m[2] << ", " << m[3]
+        << " " << m[4] << " " << m[5] << ", " << m[6] << " " << m[7] << " " << m[8]
+        << ") is not a rotation: its columns must be orthogonal unit vectors (resample the image "
+           "onto such a grid "
            "first).";
     error = why.str();
     return false;

@@ -38,7 +38,8 @@ void Allocate(vtkDataArray* array, vtkIdType tuples, const std::string& what)
 
 void Reserve(double bytes, const std::string& what)
 {
-  void* probe = bytes < 9e18 ? std::malloc(static_cast<std::size_t>(bytes > 0 ? bytes : 1)) : nullptr;
+  void* probe =
+    bytes < 9e18 ? std::malloc(static_cast<std::size_t>(bytes > 0 ? bytes : 1)) : nullptr;
   if (!probe)
   {
     throw Shortage{ bytes, what };
@@ -46,7 +47,8 @@ void Reserve(double bytes, const std::string& what)
   std::free(probe);
 }
 
-int Guard(vtkAlgorithm* algorithm, vtkDataObject* output, const char* hint, const std::function<int()>& body)
+int Guard(vtkAlgorithm* algorithm, vtkDataObject* output, const char* hint,
+  const std::function<int()>& body)
 {
   std::ostringstream why;
   try
@@ -55,8 +57,8 @@ int Guard(vtkAlgorithm* algorithm, vtkDataObject* output, const char* hint, cons
   }
   catch (const Shortage& shortage)
   {
-    why << "Not enough memory for " << std::fixed << std::setprecision(0) << shortage.bytes / (1024.0 * 1024.0)
-        << " MB (" << shortage.what << "); " << hint;
+    why << "Not enough memory for " << std::fixed << std::setprecision(0)
+        << shortage.bytes / (1024.0 * 1024.0) << " MB (" << shortage.what << "); " << hint;
   }
   catch (const std::bad_alloc&)
   {

@@ -35,7 +35,8 @@ void Reserve(double bytes, const std::string& what);
 /// (VTK arrays, the kernels' buffers), becomes the error "Not enough memory for N MB (what);
 /// <hint>" on the algorithm and an empty `output`; the pipeline stays usable. Returns
 /// what the body returned, or 1 after a shortage (the error is the user's answer).
-int Guard(vtkAlgorithm* algorithm, vtkDataObject* output, const char* hint, const std::function<int()>& body);
+int Guard(vtkAlgorithm* algorithm, vtkDataObject* output, const char* hint,
+  const std::function<int()>& body);
 
 } // namespace vtkAmbientOcclusionMemory
 

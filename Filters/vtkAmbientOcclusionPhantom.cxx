@@ -25,8 +25,8 @@ namespace
 constexpr double FieldOfViewMm = 240.0;
 
 /// Normalised ellipsoid distance: < 1 inside the ellipsoid of centre c and semi-axes a.
-double Ellipsoid(double x, double y, double z, double cx, double cy, double cz, double ax,
-  double ay, double az)
+double Ellipsoid(
+  double x, double y, double z, double cx, double cy, double cz, double ax, double ay, double az)
 {
   const double u = (x - cx) / ax, v = (y - cy) / ay, w = (z - cz) / az;
   return u * u + v * v + w * w;
@@ -64,8 +64,8 @@ double SmoothNoise(int i, int j, int k, std::uint64_t seed)
   constexpr int kNoiseCell = 4;
   constexpr std::uint64_t kLattice = 1u << 20; // lattice indices stay below this
   const int c[3] = { i / kNoiseCell, j / kNoiseCell, k / kNoiseCell };
-  const double f[3] = { (i % kNoiseCell) / double(kNoiseCell), (j % kNoiseCell) / double(kNoiseCell),
-    (k % kNoiseCell) / double(kNoiseCell) };
+  const double f[3] = { (i % kNoiseCell) / double(kNoiseCell),
+    (j % kNoiseCell) / double(kNoiseCell), (k % kNoiseCell) / double(kNoiseCell) };
   double sum = 0.0;
   for (int corner = 0; corner < 8; ++corner)
   {
@@ -101,7 +101,8 @@ double vtkAmbientOcclusionPhantom::Density(double x, double y, double z)
     return 250.0;
   }
   // Neck: an elliptic cylinder from the bottom to the skull base.
-  const bool inNeck = z < -40.0 && ((x / 50.0) * (x / 50.0) + ((y - 10.0) / 45.0) * ((y - 10.0) / 45.0)) < 1.0;
+  const bool inNeck =
+    z < -40.0 && ((x / 50.0) * (x / 50.0) + ((y - 10.0) / 45.0) * ((y - 10.0) / 45.0)) < 1.0;
   const double head = Ellipsoid(x, y, z, 0.0, 0.0, 10.0, 78.0, 95.0, 100.0);
   if (head >= 1.0 && !inNeck)
   {
@@ -154,7 +155,8 @@ double vtkAmbientOcclusionPhantom::Density(double x, double y, double z)
     return inner > 0.8 ? 42.0 : 30.0;
   }
   // Jaw bone below the skull base, in front of the neck.
-  if (z > -75.0 && z < -35.0 && y < 0.0 && Ellipsoid(x, y, z, 0.0, -30.0, -55.0, 55.0, 60.0, 22.0) < 1.0 &&
+  if (z > -75.0 && z < -35.0 && y < 0.0 &&
+    Ellipsoid(x, y, z, 0.0, -30.0, -55.0, 55.0, 60.0, 22.0) < 1.0 &&
     Ellipsoid(x, y, z, 0.0, -30.0, -55.0, 47.0, 52.0, 16.0) >= 1.0)
   {
     return 900.0;
@@ -199,12 +201,13 @@ int vtkAmbientOcclusionPhantom::RequestData(
   vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
   // Allocation failure anywhere below (caching the ranges too) is an error and an empty
   // output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, output,
-    "choose smaller Dimensions.", [&]() -> int {
-    const int result = this->ProduceOutput(outputVector);
-    vtkAmbientOcclusionRanges::CacheOutput(output);
-    return result;
-  });
+  return vtkAmbientOcclusionMemory::Guard(this, output, "choose smaller Dimensions.",
+    [&]() -> int
+    {
+      const int result = this->ProduceOutput(outputVector);
+      vtkAmbientOcclusionRanges::CacheOutput(output);
+      return result;
+    });
 }
 
 //------------------------------------------------------------------------------
@@ -235,7 +238,8 @@ int vtkAmbientOcclusionPhantom::ProduceOutput(vtkInformationVector* outputVector
         const double hu = PartialVolume(origin[0] + i * spacing[0], origin[1] + j * spacing[1],
           origin[2] + k * spacing[2], spacing);
         // Air stays clean, as in a CT whose air is clipped at the bottom of its range.
-        const double noisy = hu <= -1000.0 ? hu : hu + this->NoiseAmplitude * SmoothNoise(i, j, k, this->Seed);
+        const double noisy =
+          hu <= -1000.0 ? hu : hu + this->NoiseAmplitude * SmoothNoise(i, j, k, this->Seed);
         *out++ = static_cast<short>(std::lround(std::max(-1024.0, std::min(3000.0, noisy))));
       }
     }

@@ -29,7 +29,8 @@ bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vt
   const double* h = input->GetSpacing();
   const vao::Status status = vao::buildMomentPyramid(
     scalars.view, ExtentOrigin(input), { h[0], h[1], h[2] }, parameters, pyramid, execution);
-  error = vtkAmbientOcclusionArrayInput::KernelError(status, scalars, "The variance occlusion map failed");
+  error = vtkAmbientOcclusionArrayInput::KernelError(
+    status, scalars, "The variance occlusion map failed");
   return status.ok;
 }
 
@@ -40,7 +41,8 @@ bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vt
   const double* h = input->GetSpacing();
   const vao::Status status = vao::buildSurfacePyramid(
     scalars.view, ExtentOrigin(input), { h[0], h[1], h[2] }, parameters, pyramid, execution);
-  error = vtkAmbientOcclusionArrayInput::KernelError(status, scalars, "The variance occlusion map failed");
+  error = vtkAmbientOcclusionArrayInput::KernelError(
+    status, scalars, "The variance occlusion map failed");
   return status.ok;
 }
 
@@ -49,11 +51,12 @@ void WarnOfCoarseMeans(vtkObject* owner, const std::vector<vao::MomentLevel>& le
   const double resolution = levels.empty() ? 0.0 : vao::meanResolution(levels.back());
   if (resolution > vao::kCoarseMeanResolution)
   {
-    vtkWarningWithObjectMacro(owner, << "The values lie far from 0 against their spread: the pyramid's float32 "
-                                        "means resolve "
-                                     << resolution << " of it (above " << vao::kCoarseMeanResolution
-                                     << "), so AO and shadows lose precision. Subtract an offset first (e.g. "
-                                        "with the Calculator).");
+    vtkWarningWithObjectMacro(
+      owner, << "The values lie far from 0 against their spread: the pyramid's float32 "
+                "means resolve "
+             << resolution << " of it (above " << vao::kCoarseMeanResolution
+             << "), so AO and shadows lose precision. Subtract an offset first (e.g. "
+                "with the Calculator).");
   }
 }
 
@@ -79,7 +82,8 @@ vtkSmartPointer<vtkImageData> LevelAsImage(vao::MomentLevel& level)
     static_cast<int>(level.dims[2]));
   image->SetOrigin(level.origin.data());
   image->SetSpacing(level.spacing.data());
-  for (const auto& [name, values] : { std::make_pair("Mean", &level.mean), std::make_pair("Variance", &level.variance) })
+  for (const auto& [name, values] :
+    { std::make_pair("Mean", &level.mean), std::make_pair("Variance", &level.variance) })
   {
     // The level's block becomes the array's: no copy (a copy doubled the filter's peak).
     vtkNew<vtkFloatArray> array;

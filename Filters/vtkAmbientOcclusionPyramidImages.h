@@ -33,8 +33,8 @@ bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vt
 /// The same as a SurfacePyramid (level 0 built where the surface queries reach it), which
 /// reads `scalars` again whenever a query builds tiles.
 bool BuildPyramid(const vtkAmbientOcclusionArrayInput::ScalarVolume& scalars, vtkImageData* input,
-  const vao::PyramidParameters& parameters, const vao::Execution& execution, vao::SurfacePyramid& pyramid,
-  std::string& error);
+  const vao::PyramidParameters& parameters, const vao::Execution& execution,
+  vao::SurfacePyramid& pyramid, std::string& error);
 
 /// Warns, as `owner`, when the levels' float32 means resolve the values coarsely
 /// (vao::meanResolution of the coarsest level past vao::kCoarseMeanResolution: values far

@@ -32,7 +32,8 @@ void Store(vtkFloatArray* values, const vao::ValueRanges& ranges)
     perComponent->SetNumberOfInformationObjects(components);
     for (int c = 0; c < components; ++c)
     {
-      perComponent->GetInformationObject(c)->Set(vtkDataArray::COMPONENT_RANGE(), ranges.components.data() + 2 * c, 2);
+      perComponent->GetInformationObject(c)->Set(
+        vtkDataArray::COMPONENT_RANGE(), ranges.components.data() + 2 * c, 2);
     }
     info->Set(key, perComponent);
   }
@@ -45,7 +46,6 @@ void Store(vtkFloatArray* values, const vao::ValueRanges& ranges)
 
 } // namespace
 
-
 void Cache(vtkDataArray* array)
 {
   auto* values = vtkFloatArray::SafeDownCast(array);
@@ -55,7 +55,8 @@ void Cache(vtkDataArray* array)
   }
   const int components = values->GetNumberOfComponents();
   vao::ValueRanges ranges;
-  if (!vao::computeFiniteValueRanges(values->GetPointer(0), values->GetNumberOfTuples(), components, ranges))
+  if (!vao::computeFiniteValueRanges(
+        values->GetPointer(0), values->GetNumberOfTuples(), components, ranges))
   {
     return;
   }
@@ -76,7 +77,8 @@ void CacheKnown(vtkDataArray* array, double lowest, double highest)
 
 void CacheOutput(vtkDataObject* output)
 {
-  auto cacheSet = [](vtkDataSet* set) {
+  auto cacheSet = [](vtkDataSet* set)
+  {
     vtkPointData* pd = set ? set->GetPointData() : nullptr;
     for (int i = 0; pd && i < pd->GetNumberOfArrays(); ++i)
     {

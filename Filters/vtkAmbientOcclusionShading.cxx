@@ -15,8 +15,8 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
-#include "vtkNew.h"
 #include "vtkMultiProcessController.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkPointData.h"
@@ -105,7 +105,8 @@ std::string vtkAmbientOcclusionShading::CheckInput(
   std::ostringstream why;
   vtkDataArray* ao = pd->GetArray(this->AmbientOcclusionArrayName.c_str());
   if (!std::isfinite(this->AmbientIntensity) || this->AmbientIntensity < 0.0)
-    why << "AmbientIntensity must be a finite, non-negative number (got " << this->AmbientIntensity << ").";
+    why << "AmbientIntensity must be a finite, non-negative number (got " << this->AmbientIntensity
+        << ").";
   else if (!std::isfinite(this->Gamma) || !(this->Gamma > 0.0))
     why << "Gamma must be a finite, positive number (got " << this->Gamma << ").";
   else if (!std::isfinite(this->VarianceMax))
@@ -117,17 +118,21 @@ std::string vtkAmbientOcclusionShading::CheckInput(
   else if (!ao || ao->GetNumberOfComponents() != 1)
     why << "No one-component point array '" << this->AmbientOcclusionArrayName
         << "': apply an ambient occlusion filter first, or name its output array.";
-  else if ((volume || !this->ScalarsArrayName.empty()) && (!scalars || scalars->GetNumberOfComponents() != 1))
-    why << "No one-component point scalars to colour" << (this->ScalarsArrayName.empty() ? "" : " named '")
-        << this->ScalarsArrayName << (this->ScalarsArrayName.empty() ? "." : "'.");
+  else if ((volume || !this->ScalarsArrayName.empty()) &&
+    (!scalars || scalars->GetNumberOfComponents() != 1))
+    why << "No one-component point scalars to colour"
+        << (this->ScalarsArrayName.empty() ? "" : " named '") << this->ScalarsArrayName
+        << (this->ScalarsArrayName.empty() ? "." : "'.");
   else if (volume && this->ModulateOpacity && !pd->GetArray("Variance"))
-    why << "ModulateOpacity needs the point array 'Variance' (Volumetric Ambient Occlusion with Compute "
+    why << "ModulateOpacity needs the point array 'Variance' (Volumetric Ambient Occlusion with "
+           "Compute "
            "Variance on).";
   else if (!std::isfinite(this->ScalarRange[0]) || !std::isfinite(this->ScalarRange[1]))
-    why << "ScalarRange must be finite (got " << this->ScalarRange[0] << ", " << this->ScalarRange[1]
-        << "); an empty range such as (1, 0) means the data's.";
+    why << "ScalarRange must be finite (got " << this->ScalarRange[0] << ", "
+        << this->ScalarRange[1] << "); an empty range such as (1, 0) means the data's.";
   else if (!std::isfinite(this->OpacityRamp[0]) || !std::isfinite(this->OpacityRamp[1]))
-    why << "OpacityRamp must be finite (got " << this->OpacityRamp[0] << ", " << this->OpacityRamp[1]
+    why << "OpacityRamp must be finite (got " << this->OpacityRamp[0] << ", "
+        << this->OpacityRamp[1]
         << "); an empty ramp such as (1, 0) means the upper half of the range.";
   if (!why.str().empty())
     return why.str();
@@ -177,13 +182,14 @@ void vtkAmbientOcclusionShading::ColourRange(vtkDataArray* scalars, double range
 }
 
 //------------------------------------------------------------------------------
-bool vtkAmbientOcclusionShading::ShadePoints(
-  vtkPointData* pd, vtkDataArray* scalars, bool volume, const double range[2], vtkUnsignedCharArray* shaded)
+bool vtkAmbientOcclusionShading::ShadePoints(vtkPointData* pd, vtkDataArray* scalars, bool volume,
+  const double range[2], vtkUnsignedCharArray* shaded)
 {
   vtkDataArray* ao = pd->GetArray(this->AmbientOcclusionArrayName.c_str());
   vtkDataArray* shadow = volume ? nullptr : pd->GetArray("Shadow");
   vtkDataArray* variance = volume && this->ModulateOpacity ? pd->GetArray("Variance") : nullptr;
-  vtkSmartPointer<vtkScalarsToColors> colors = this->Colors ? this->Colors : PresetColors(this->ColorPreset, range);
+  vtkSmartPointer<vtkScalarsToColors> colors =
+    this->Colors ? this->Colors : PresetColors(this->ColorPreset, range);
   double ramp[2] = { this->OpacityRamp[0], this->OpacityRamp[1] };
   if (ramp[0] > ramp[1])
   {
@@ -199,33 +205,39 @@ bool vtkAmbientOcclusionShading::ShadePoints(
   // Points in chunks on the library's workers. Each chunk evaluates its own copies of the
   // transfer functions: their evaluation may build tables lazily, which is not
   // thread-safe on one shared object. Progress and abort are polled on this thread.
-  const bool finished = vao::parallelRanges(n, vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads),
-    [&](std::int64_t begin, std::int64_t end) {
-      vtkSmartPointer<vtkScalarsToColors> chunkColors = vtk::TakeSmartPointer(colors->NewInstance());
-      chunkColors->DeepCopy(colors);
-      vtkSmartPointer<vtkPiecewiseFunction> chunkOpacity = vtk::TakeSmartPointer(opacity->NewInstance());
-      chunkOpacity->DeepCopy(opacity);
-      unsigned char* out = pixels + begin * components;
-      for (std::int64_t i = begin; i < end; ++i)
+  const bool finished =
+    vao::parallelRanges(n, vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads),
+      [&](std::int64_t begin, std::int64_t end)
       {
-        double rgb[3] = { 1.0, 1.0, 1.0 };
-        const double v = scalars ? scalars->GetComponent(i, 0) : 0.0;
-        if (scalars)
+        vtkSmartPointer<vtkScalarsToColors> chunkColors =
+          vtk::TakeSmartPointer(colors->NewInstance());
+        chunkColors->DeepCopy(colors);
+        vtkSmartPointer<vtkPiecewiseFunction> chunkOpacity =
+          vtk::TakeSmartPointer(opacity->NewInstance());
+        chunkOpacity->DeepCopy(opacity);
+        unsigned char* out = pixels + begin * components;
+        for (std::int64_t i = begin; i < end; ++i)
         {
-          chunkColors->GetColor(v, rgb);
+          double rgb[3] = { 1.0, 1.0, 1.0 };
+          const double v = scalars ? scalars->GetComponent(i, 0) : 0.0;
+          if (scalars)
+          {
+            chunkColors->GetColor(v, rgb);
+          }
+          const double o = ao->GetComponent(i, 0) * (shadow ? shadow->GetComponent(i, 0) : 1.0);
+          for (int c = 0; c < 3; ++c)
+          {
+            *out++ =
+              vao::toByte(vao::ambientLighting(this->AmbientIntensity, o, rgb[c], this->Gamma));
+          }
+          if (volume)
+          {
+            const double m =
+              variance ? vao::varianceModulation(variance->GetComponent(i, 0), varianceMax) : 1.0;
+            *out++ = vao::toByte(chunkOpacity->GetValue(v) * m);
+          }
         }
-        const double o = ao->GetComponent(i, 0) * (shadow ? shadow->GetComponent(i, 0) : 1.0);
-        for (int c = 0; c < 3; ++c)
-        {
-          *out++ = vao::toByte(vao::ambientLighting(this->AmbientIntensity, o, rgb[c], this->Gamma));
-        }
-        if (volume)
-        {
-          const double m = variance ? vao::varianceModulation(variance->GetComponent(i, 0), varianceMax) : 1.0;
-          *out++ = vao::toByte(chunkOpacity->GetValue(v) * m);
-        }
-      }
-    });
+      });
   return finished;
 }
 
@@ -237,11 +249,13 @@ int vtkAmbientOcclusionShading::RequestData(
   // Allocation failure anywhere below (caching the ranges too) is an error and an empty
   // output, not an abort.
   return vtkAmbientOcclusionMemory::Guard(this, output,
-    "shade a smaller extent or compute it in pieces (streaming or more MPI ranks).", [&]() -> int {
-    const int result = this->ProduceOutput(inputVector, outputVector);
-    vtkAmbientOcclusionRanges::CacheOutput(output);
-    return result;
-  });
+    "shade a smaller extent or compute it in pieces (streaming or more MPI ranks).",
+    [&]() -> int
+    {
+      const int result = this->ProduceOutput(inputVector, outputVector);
+      vtkAmbientOcclusionRanges::CacheOutput(output);
+      return result;
+    });
 }
 
 //------------------------------------------------------------------------------
@@ -256,8 +270,9 @@ int vtkAmbientOcclusionShading::ProduceOutput(
   }
   output->ShallowCopy(input);
   vtkPointData* pd = input->GetPointData();
-  vtkDataArray* scalars =
-    this->ScalarsArrayName.empty() ? pd->GetScalars() : pd->GetArray(this->ScalarsArrayName.c_str());
+  vtkDataArray* scalars = this->ScalarsArrayName.empty()
+    ? pd->GetScalars()
+    : pd->GetArray(this->ScalarsArrayName.c_str());
   const bool volume = vtkImageData::SafeDownCast(input) != nullptr;
   const std::string error = this->CheckInput(pd, input->GetNumberOfPoints(), scalars, volume);
   // The range is reduced before any error return: every process must take part.
@@ -289,9 +304,12 @@ void vtkAmbientOcclusionShading::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "AmbientOcclusionArrayName: " << this->AmbientOcclusionArrayName << "\n";
   os << indent << "ScalarsArrayName: " << this->ScalarsArrayName << "\n";
-  os << indent << "AmbientIntensity: " << this->AmbientIntensity << ", Gamma: " << this->Gamma << "\n";
-  os << indent << "ModulateOpacity: " << this->ModulateOpacity << ", VarianceMax: " << this->VarianceMax << "\n";
-  os << indent << "ColorPreset: " << this->ColorPreset << ", ScalarRange: " << this->ScalarRange[0] << " "
-     << this->ScalarRange[1] << ", OpacityRamp: " << this->OpacityRamp[0] << " " << this->OpacityRamp[1] << "\n";
+  os << indent << "AmbientIntensity: " << this->AmbientIntensity << ", Gamma: " << this->Gamma
+     << "\n";
+  os << indent << "ModulateOpacity: " << this->ModulateOpacity
+     << ", VarianceMax: " << this->VarianceMax << "\n";
+  os << indent << "ColorPreset: " << this->ColorPreset << ", ScalarRange: " << this->ScalarRange[0]
+     << " " << this->ScalarRange[1] << ", OpacityRamp: " << this->OpacityRamp[0] << " "
+     << this->OpacityRamp[1] << "\n";
   os << indent << "Controller: " << this->Controller.Get() << "\n";
 }

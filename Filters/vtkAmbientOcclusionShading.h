@@ -146,12 +146,13 @@ private:
   int ProduceOutput(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
 
   /// Why the parameters or the input's arrays cannot be shaded; empty when they can.
-  std::string CheckInput(vtkPointData* pd, vtkIdType points, vtkDataArray* scalars, bool volume) const;
+  std::string CheckInput(
+    vtkPointData* pd, vtkIdType points, vtkDataArray* scalars, bool volume) const;
   /// ScalarRange, or when it is empty the scalars' range over every process. Collective.
   void ColourRange(vtkDataArray* scalars, double range[2]);
   /// Fills `shaded` (3 components a point, 4 on a volume); false when the user aborted.
-  bool ShadePoints(
-    vtkPointData* pd, vtkDataArray* scalars, bool volume, const double range[2], vtkUnsignedCharArray* shaded);
+  bool ShadePoints(vtkPointData* pd, vtkDataArray* scalars, bool volume, const double range[2],
+    vtkUnsignedCharArray* shaded);
 };
 
 #endif

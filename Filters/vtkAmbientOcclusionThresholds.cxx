@@ -27,7 +27,8 @@ namespace
 void Reduce(vtkMultiProcessController* controller, vao::ValueHistogram& histogram)
 {
   const vtkIdType cells = static_cast<vtkIdType>(histogram.counts.size());
-  std::vector<long long> local(histogram.counts.begin(), histogram.counts.end()), total(local.size());
+  std::vector<long long> local(histogram.counts.begin(), histogram.counts.end()),
+    total(local.size());
   controller->AllReduce(local.data(), total.data(), cells, vtkCommunicator::SUM_OP);
   std::copy(total.begin(), total.end(), histogram.counts.begin());
   std::vector<double> reduced(histogram.minimum.size());
@@ -39,7 +40,8 @@ void Reduce(vtkMultiProcessController* controller, vao::ValueHistogram& histogra
 
 } // namespace
 
-std::vector<std::vector<int>> SubtractExtents(const int ext[6], const std::vector<const int*>& others)
+std::vector<std::vector<int>> SubtractExtents(
+  const int ext[6], const std::vector<const int*>& others)
 {
   std::vector<std::vector<int>> boxes;
   if (!vtkAmbientOcclusionExtents::EmptyExtent(ext))
@@ -88,8 +90,8 @@ namespace
 /// process's output extent holds, so that each voxel is counted once, by the lowest process
 /// whose output extent holds it. Collective (`controller` null: one process). False when
 /// any process failed before.
-bool OwnedBoxes(vtkMultiProcessController* controller, const Piece& piece, std::vector<std::vector<int>>& owned,
-  std::string& error)
+bool OwnedBoxes(vtkMultiProcessController* controller, const Piece& piece,
+  std::vector<std::vector<int>>& owned, std::string& error)
 {
   const bool holds = piece.volume && !piece.failed;
   int mine[6] = { 0, -1, 0, -1, 0, -1 };
@@ -105,7 +107,8 @@ bool OwnedBoxes(vtkMultiProcessController* controller, const Piece& piece, std::
     if (vtkAmbientOcclusionCollectives::GlobalMax(controller, piece.failed ? 1.0 : 0.0) > 0.0)
     {
       if (!piece.failed)
-        error = "Histogram CDF: another process failed, so the thresholds of the whole data set are unknown.";
+        error = "Histogram CDF: another process failed, so the thresholds of the whole data set "
+                "are unknown.";
       return false;
     }
   }
@@ -129,7 +132,8 @@ bool OwnedBoxes(vtkMultiProcessController* controller, const Piece& piece, std::
 bool HistogramCells(vtkMultiProcessController* controller, const Piece& piece,
   const std::vector<std::vector<int>>& owned, vao::ValueHistogram& histogram, std::string& error)
 {
-  double range[2] = { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() };
+  double range[2] = { std::numeric_limits<double>::infinity(),
+    -std::numeric_limits<double>::infinity() };
   if (piece.volume && !owned.empty())
   {
     range[0] = piece.scan->minimum;
@@ -147,7 +151,8 @@ bool HistogramCells(vtkMultiProcessController* controller, const Piece& piece,
     error = "Histogram CDF: no process holds any voxel of the data set.";
     return false;
   }
-  histogram = vao::ValueHistogram::forRange(static_cast<vao::ScalarType>(static_cast<int>(type)), range[0], range[1]);
+  histogram = vao::ValueHistogram::forRange(
+    static_cast<vao::ScalarType>(static_cast<int>(type)), range[0], range[1]);
   return true;
 }
 
@@ -181,7 +186,8 @@ bool CountOwnedVoxels(vtkMultiProcessController* controller, const Piece& piece,
   if (vtkAmbientOcclusionCollectives::GlobalMax(controller, failed ? 1.0 : 0.0) > 0.0)
   {
     if (error.empty())
-      error = "Histogram CDF: another process failed, so the thresholds of the whole data set are unknown.";
+      error = "Histogram CDF: another process failed, so the thresholds of the whole data set are "
+              "unknown.";
     return false;
   }
   Reduce(controller, histogram);
@@ -196,7 +202,8 @@ bool CoversWholeExtent(const vao::ValueHistogram& histogram, const int whole[6],
   const long long expected = vtkAmbientOcclusionExtents::ExtentPoints(whole);
   if (counted != expected)
   {
-    error = "Histogram CDF takes its thresholds from every voxel of the data set, but the processes' pieces hold " +
+    error = "Histogram CDF takes its thresholds from every voxel of the data set, but the "
+            "processes' pieces hold " +
       std::to_string(counted) + " of its " + std::to_string(expected) +
       " voxels: request the whole extent, or pieces that cover it.";
     return false;
@@ -206,8 +213,8 @@ bool CoversWholeExtent(const vao::ValueHistogram& histogram, const int whole[6],
 
 } // namespace
 
-bool Compute(vtkMultiProcessController* controller, const Piece& piece, int bins, std::vector<double>& thresholds,
-  std::string& error)
+bool Compute(vtkMultiProcessController* controller, const Piece& piece, int bins,
+  std::vector<double>& thresholds, std::string& error)
 {
   const int ranks = controller ? controller->GetNumberOfProcesses() : 1;
   if (ranks <= 1)
@@ -216,7 +223,8 @@ bool Compute(vtkMultiProcessController* controller, const Piece& piece, int bins
   }
   std::vector<std::vector<int>> owned;
   vao::ValueHistogram histogram;
-  if (!OwnedBoxes(controller, piece, owned, error) || !HistogramCells(controller, piece, owned, histogram, error) ||
+  if (!OwnedBoxes(controller, piece, owned, error) ||
+    !HistogramCells(controller, piece, owned, histogram, error) ||
     !CountOwnedVoxels(controller, piece, owned, histogram, error) ||
     !CoversWholeExtent(histogram, piece.whole, error))
   {
@@ -232,7 +240,8 @@ bool ComputeInSlabs(vtkAlgorithm* producer, int port, int slabs, int bins,
 {
   producer->UpdateInformation();
   int whole[6];
-  producer->GetOutputInformation(port)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  producer->GetOutputInformation(port)->Get(
+    vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
   const int nz = whole[5] - whole[4] + 1;
   if (vtkAmbientOcclusionExtents::EmptyExtent(whole))
   {
@@ -240,7 +249,8 @@ bool ComputeInSlabs(vtkAlgorithm* producer, int port, int slabs, int bins,
     return false;
   }
   slabs = std::max(1, std::min(slabs, nz));
-  double range[2] = { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() };
+  double range[2] = { std::numeric_limits<double>::infinity(),
+    -std::numeric_limits<double>::infinity() };
   vao::ValueHistogram histogram;
   // Pass 0: the range (it fixes the cells); pass 1: the histogram of each slab.
   for (int pass = 0; pass < 2; ++pass)
@@ -257,10 +267,12 @@ bool ComputeInSlabs(vtkAlgorithm* producer, int port, int slabs, int bins,
       vtkImageData* image = vtkImageData::SafeDownCast(producer->GetOutputDataObject(port));
       vao::VolumeView volume;
       int common[6];
-      if (!image || !vtkAmbientOcclusionExtents::IntersectExtents(image->GetExtent(), slab, common) ||
+      if (!image ||
+        !vtkAmbientOcclusionExtents::IntersectExtents(image->GetExtent(), slab, common) ||
         !std::equal(common, common + 6, slab))
       {
-        error = "the input did not deliver the slab z = " + std::to_string(slab[4]) + ".." + std::to_string(slab[5]);
+        error = "the input did not deliver the slab z = " + std::to_string(slab[4]) + ".." +
+          std::to_string(slab[5]);
         return false;
       }
       if (!view(image, volume, error))
@@ -279,8 +291,8 @@ bool ComputeInSlabs(vtkAlgorithm* producer, int port, int slabs, int bins,
         const vao::Status finite = vao::finiteStatus(scan);
         if (!finite.ok)
         {
-          error = "the slab z = " + std::to_string(slab[4]) + ".." + std::to_string(slab[5]) + " holds " +
-            std::to_string(finite.nonFiniteCount) + " NaN or infinite values";
+          error = "the slab z = " + std::to_string(slab[4]) + ".." + std::to_string(slab[5]) +
+            " holds " + std::to_string(finite.nonFiniteCount) + " NaN or infinite values";
           return false;
         }
         range[0] = std::min(range[0], scan.minimum);

@@ -45,8 +45,8 @@ struct Piece
 /// too). False, with the reason in `error`, when a process failed, or when the processes'
 /// output extents do not cover the whole extent (the thresholds would not be the whole
 /// data set's).
-bool Compute(vtkMultiProcessController* controller, const Piece& piece, int bins, std::vector<double>& thresholds,
-  std::string& error);
+bool Compute(vtkMultiProcessController* controller, const Piece& piece, int bins,
+  std::vector<double>& thresholds, std::string& error);
 
 /// The thresholds of the data set produced by `producer` (output `port`), read in `slabs`
 /// slabs along z, each an update of the upstream pipeline with that extent, so that a
@@ -58,7 +58,8 @@ bool ComputeInSlabs(vtkAlgorithm* producer, int port, int slabs, int bins,
   std::vector<double>& thresholds, std::string& error);
 
 /// The boxes of `ext` not covered by any extent of `others` (each 6 ints), as extents.
-std::vector<std::vector<int>> SubtractExtents(const int ext[6], const std::vector<const int*>& others);
+std::vector<std::vector<int>> SubtractExtents(
+  const int ext[6], const std::vector<const int*>& others);
 
 } // namespace vtkAmbientOcclusionThresholds
 

@@ -42,11 +42,13 @@ vtkMultiProcessController* vtkIsosurfaceAmbientOcclusion::GetController() const
 }
 
 //------------------------------------------------------------------------------
-void vtkIsosurfaceAmbientOcclusion::SetVolumeScalars(int, int, int, int association, const char* name)
+void vtkIsosurfaceAmbientOcclusion::SetVolumeScalars(
+  int, int, int, int association, const char* name)
 {
   if (association != vtkDataObject::FIELD_ASSOCIATION_POINTS)
   {
-    vtkErrorMacro(<< "Scalars must be a point array of the volume (got association " << association << ").");
+    vtkErrorMacro(<< "Scalars must be a point array of the volume (got association " << association
+                  << ").");
     return;
   }
   this->SetVolumeScalars(name);
@@ -61,7 +63,8 @@ void vtkIsosurfaceAmbientOcclusion::SetVolumeScalars(const char* name)
   }
   else
   {
-    this->SetInputArrayToProcess(0, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+    this->SetInputArrayToProcess(
+      0, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
   }
 }
 
@@ -103,10 +106,12 @@ bool vtkIsosurfaceAmbientOcclusion::CheckParameters()
   // reach of a piece). The kernel's own checks (finiteness) keep its wording.
   std::ostringstream why;
   const double* l = this->LightDirection;
-  const vao::Status iso = this->QueryMode == ISO_VALUE ? vao::checkFiniteParameter(this->IsoValue, "IsoValue")
-                                                       : vao::Status::success();
-  const vao::Status light =
-    this->ComputeShadows ? vao::checkFinitePoint({ l[0], l[1], l[2] }, "LightDirection") : vao::Status::success();
+  const vao::Status iso = this->QueryMode == ISO_VALUE
+    ? vao::checkFiniteParameter(this->IsoValue, "IsoValue")
+    : vao::Status::success();
+  const vao::Status light = this->ComputeShadows
+    ? vao::checkFinitePoint({ l[0], l[1], l[2] }, "LightDirection")
+    : vao::Status::success();
   const double length = std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
   if (this->QueryMode != HALF_VOXEL_INSIDE && this->QueryMode != ISO_VALUE)
     why << "Unknown QueryMode " << this->QueryMode << " (0 Half Voxel Inside, 1 Iso Value).";
@@ -123,8 +128,8 @@ bool vtkIsosurfaceAmbientOcclusion::CheckParameters()
   else if (!light.ok)
     why << light.message << ".";
   else if (this->ComputeShadows && !(std::isfinite(length) && length > 0.0))
-    why << "LightDirection must be a non-zero vector of finite length (got " << l[0] << ", " << l[1] << ", "
-        << l[2] << ").";
+    why << "LightDirection must be a non-zero vector of finite length (got " << l[0] << ", " << l[1]
+        << ", " << l[2] << ").";
   else if (this->NumberOfThreads < 0)
     why << vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
   if (why.tellp() == 0)
@@ -139,12 +144,14 @@ bool vtkIsosurfaceAmbientOcclusion::CheckParameters()
 vao::SurfaceOcclusionParameters vtkIsosurfaceAmbientOcclusion::Parameters() const
 {
   vao::SurfaceOcclusionParameters parameters;
-  parameters.query = this->QueryMode == ISO_VALUE ? vao::SurfaceQuery::IsoValue : vao::SurfaceQuery::HalfVoxelInside;
+  parameters.query =
+    this->QueryMode == ISO_VALUE ? vao::SurfaceQuery::IsoValue : vao::SurfaceQuery::HalfVoxelInside;
   parameters.isoValue = this->IsoValue;
   parameters.offsetFactor = this->OffsetFactor;
-  parameters.estimator = this->Estimator == GAUSSIAN_CDF ? vao::Method::GaussianCdf : vao::Method::Chebyshev;
-  parameters.combination =
-    this->Combine == COMBINE_MEAN ? vao::LevelCombination::Mean : vao::LevelCombination::MaximumOcclusion;
+  parameters.estimator =
+    this->Estimator == GAUSSIAN_CDF ? vao::Method::GaussianCdf : vao::Method::Chebyshev;
+  parameters.combination = this->Combine == COMBINE_MEAN ? vao::LevelCombination::Mean
+                                                         : vao::LevelCombination::MaximumOcclusion;
   return parameters;
 }
 
@@ -156,7 +163,8 @@ vao::PyramidParameters vtkIsosurfaceAmbientOcclusion::PyramidRequest() const
 //------------------------------------------------------------------------------
 bool vtkIsosurfaceAmbientOcclusion::IsDistributed() const
 {
-  return this->Controller && this->Controller->GetNumberOfProcesses() > 1 && this->NumberOfLevels >= 2;
+  return this->Controller && this->Controller->GetNumberOfProcesses() > 1 &&
+    this->NumberOfLevels >= 2;
 }
 
 //------------------------------------------------------------------------------
@@ -171,8 +179,8 @@ void vtkIsosurfaceAmbientOcclusion::VolumeExtentOf(
     return;
   }
   const int levels = std::max(2, std::min(this->NumberOfLevels, 16));
-  Extents::GrowForSurfaceQueries(
-    whole, piece, spacing, levels, this->StartAtHalfResolution != 0, this->OffsetFactor, kSurfaceSlack, ext);
+  Extents::GrowForSurfaceQueries(whole, piece, spacing, levels, this->StartAtHalfResolution != 0,
+    this->OffsetFactor, kSurfaceSlack, ext);
 }
 
 //------------------------------------------------------------------------------
@@ -197,10 +205,12 @@ bool vtkIsosurfaceAmbientOcclusion::CheckSurfaceInVolume(
   this->PlaceSurface(surface, surfaceBounds);
   for (int a = 0; a < 3; ++a)
   {
-    if (surfaceBounds[2 * a] < bounds[2 * a] - 0.5 * h[a] || surfaceBounds[2 * a + 1] > bounds[2 * a + 1] + 0.5 * h[a])
+    if (surfaceBounds[2 * a] < bounds[2 * a] - 0.5 * h[a] ||
+      surfaceBounds[2 * a + 1] > bounds[2 * a + 1] + 0.5 * h[a])
     {
-      vtkErrorMacro(<< "The surface reaches outside the volume (axis " << a << ": surface " << surfaceBounds[2 * a]
-                    << ".." << surfaceBounds[2 * a + 1] << ", volume " << bounds[2 * a] << ".." << bounds[2 * a + 1]
+      vtkErrorMacro(<< "The surface reaches outside the volume (axis " << a << ": surface "
+                    << surfaceBounds[2 * a] << ".." << surfaceBounds[2 * a + 1] << ", volume "
+                    << bounds[2 * a] << ".." << bounds[2 * a + 1]
                     << "): give the volume the surface was extracted from.");
       return false;
     }
@@ -216,11 +226,13 @@ int vtkIsosurfaceAmbientOcclusion::RequestData(
   // Allocation failure anywhere below (caching the ranges too) is an error and an empty
   // output, not an abort.
   return vtkAmbientOcclusionMemory::Guard(this, output,
-    "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.", [&]() -> int {
-    const int result = this->ProduceOutput(inputVector, outputVector);
-    vtkAmbientOcclusionRanges::CacheOutput(output);
-    return result;
-  });
+    "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.",
+    [&]() -> int
+    {
+      const int result = this->ProduceOutput(inputVector, outputVector);
+      vtkAmbientOcclusionRanges::CacheOutput(output);
+      return result;
+    });
 }
 
 //------------------------------------------------------------------------------
@@ -237,14 +249,16 @@ int vtkIsosurfaceAmbientOcclusion::ProduceOutput(
     return 1;
   }
   int whole[6];
-  inputVector[1]->GetInformationObject(0)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  inputVector[1]->GetInformationObject(0)->Get(
+    vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
   const bool distributed = this->IsDistributed();
   if (!distributed && !std::equal(whole, whole + 6, volume->GetExtent()))
   {
     // Happens when the surface is extracted from the same source output in pieces (MPI):
     // the shared output then holds the surface's piece, not the whole volume.
-    vtkErrorMacro(<< "The volume arrived as a piece, not whole: under MPI, feed the Volume input from its own "
-                     "reader rather than from the output the surface was extracted from.");
+    vtkErrorMacro(
+      << "The volume arrived as a piece, not whole: under MPI, feed the Volume input from its own "
+         "reader rather than from the output the surface was extracted from.");
     return 1;
   }
   if (!this->CheckParameters()) // the same answer on every process
@@ -275,15 +289,17 @@ int vtkIsosurfaceAmbientOcclusion::ProduceOutput(
 void vtkIsosurfaceAmbientOcclusion::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "QueryMode: " << (this->QueryMode == ISO_VALUE ? "Iso Value" : "Half Voxel Inside")
+  os << indent
+     << "QueryMode: " << (this->QueryMode == ISO_VALUE ? "Iso Value" : "Half Voxel Inside")
      << ", IsoValue: " << this->IsoValue << "\n";
-  os << indent << "NumberOfLevels: " << this->NumberOfLevels << ", StartAtHalfResolution: "
-     << this->StartAtHalfResolution << "\n";
+  os << indent << "NumberOfLevels: " << this->NumberOfLevels
+     << ", StartAtHalfResolution: " << this->StartAtHalfResolution << "\n";
   os << indent << "OffsetFactor: " << this->OffsetFactor << "\n";
-  os << indent << "Combine: " << (this->Combine == COMBINE_MEAN ? "Mean" : "Max") << ", Estimator: "
-     << (this->Estimator == GAUSSIAN_CDF ? "Gaussian CDF" : "Chebyshev") << "\n";
-  os << indent << "ComputeShadows: " << this->ComputeShadows << ", LightDirection: " << this->LightDirection[0]
-     << " " << this->LightDirection[1] << " " << this->LightDirection[2] << "\n";
+  os << indent << "Combine: " << (this->Combine == COMBINE_MEAN ? "Mean" : "Max")
+     << ", Estimator: " << (this->Estimator == GAUSSIAN_CDF ? "Gaussian CDF" : "Chebyshev") << "\n";
+  os << indent << "ComputeShadows: " << this->ComputeShadows
+     << ", LightDirection: " << this->LightDirection[0] << " " << this->LightDirection[1] << " "
+     << this->LightDirection[2] << "\n";
   os << indent << "Component: " << this->Component << ", NumberOfThreads: " << this->NumberOfThreads
      << ", PyramidBuilds: " << this->PyramidBuilds << "\n";
   os << indent << "Controller: " << this->Controller.Get() << "\n";

@@ -199,16 +199,19 @@ private:
   void VolumeExtentOf(const int whole[6], const double spacing[3], int piece[6], int ext[6]) const;
   /// The pyramid of this process's extent, its coarsest level replaced by the whole one.
   /// Collective: every process calls it, also after an error of its own.
-  bool UpdateDistributedPyramid(vtkImageData* volume, vtkDataArray* chosen, const int whole[6], int piece[6]);
+  bool UpdateDistributedPyramid(
+    vtkImageData* volume, vtkDataArray* chosen, const int whole[6], int piece[6]);
   /// Replaces the coarsest level of this process's pyramid (built from `inputExt`) by the
   /// whole volume's, assembled from every process's piece. Collective.
-  void ShareCoarsestLevel(vtkImageData* volume, const int whole[6], const int inputExt[6], const int piece[6]);
+  void ShareCoarsestLevel(
+    vtkImageData* volume, const int whole[6], const int inputExt[6], const int piece[6]);
   /// Decides which frame the surface's points are in (the physical one, or the image's
   /// axes where the extracting filter ignored an oriented volume's direction matrix) and
   /// gives their bounds in the volume's own axis-aligned frame, where the kernels sample.
   void PlaceSurface(vtkPolyData* surface, double bounds[6]);
   /// The surface lies in the volume (or near this process's piece of it when distributed).
-  bool CheckSurfaceInVolume(vtkPolyData* surface, vtkImageData* volume, const int whole[6], const int piece[6]);
+  bool CheckSurfaceInVolume(
+    vtkPolyData* surface, vtkImageData* volume, const int whole[6], const int piece[6]);
   /// Samples the pyramid at the surface's points into output's AO (and Shadow) arrays.
   bool Shade(vtkPolyData* surface, vtkPolyData* output);
 };

@@ -58,8 +58,9 @@ struct SurfaceKey
     : points(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr)
     , normals(vtkAmbientOcclusionArrayInput::GivenNormals(surface))
     , count(surface->GetNumberOfPoints())
-    , query{ static_cast<double>(p.query), p.isoValue, p.offsetFactor, static_cast<double>(p.estimator),
-      static_cast<double>(p.combination), static_cast<double>(p.levels) }
+    , query{ static_cast<double>(p.query), p.isoValue, p.offsetFactor,
+      static_cast<double>(p.estimator), static_cast<double>(p.combination),
+      static_cast<double>(p.levels) }
     , pyramidBuilds(builds)
   {
     this->pointsTime = this->points ? this->points->GetMTime() : 0;
@@ -68,8 +69,8 @@ struct SurfaceKey
 
   bool operator==(const SurfaceKey& o) const
   {
-    return std::tie(this->points, this->pointsTime, this->normals, this->normalsTime, this->count, this->query,
-             this->pyramidBuilds) ==
+    return std::tie(this->points, this->pointsTime, this->normals, this->normalsTime, this->count,
+             this->query, this->pyramidBuilds) ==
       std::tie(o.points, o.pointsTime, o.normals, o.normalsTime, o.count, o.query, o.pyramidBuilds);
   }
 };
@@ -115,18 +116,21 @@ bool AlongImageAxes(vtkPolyData* surface, const vtkAmbientOcclusionArrayInput::S
   for (vtkIdType i = 0; i < n; i += std::max<vtkIdType>(1, n / kFrameSamples))
   {
     const double* p = surface->GetPoint(i);
-    inFrame.push_back(vao::sampleVolume(volume.view, origin, spacing, volume.frame.PointToImage(p)));
+    inFrame.push_back(
+      vao::sampleVolume(volume.view, origin, spacing, volume.frame.PointToImage(p)));
     alongAxes.push_back(vao::sampleVolume(volume.view, origin, spacing, { p[0], p[1], p[2] }));
   }
   const auto [low, high] = std::minmax_element(inFrame.begin(), inFrame.end());
   const auto [lowAxes, highAxes] = std::minmax_element(alongAxes.begin(), alongAxes.end());
   const double spread = std::max(*high, *highAxes) - std::min(*low, *lowAxes);
   const double disagreement = MedianDeviation(inFrame);
-  return disagreement > kFrameDisagreement * spread && MedianDeviation(alongAxes) < kAxesAgreement * disagreement;
+  return disagreement > kFrameDisagreement * spread &&
+    MedianDeviation(alongAxes) < kAxesAgreement * disagreement;
 }
 
 /// The bounds of the surface's points in the volume's axis-aligned frame (from `frame`).
-void BoundsInFrame(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Frame& frame, double bounds[6])
+void BoundsInFrame(
+  vtkPolyData* surface, const vtkAmbientOcclusionFrame::Frame& frame, double bounds[6])
 {
   if (frame.identity)
   {
@@ -164,7 +168,9 @@ struct Sampling
 struct PyramidKernels
 {
   std::function<vao::Status(const SurfacePoints& points, float* out)> occlusion;
-  std::function<vao::Status(const SurfacePoints& points, const std::array<double, 3>& light, float* out)> shadow;
+  std::function<vao::Status(
+    const SurfacePoints& points, const std::array<double, 3>& light, float* out)>
+    shadow;
 };
 
 /// The two queries on `source`: in one process the SurfacePyramid, whose finest levels are
@@ -174,16 +180,24 @@ template <class Source>
 PyramidKernels Kernels(Source& source, const Sampling& s)
 {
   PyramidKernels kernels;
-  kernels.occlusion = [&source, &s](const SurfacePoints& points, float* out) {
-    return points.Run([&](auto xyz, auto normals) {
-      return vao::surfaceAmbientOcclusion(
-        source, s.volume, s.origin, s.spacing, xyz, normals, points.count, s.parameters, out, s.execution);
-    });
+  kernels.occlusion = [&source, &s](const SurfacePoints& points, float* out)
+  {
+    return points.Run(
+      [&](auto xyz, auto normals)
+      {
+        return vao::surfaceAmbientOcclusion(source, s.volume, s.origin, s.spacing, xyz, normals,
+          points.count, s.parameters, out, s.execution);
+      });
   };
-  kernels.shadow = [&source, &s](const SurfacePoints& points, const std::array<double, 3>& light, float* out) {
-    return points.Run([&](auto xyz, auto normals) {
-      return vao::surfaceShadow(source, xyz, normals, points.count, light, s.parameters, out, s.execution);
-    });
+  kernels.shadow = [&source, &s](
+                     const SurfacePoints& points, const std::array<double, 3>& light, float* out)
+  {
+    return points.Run(
+      [&](auto xyz, auto normals)
+      {
+        return vao::surfaceShadow(
+          source, xyz, normals, points.count, light, s.parameters, out, s.execution);
+      });
   };
   return kernels;
 }
@@ -240,12 +254,13 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
   const double* h = volume->GetSpacing();
   const double* d = volume->GetDirectionMatrix()->GetData();
   const bool sameGrid = std::equal(extent, extent + 6, cache.extent.begin()) &&
-    cache.origin == PyramidImages::ExtentOrigin(volume) && cache.spacing == std::array<double, 3>{ h[0], h[1], h[2] } &&
+    cache.origin == PyramidImages::ExtentOrigin(volume) &&
+    cache.spacing == std::array<double, 3>{ h[0], h[1], h[2] } &&
     std::equal(d, d + 9, cache.scalars.frame.direction.begin());
-  const bool fresh = chosen && cache.array == chosen && cache.arrayTime == chosen->GetMTime() && sameGrid &&
-    cache.component == this->Component &&
-    cache.numberOfLevels == this->NumberOfLevels && cache.halfResolution == (this->StartAtHalfResolution != 0) &&
-    !cache.surface.empty();
+  const bool fresh = chosen && cache.array == chosen && cache.arrayTime == chosen->GetMTime() &&
+    sameGrid && cache.component == this->Component &&
+    cache.numberOfLevels == this->NumberOfLevels &&
+    cache.halfResolution == (this->StartAtHalfResolution != 0) && !cache.surface.empty();
   if (fresh)
   {
     return true;
@@ -292,7 +307,8 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
   const bool empty = Extents::EmptyExtent(piece);
   if (!empty && !std::equal(expected, expected + 6, volume->GetExtent()))
   {
-    error = "The volume input delivered another extent than this process's piece and its reach: under MPI, "
+    error = "The volume input delivered another extent than this process's piece and its reach: "
+            "under MPI, "
             "feed the Volume input from its own reader.";
   }
   else if (!empty && Extents::CheckWholeExtent(whole, error) &&
@@ -305,7 +321,9 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
   const bool failed = !error.empty() || (!empty && cache.levels.empty());
   if (vtkAmbientOcclusionCollectives::GlobalMax(this->Controller, failed ? 1.0 : 0.0) > 0.0)
   {
-    vtkErrorMacro(<< (error.empty() ? std::string("The pyramid failed on another process (see its message).") : error));
+    vtkErrorMacro(<< (error.empty()
+                      ? std::string("The pyramid failed on another process (see its message).")
+                      : error));
     cache.levels.clear();
     return false;
   }
@@ -370,9 +388,10 @@ void vtkIsosurfaceAmbientOcclusion::PlaceSurface(vtkPolyData* surface, double bo
     AlongImageAxes(surface, cache.scalars, cache.origin, cache.spacing))
   {
     cache.surfaceFrame = vtkAmbientOcclusionFrame::Frame{};
-    vtkWarningMacro(<< "The surface lies on the volume's iso-surface only with the volume's direction matrix "
-                       "ignored, as vtkContourFilter and ParaView 5.11's Contour extract it: its points, normals "
-                       "and LightDirection are taken along the image's axes.");
+    vtkWarningMacro(
+      << "The surface lies on the volume's iso-surface only with the volume's direction matrix "
+         "ignored, as vtkContourFilter and ParaView 5.11's Contour extract it: its points, normals "
+         "and LightDirection are taken along the image's axes.");
   }
   BoundsInFrame(surface, cache.surfaceFrame, bounds);
 }
@@ -388,8 +407,8 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
   const vtkAmbientOcclusionFrame::Frame& frame = cache.surfaceFrame; // PlaceSurface's
   SurfacePoints points;
   std::string error;
-  if (!vtkAmbientOcclusionArrayInput::ReadSurfacePoints(surface, frame, cache.scalars, cache.origin, cache.spacing,
-        newOcclusion || this->ComputeShadows, points, error))
+  if (!vtkAmbientOcclusionArrayInput::ReadSurfacePoints(surface, frame, cache.scalars, cache.origin,
+        cache.spacing, newOcclusion || this->ComputeShadows, points, error))
   {
     vtkErrorMacro(<< error);
     return false;
@@ -418,13 +437,15 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
     shadow->SetName("Shadow");
     vtkAmbientOcclusionMemory::Allocate(shadow, points.count, "the Shadow output");
     const std::array<double, 3> light = frame.identity
-      ? std::array<double, 3>{ this->LightDirection[0], this->LightDirection[1], this->LightDirection[2] }
+      ? std::array<double, 3>{ this->LightDirection[0], this->LightDirection[1],
+          this->LightDirection[2] }
       : frame.VectorToImage(this->LightDirection);
     status = kernels.shadow(points, light, shadow->GetPointer(0));
   }
   if (!status.ok)
   {
-    error = vtkAmbientOcclusionArrayInput::KernelError(status, cache.scalars, "Isosurface ambient occlusion failed");
+    error = vtkAmbientOcclusionArrayInput::KernelError(
+      status, cache.scalars, "Isosurface ambient occlusion failed");
     if (!error.empty())
     {
       vtkErrorMacro(<< error);

@@ -12,11 +12,11 @@
 
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
-#include "vtkIntArray.h"
-#include "vtkMultiProcessController.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -77,7 +77,8 @@ void SlabInputExtent(const int whole[6], int rank, int ranks, int ext[6])
 /// ConvergenceTolerance, or when it is 0 a thousandth of the smallest spacing.
 double ExchangeTolerance(double convergenceTolerance, const double spacing[3])
 {
-  return convergenceTolerance > 0.0 ? convergenceTolerance : 1e-3 * std::min({ spacing[0], spacing[1], spacing[2] });
+  return convergenceTolerance > 0.0 ? convergenceTolerance
+                                    : 1e-3 * std::min({ spacing[0], spacing[1], spacing[2] });
 }
 
 /// Exchanges the face buffers with the slab neighbours (rank - 1 across the lower face,
@@ -117,11 +118,13 @@ double ExchangeFaces(vtkMultiProcessController* controller, vao::BlockSweeper& b
 /// where the kernel writes them.
 vao::SweepOutput AddOutputArrays(vtkImageData* image, bool withOctants)
 {
-  auto add = [image](const char* name, int components) {
+  auto add = [image](const char* name, int components)
+  {
     vtkNew<vtkFloatArray> array;
     array->SetName(name);
     array->SetNumberOfComponents(components);
-    vtkAmbientOcclusionMemory::Allocate(array, image->GetNumberOfPoints(), std::string("the ") + name + " output");
+    vtkAmbientOcclusionMemory::Allocate(
+      array, image->GetNumberOfPoints(), std::string("the ") + name + " output");
     image->GetPointData()->AddArray(array);
     return array->GetPointer(0);
   };
@@ -136,7 +139,7 @@ vao::SweepOutput AddOutputArrays(vtkImageData* image, bool withOctants)
 
 struct vtkOcclusionSweeping::Slab
 {
-  int extent[6]; // the voxels this process sweeps (its input has a ghost layer more)
+  int extent[6];        // the voxels this process sweeps (its input has a ghost layer more)
   ScalarVolume scalars; // read by the block sweeper until it finishes
   std::unique_ptr<vao::BlockSweeper> block;
 };
@@ -204,8 +207,8 @@ int vtkOcclusionSweeping::RequestUpdateExtent(
   if (this->IsDistributed(whole))
   {
     int ext[6];
-    SlabInputExtent(whole, this->Controller->GetLocalProcessId(),
-      this->Controller->GetNumberOfProcesses(), ext);
+    SlabInputExtent(
+      whole, this->Controller->GetLocalProcessId(), this->Controller->GetNumberOfProcesses(), ext);
     vtkAmbientOcclusionExtents::RequestExactExtent(inInfo, ext);
   }
   else
@@ -231,11 +234,13 @@ int vtkOcclusionSweeping::RequestData(
   // Allocation failure anywhere below (caching the ranges too) is an error and an empty
   // output, not an abort.
   return vtkAmbientOcclusionMemory::Guard(this, output,
-    "use more MPI ranks, turn OutputOctantVisibility off, or crop or resample the volume.", [&]() -> int {
-    const int result = this->ProduceOutput(inputVector, outputVector);
-    vtkAmbientOcclusionRanges::CacheOutput(output);
-    return result;
-  });
+    "use more MPI ranks, turn OutputOctantVisibility off, or crop or resample the volume.",
+    [&]() -> int
+    {
+      const int result = this->ProduceOutput(inputVector, outputVector);
+      vtkAmbientOcclusionRanges::CacheOutput(output);
+      return result;
+    });
 }
 
 //------------------------------------------------------------------------------
@@ -252,7 +257,8 @@ int vtkOcclusionSweeping::ProduceOutput(
   int whole[6], outExt[6];
   std::string error = vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
   if (!error.empty() ||
-    !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, whole, outExt, error))
+    !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(
+      inputVector[0], outputVector, whole, outExt, error))
   {
     vtkErrorMacro(<< error);
     return 1;
@@ -265,7 +271,8 @@ int vtkOcclusionSweeping::ProduceOutput(
   this->LastRounds = 0;
   if (!std::equal(whole, whole + 6, input->GetExtent()))
   {
-    vtkErrorMacro(<< "Occlusion sweeping needs the whole volume; the upstream source delivered only part of it.");
+    vtkErrorMacro(<< "Occlusion sweeping needs the whole volume; the upstream source delivered "
+                     "only part of it.");
     return 1;
   }
   ScalarVolume scalars;
@@ -281,8 +288,9 @@ int vtkOcclusionSweeping::ProduceOutput(
   const vao::SweepOutput arrays = AddOutputArrays(whole3d, this->OutputOctantVisibility != 0);
   const double* spacing = input->GetSpacing();
   vao::SweepReport report;
-  const vao::Status status = vao::computeOcclusionSweeping(scalars.view, { spacing[0], spacing[1], spacing[2] },
-    this->Parameters(), arrays, ExecutionOf(this, this->NumberOfThreads), &report);
+  const vao::Status status =
+    vao::computeOcclusionSweeping(scalars.view, { spacing[0], spacing[1], spacing[2] },
+      this->Parameters(), arrays, ExecutionOf(this, this->NumberOfThreads), &report);
   if (!status.ok)
   {
     error = KernelError(status, scalars, "Occlusion sweeping failed");
@@ -304,9 +312,11 @@ int vtkOcclusionSweeping::ProduceOutput(
 }
 
 //------------------------------------------------------------------------------
-std::string vtkOcclusionSweeping::StartSlab(vtkImageData* input, vtkDataArray* chosen, const int whole[6], Slab& slab)
+std::string vtkOcclusionSweeping::StartSlab(
+  vtkImageData* input, vtkDataArray* chosen, const int whole[6], Slab& slab)
 {
-  const int rank = this->Controller->GetLocalProcessId(), ranks = this->Controller->GetNumberOfProcesses();
+  const int rank = this->Controller->GetLocalProcessId(),
+            ranks = this->Controller->GetNumberOfProcesses();
   int expected[6];
   SlabExtent(whole, rank, ranks, slab.extent);
   SlabInputExtent(whole, rank, ranks, expected);
@@ -315,10 +325,11 @@ std::string vtkOcclusionSweeping::StartSlab(vtkImageData* input, vtkDataArray* c
   if (!std::equal(expected, expected + 6, inExt))
   {
     std::ostringstream why;
-    why << "Occlusion sweeping under MPI needs its slab and one ghost layer (" << expected[0] << ".."
-        << expected[1] << ", " << expected[2] << ".." << expected[3] << ", " << expected[4] << ".."
-        << expected[5] << "); the upstream source delivered (" << inExt[0] << ".." << inExt[1] << ", "
-        << inExt[2] << ".." << inExt[3] << ", " << inExt[4] << ".." << inExt[5] << ").";
+    why << "Occlusion sweeping under MPI needs its slab and one ghost layer (" << expected[0]
+        << ".." << expected[1] << ", " << expected[2] << ".." << expected[3] << ", " << expected[4]
+        << ".." << expected[5] << "); the upstream source delivered (" << inExt[0] << ".."
+        << inExt[1] << ", " << inExt[2] << ".." << inExt[3] << ", " << inExt[4] << ".." << inExt[5]
+        << ").";
     return why.str();
   }
   if (!PrepareScalars(this, chosen, input, this->Component, slab.scalars, error))
@@ -335,16 +346,18 @@ std::string vtkOcclusionSweeping::StartSlab(vtkImageData* input, vtkDataArray* c
     placement.begin[a] = slab.extent[2 * a] - whole[2 * a];
     placement.size[a] = slab.extent[2 * a + 1] - slab.extent[2 * a] + 1;
   }
-  slab.block.reset(new vao::BlockSweeper(slab.scalars.view, placement, { spacing[0], spacing[1], spacing[2] },
-    parameters, ExecutionOf(this, this->NumberOfThreads)));
+  slab.block.reset(new vao::BlockSweeper(slab.scalars.view, placement,
+    { spacing[0], spacing[1], spacing[2] }, parameters, ExecutionOf(this, this->NumberOfThreads)));
   return KernelError(slab.block->initialise(), slab.scalars, "Occlusion sweeping failed");
 }
 
 //------------------------------------------------------------------------------
 void vtkOcclusionSweeping::ReportStop(const std::string& error)
 {
-  vtkErrorMacro(<< (error.empty() ? std::string("Occlusion sweeping stopped: another process failed (see its message).")
-                                  : error));
+  vtkErrorMacro(<< (error.empty()
+                    ? std::string(
+                        "Occlusion sweeping stopped: another process failed (see its message).")
+                    : error));
 }
 
 //------------------------------------------------------------------------------
@@ -378,15 +391,15 @@ int vtkOcclusionSweeping::SweepRounds(Slab& slab, int axis, double tolerance)
   } while (++rounds < maxRounds && change > tolerance);
   if (change > tolerance)
   {
-    vtkWarningMacro(<< "Occlusion sweeping: the slabs still changed by " << change << " after " << rounds
-                    << " rounds of exchanges.");
+    vtkWarningMacro(<< "Occlusion sweeping: the slabs still changed by " << change << " after "
+                    << rounds << " rounds of exchanges.");
   }
   return rounds;
 }
 
 //------------------------------------------------------------------------------
-int vtkOcclusionSweeping::RequestDistributedData(
-  vtkImageData* input, vtkImageData* output, const int whole[6], const int outExt[6], vtkDataArray* chosen)
+int vtkOcclusionSweeping::RequestDistributedData(vtkImageData* input, vtkImageData* output,
+  const int whole[6], const int outExt[6], vtkDataArray* chosen)
 {
   // Every process checks its slab, then all agree: one that stopped alone would leave
   // the others waiting at the first exchange.
@@ -419,7 +432,8 @@ int vtkOcclusionSweeping::RequestDistributedData(
   // The slab's results with the input's arrays, then to whatever extent was requested.
   vtkNew<vtkImageData> held;
   vtkAmbientOcclusionExtents::CopyRequestedExtent(input, held, slab.extent);
-  const vao::Status finished = block.finish(AddOutputArrays(held, this->OutputOctantVisibility != 0));
+  const vao::Status finished =
+    block.finish(AddOutputArrays(held, this->OutputOctantVisibility != 0));
   if (GlobalMax(controller, finished.ok ? 0.0 : 1.0) > 0.0) // before the collective below
   {
     this->ReportStop(KernelError(finished, slab.scalars, "Occlusion sweeping failed"));
@@ -438,10 +452,10 @@ int vtkOcclusionSweeping::RequestDistributedData(
 void vtkOcclusionSweeping::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "IsoValue: " << this->IsoValue << " (inside is " << (this->InsideIsAbove ? "above" : "below")
-     << ")\n";
-  os << indent << "NumberOfIterations: " << this->NumberOfIterations << ", ConvergenceTolerance: "
-     << this->ConvergenceTolerance << "\n";
+  os << indent << "IsoValue: " << this->IsoValue << " (inside is "
+     << (this->InsideIsAbove ? "above" : "below") << ")\n";
+  os << indent << "NumberOfIterations: " << this->NumberOfIterations
+     << ", ConvergenceTolerance: " << this->ConvergenceTolerance << "\n";
   os << indent << "UseGeometryTerm: " << this->UseGeometryTerm << "\n";
   os << indent << "OctantMask:";
   for (int s = 0; s < 8; ++s)
@@ -450,6 +464,7 @@ void vtkOcclusionSweeping::PrintSelf(ostream& os, vtkIndent indent)
   }
   os << "\n" << indent << "Gamma: " << this->Gamma << ", Opacity: " << this->Opacity << "\n";
   os << indent << "OutputOctantVisibility: " << this->OutputOctantVisibility << "\n";
-  os << indent << "Component: " << this->Component << ", NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "Component: " << this->Component << ", NumberOfThreads: " << this->NumberOfThreads
+     << "\n";
   os << indent << "Controller: " << this->Controller.Get() << "\n";
 }

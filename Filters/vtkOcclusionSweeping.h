@@ -170,8 +170,8 @@ private:
   bool IsDistributed(const int whole[6]) const;
   void WarnNoSurface(const std::string& arrayName);
   /// The distributed execution (Controller with several processes).
-  int RequestDistributedData(
-    vtkImageData* input, vtkImageData* output, const int whole[6], const int outExt[6], vtkDataArray* chosen);
+  int RequestDistributedData(vtkImageData* input, vtkImageData* output, const int whole[6],
+    const int outExt[6], vtkDataArray* chosen);
   /// This process's slab: its scalars and its block sweeper.
   struct Slab;
   /// Starts the block sweeper of this process's slab; the reason when it cannot.

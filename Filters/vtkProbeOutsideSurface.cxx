@@ -54,7 +54,8 @@ bool InVolume(vtkImageData* volume, const double x[3])
 }
 
 /// p + offset n / |n| where that is in the volume and n is a usable normal; else p.
-void Displaced(vtkImageData* volume, const double p[3], const double n[3], double offset, double x[3])
+void Displaced(
+  vtkImageData* volume, const double p[3], const double n[3], double offset, double x[3])
 {
   const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   for (int a = 0; a < 3; ++a)
@@ -69,8 +70,8 @@ void Displaced(vtkImageData* volume, const double p[3], const double n[3], doubl
 }
 
 /// For every surface point, in turn, Displaced by each of `offsets`: the points to sample.
-vtkSmartPointer<vtkPoints> DisplacedPoints(
-  vtkPolyData* surface, vtkDataArray* normals, vtkImageData* volume, std::initializer_list<double> offsets)
+vtkSmartPointer<vtkPoints> DisplacedPoints(vtkPolyData* surface, vtkDataArray* normals,
+  vtkImageData* volume, std::initializer_list<double> offsets)
 {
   const vtkIdType n = surface->GetNumberOfPoints();
   const vtkIdType k = static_cast<vtkIdType>(offsets.size());
@@ -102,7 +103,8 @@ vtkSmartPointer<vtkDataSet> Sample(vtkImageData* volume, vtkPoints* points)
   for (int a = 0; a < arrays->GetNumberOfArrays(); ++a)
     if (vtkDataArray* array = arrays->GetArray(a))
       bytesPerPoint += array->GetNumberOfComponents() * array->GetDataTypeSize();
-  vtkAmbientOcclusionMemory::Reserve(bytesPerPoint * points->GetNumberOfPoints(), "the samples of the volume's arrays");
+  vtkAmbientOcclusionMemory::Reserve(
+    bytesPerPoint * points->GetNumberOfPoints(), "the samples of the volume's arrays");
   vtkNew<vtkPolyData> where;
   where->SetPoints(points);
   vtkNew<vtkProbeFilter> probe;
@@ -155,7 +157,8 @@ int vtkProbeOutsideSurface::RequestUpdateExtent(
   int reach[3];
   for (int a = 0; a < 3; ++a)
   {
-    const double voxels = std::abs(spacing[a]) > 0.0 ? this->Distance * smallest / std::abs(spacing[a]) : 0.0;
+    const double voxels =
+      std::abs(spacing[a]) > 0.0 ? this->Distance * smallest / std::abs(spacing[a]) : 0.0;
     reach[a] = static_cast<int>(std::ceil(std::min(voxels, 1e6))) + 2;
   }
   Extents::GrowExtent(ext, reach, whole);
@@ -168,17 +171,22 @@ std::string vtkProbeOutsideSurface::InputError(vtkPolyData* surface, vtkImageDat
 {
   std::ostringstream why;
   if (!std::isfinite(this->Distance) || this->Distance < 0.0)
-    why << "Distance must be a finite, non-negative number of voxels (got " << this->Distance << ").";
+    why << "Distance must be a finite, non-negative number of voxels (got " << this->Distance
+        << ").";
   else if (this->Orientation < AUTO || this->Orientation > REVERSED_NORMALS)
-    why << "Unknown Orientation " << this->Orientation << " (0 Auto, 1 Normals, 2 Reversed Normals).";
+    why << "Unknown Orientation " << this->Orientation
+        << " (0 Auto, 1 Normals, 2 Reversed Normals).";
   else if (!volume || volume->GetNumberOfPoints() == 0)
-    why << "No volume: connect image data to the Volume input (e.g. the output of Occlusion Sweeping).";
+    why << "No volume: connect image data to the Volume input (e.g. the output of Occlusion "
+           "Sweeping).";
   else if (volume->GetPointData()->GetNumberOfArrays() == 0)
     why << "The volume has no point arrays to sample.";
   else if (const double h = SmallestSpacing(volume->GetSpacing()); !(h > 0.0 && std::isfinite(h)))
     why << "The volume's spacing must be positive and finite.";
-  else if (surface->GetNumberOfPoints() > 0 && !vtkAmbientOcclusionArrayInput::GivenNormals(surface))
-    why << "The surface has no point normals: turn on Compute Normals in Contour, or apply Generate Surface "
+  else if (surface->GetNumberOfPoints() > 0 &&
+    !vtkAmbientOcclusionArrayInput::GivenNormals(surface))
+    why << "The surface has no point normals: turn on Compute Normals in Contour, or apply "
+           "Generate Surface "
            "Normals first.";
   else if (vtkDataArray* normals = vtkAmbientOcclusionArrayInput::GivenNormals(surface))
   {
@@ -189,7 +197,8 @@ std::string vtkProbeOutsideSurface::InputError(vtkPolyData* surface, vtkImageDat
   // would be read past its end.
   vtkPointData* arrays = volume ? volume->GetPointData() : nullptr;
   for (int a = 0; why.str().empty() && arrays && a < arrays->GetNumberOfArrays(); ++a)
-    why << vtkAmbientOcclusionArrayInput::PointCountError(arrays->GetArray(a), volume->GetNumberOfPoints());
+    why << vtkAmbientOcclusionArrayInput::PointCountError(
+      arrays->GetArray(a), volume->GetNumberOfPoints());
   return why.str();
 }
 
@@ -209,7 +218,8 @@ int vtkProbeOutsideSurface::OutsideSide(
   field->CopyStructure(volume);
   field->GetPointData()->AddArray(distance);
   const vtkIdType n = surface->GetNumberOfPoints();
-  vtkSmartPointer<vtkDataSet> samples = Sample(field, DisplacedPoints(surface, normals, volume, { offset, -offset }));
+  vtkSmartPointer<vtkDataSet> samples =
+    Sample(field, DisplacedPoints(surface, normals, volume, { offset, -offset }));
   vtkDataArray* sampled = samples->GetPointData()->GetArray(kSignedDistance);
   vtkIdType along = 0, against = 0;
   for (vtkIdType i = 0; sampled && i < n; ++i)
@@ -238,15 +248,18 @@ int vtkProbeOutsideSurface::RequestData(
   // Allocation failure (the sample points, the probe's arrays, caching the ranges) becomes
   // an error and an empty output, not an abort.
   return vtkAmbientOcclusionMemory::Guard(this, output,
-    "try a surface with fewer points (Decimate), or more MPI ranks.", [&]() -> int {
-    const int result = this->ProduceOutput(surface, volume, output);
-    vtkAmbientOcclusionRanges::CacheOutput(output);
-    return result;
-  });
+    "try a surface with fewer points (Decimate), or more MPI ranks.",
+    [&]() -> int
+    {
+      const int result = this->ProduceOutput(surface, volume, output);
+      vtkAmbientOcclusionRanges::CacheOutput(output);
+      return result;
+    });
 }
 
 //------------------------------------------------------------------------------
-int vtkProbeOutsideSurface::ProduceOutput(vtkPolyData* surface, vtkImageData* volume, vtkPolyData* output)
+int vtkProbeOutsideSurface::ProduceOutput(
+  vtkPolyData* surface, vtkImageData* volume, vtkPolyData* output)
 {
   output->ShallowCopy(surface);
   if (surface->GetNumberOfPoints() == 0)
@@ -271,7 +284,8 @@ int vtkProbeOutsideSurface::ProduceOutput(vtkPolyData* surface, vtkImageData* vo
   {
     vtkDataArray* array = from->GetArray(a);
     const char* name = array ? array->GetName() : nullptr;
-    if (!name || !strcmp(name, "vtkValidPointMask") || !strcmp(name, vtkDataSetAttributes::GhostArrayName()))
+    if (!name || !strcmp(name, "vtkValidPointMask") ||
+      !strcmp(name, vtkDataSetAttributes::GhostArrayName()))
       continue;
     output->GetPointData()->RemoveArray(name);
     output->GetPointData()->AddArray(array);

@@ -85,7 +85,8 @@ private:
   /// The reason the inputs or parameters cannot be used, or an empty string.
   std::string InputError(vtkPolyData* surface, vtkImageData* volume) const;
   /// +1 or -1: the side of the normals that is outside (see the class documentation).
-  int OutsideSide(vtkPolyData* surface, vtkDataArray* normals, vtkImageData* volume, double offset) const;
+  int OutsideSide(
+    vtkPolyData* surface, vtkDataArray* normals, vtkImageData* volume, double offset) const;
   /// The surface with the volume's arrays sampled outside it (RequestData's body, inside
   /// its memory guard; the inputs were checked).
   int ProduceOutput(vtkPolyData* surface, vtkImageData* volume, vtkPolyData* output);

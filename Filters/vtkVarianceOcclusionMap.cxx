@@ -42,14 +42,14 @@ int vtkVarianceOcclusionMap::FillInputPortInformation(int, vtkInformation* info)
 }
 
 //------------------------------------------------------------------------------
-void vtkVarianceOcclusionMap::InputExtentOf(const int whole[6], const int piece[6], int ext[6]) const
+void vtkVarianceOcclusionMap::InputExtentOf(
+  const int whole[6], const int piece[6], int ext[6]) const
 {
   const bool half = this->StartAtHalfResolution != 0;
   const int levels = std::max(1, std::min(this->NumberOfLevels, 16));
   const int reach = Extents::PyramidReach(levels, half);
   const int reaches[3] = { reach, reach, reach };
-  Extents::GrowForPyramid(
-    whole, piece, reaches, Extents::PyramidAlignment(levels, half), ext);
+  Extents::GrowForPyramid(whole, piece, reaches, Extents::PyramidAlignment(levels, half), ext);
 }
 
 //------------------------------------------------------------------------------
@@ -91,11 +91,13 @@ int vtkVarianceOcclusionMap::RequestData(
   // Allocation failure anywhere below (caching the ranges too) is an error and an empty
   // output, not an abort.
   return vtkAmbientOcclusionMemory::Guard(this, output,
-    "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.", [&]() -> int {
-    const int result = this->ProduceOutput(inputVector, outputVector);
-    vtkAmbientOcclusionRanges::CacheOutput(output);
-    return result;
-  });
+    "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.",
+    [&]() -> int
+    {
+      const int result = this->ProduceOutput(inputVector, outputVector);
+      vtkAmbientOcclusionRanges::CacheOutput(output);
+      return result;
+    });
 }
 
 //------------------------------------------------------------------------------
@@ -125,9 +127,10 @@ int vtkVarianceOcclusionMap::ProduceOutput(
   this->InputExtentOf(whole, piece, expected);
   if (input && !std::equal(expected, expected + 6, input->GetExtent()))
   {
-    vtkErrorMacro(<< "The variance occlusion map of this piece needs the input extent " << expected[0] << ".."
-                  << expected[1] << ", " << expected[2] << ".." << expected[3] << ", " << expected[4] << ".."
-                  << expected[5] << "; the upstream source delivered another one.");
+    vtkErrorMacro(<< "The variance occlusion map of this piece needs the input extent "
+                  << expected[0] << ".." << expected[1] << ", " << expected[2] << ".."
+                  << expected[3] << ", " << expected[4] << ".." << expected[5]
+                  << "; the upstream source delivered another one.");
     return 1;
   }
   std::vector<vao::MomentLevel> pyramid;
@@ -151,7 +154,8 @@ int vtkVarianceOcclusionMap::ProduceOutput(
   int step = this->StartAtHalfResolution ? 2 : 1;
   for (size_t l = 0; l < pyramid.size(); ++l, step *= 2)
   {
-    auto part = vtkAmbientOcclusionPyramidImages::LevelPiece(pyramid[l], whole, expected, piece, step);
+    auto part =
+      vtkAmbientOcclusionPyramidImages::LevelPiece(pyramid[l], whole, expected, piece, step);
     vtkAmbientOcclusionFrame::PlaceInWorld(scalars.frame, part); // where the input's own voxels lie
     output->SetBlock(static_cast<unsigned int>(l), part);
     output->GetMetaData(static_cast<unsigned int>(l))
@@ -166,5 +170,6 @@ void vtkVarianceOcclusionMap::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "NumberOfLevels: " << this->NumberOfLevels << "\n";
   os << indent << "StartAtHalfResolution: " << this->StartAtHalfResolution << "\n";
-  os << indent << "Component: " << this->Component << ", NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "Component: " << this->Component << ", NumberOfThreads: " << this->NumberOfThreads
+     << "\n";
 }

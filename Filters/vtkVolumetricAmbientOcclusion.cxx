@@ -75,7 +75,8 @@ vao::QueryMode KernelQueryMode(int mode)
 
 vao::ErfMode KernelErfMode(int erf)
 {
-  return erf == vtkVolumetricAmbientOcclusion::ERF_WINITZKI ? vao::ErfMode::Winitzki : vao::ErfMode::Exact;
+  return erf == vtkVolumetricAmbientOcclusion::ERF_WINITZKI ? vao::ErfMode::Winitzki
+                                                            : vao::ErfMode::Exact;
 }
 
 vtkSmartPointer<vtkFloatArray> NewFloatArray(const char* name, vtkIdType values)
@@ -227,11 +228,14 @@ int vtkVolumetricAmbientOcclusion::RequestData(
   // Allocation failure anywhere below (caching the ranges too) is an error and an empty
   // output, not an abort.
   return vtkAmbientOcclusionMemory::Guard(this, output,
-    "compute it in pieces (streaming or more MPI ranks), on a smaller extent, or without ComputeVariance.", [&]() -> int {
-    const int result = this->ProduceOutput(inputVector, outputVector);
-    vtkAmbientOcclusionRanges::CacheOutput(output);
-    return result;
-  });
+    "compute it in pieces (streaming or more MPI ranks), on a smaller extent, or without "
+    "ComputeVariance.",
+    [&]() -> int
+    {
+      const int result = this->ProduceOutput(inputVector, outputVector);
+      vtkAmbientOcclusionRanges::CacheOutput(output);
+      return result;
+    });
 }
 
 //------------------------------------------------------------------------------
@@ -250,7 +254,8 @@ int vtkVolumetricAmbientOcclusion::ProduceOutput(
   Run run;
   std::string error;
   if (input &&
-    !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(inputVector[0], outputVector, run.whole, run.outExt, error))
+    !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(
+      inputVector[0], outputVector, run.whole, run.outExt, error))
   {
     vtkErrorMacro(<< error);
     return 1; // the whole extent is the same on every process
@@ -272,7 +277,8 @@ int vtkVolumetricAmbientOcclusion::ProduceOutput(
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumetricAmbientOcclusion::ReadInput(vtkImageData* input, vtkInformationVector** inputVector, Run& run)
+bool vtkVolumetricAmbientOcclusion::ReadInput(
+  vtkImageData* input, vtkInformationVector** inputVector, Run& run)
 {
   // An empty piece of a distributed data set (e.g. MetaImage on rank > 0) has nothing
   // to compute, but still takes part in the thresholds of Histogram CDF.
@@ -283,8 +289,8 @@ bool vtkVolumetricAmbientOcclusion::ReadInput(vtkImageData* input, vtkInformatio
     return false;
   }
   std::string error;
-  if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
-        this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, run.scalars, error))
+  if (!vtkAmbientOcclusionArrayInput::PrepareScalars(this,
+        this->GetInputArrayToProcess(0, inputVector), input, this->Component, run.scalars, error))
   {
     vtkErrorMacro(<< error);
     return false;
@@ -297,7 +303,8 @@ bool vtkVolumetricAmbientOcclusion::ReadInput(vtkImageData* input, vtkInformatio
     const vao::Status finite = vao::finiteStatus(run.scan);
     if (!finite.ok)
     {
-      vtkErrorMacro(<< vtkAmbientOcclusionArrayInput::KernelError(finite, run.scalars, "Ambient occlusion failed"));
+      vtkErrorMacro(<< vtkAmbientOcclusionArrayInput::KernelError(
+                      finite, run.scalars, "Ambient occlusion failed"));
       return false;
     }
   }
@@ -318,7 +325,8 @@ bool vtkVolumetricAmbientOcclusion::ComputeArrays(vtkImageData* input, Run& run)
   run.parameters = this->Parameters(run.radius);
   run.parameters.thresholds = std::move(run.thresholds);
   const vao::Status status = this->Compute(run.scalars.view, region, run.parameters,
-    { run.openness->GetPointer(0), run.variance ? run.variance->GetPointer(0) : nullptr, &run.range });
+    { run.openness->GetPointer(0), run.variance ? run.variance->GetPointer(0) : nullptr,
+      &run.range });
   if (!status.ok)
   {
     const std::string error =
@@ -333,7 +341,8 @@ bool vtkVolumetricAmbientOcclusion::ComputeArrays(vtkImageData* input, Run& run)
 }
 
 //------------------------------------------------------------------------------
-void vtkVolumetricAmbientOcclusion::AssembleOutput(vtkImageData* input, vtkImageData* output, const Run& run)
+void vtkVolumetricAmbientOcclusion::AssembleOutput(
+  vtkImageData* input, vtkImageData* output, const Run& run)
 {
   // The output is exactly the requested extent: the input's arrays cropped to it.
   vtkAmbientOcclusionExtents::CopyRequestedExtent(input, output, run.outExt);
@@ -348,7 +357,8 @@ void vtkVolumetricAmbientOcclusion::AssembleOutput(vtkImageData* input, vtkImage
 }
 
 //------------------------------------------------------------------------------
-void vtkVolumetricAmbientOcclusion::RecordRun(vtkImageData* output, const std::vector<double>& thresholds)
+void vtkVolumetricAmbientOcclusion::RecordRun(
+  vtkImageData* output, const std::vector<double>& thresholds)
 {
   if (this->Method == HISTOGRAM_CDF)
   {
@@ -375,10 +385,12 @@ void vtkVolumetricAmbientOcclusion::RecordRun(vtkImageData* output, const std::v
 }
 
 //------------------------------------------------------------------------------
-vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume, const vao::Region& region,
-  const vao::AmbientOcclusionParameters& parameters, const vao::AmbientOcclusionOutput& arrays)
+vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume,
+  const vao::Region& region, const vao::AmbientOcclusionParameters& parameters,
+  const vao::AmbientOcclusionOutput& arrays)
 {
-  vao::Execution execution = vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads);
+  vao::Execution execution =
+    vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads);
   execution.device = this->Device;
   vao::Status status;
   // The device runs every method, with the voxel's value or an iso value as the query.
@@ -392,7 +404,8 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
     // falls back.
     if (!status.ok && status.deviceFailure)
     {
-      vtkWarningMacro(<< "The CUDA backend failed (" << status.message << "); computing on the CPU.");
+      vtkWarningMacro(<< "The CUDA backend failed (" << status.message
+                      << "); computing on the CPU.");
       onDevice = false;
     }
   }
@@ -406,7 +419,8 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumetricAmbientOcclusion::ChooseCuda(bool onDeviceQuery, bool exactMethod, long long voxels)
+bool vtkVolumetricAmbientOcclusion::ChooseCuda(
+  bool onDeviceQuery, bool exactMethod, long long voxels)
 {
   if (this->Backend == BACKEND_CPU)
   {
@@ -426,7 +440,8 @@ bool vtkVolumetricAmbientOcclusion::ChooseCuda(bool onDeviceQuery, bool exactMet
   }
   if (!device.available)
   {
-    vtkWarningMacro(<< "Backend CUDA: no CUDA device (" << device.description << "); computing on the CPU.");
+    vtkWarningMacro(<< "Backend CUDA: no CUDA device (" << device.description
+                    << "); computing on the CPU.");
     return false;
   }
   return true;
@@ -440,12 +455,16 @@ void vtkVolumetricAmbientOcclusion::PrintSelf(ostream& os, vtkIndent indent)
   const bool knownQuery = this->QueryMode >= VOXEL_VALUE && this->QueryMode <= SMOOTHED_VALUE;
   os << indent << "Method: " << (knownMethod ? MethodNames[this->Method] : "(invalid)") << "\n";
   os << indent << "NumberOfBins: " << this->NumberOfBins << "\n";
-  os << indent << "Radius: " << this->Radius << (this->RadiusUnits == WORLD ? " world" : " voxels") << "\n";
-  os << indent << "QueryMode: " << (knownQuery ? QueryModeNames[this->QueryMode] : "(invalid)") << "\n";
+  os << indent << "Radius: " << this->Radius << (this->RadiusUnits == WORLD ? " world" : " voxels")
+     << "\n";
+  os << indent << "QueryMode: " << (knownQuery ? QueryModeNames[this->QueryMode] : "(invalid)")
+     << "\n";
   os << indent << "IsoValue: " << this->IsoValue << "\n";
   os << indent << "QuerySmoothing: " << this->QuerySmoothing << "\n";
   os << indent << "Controller: " << this->Controller.Get() << "\n";
-  os << indent << "ErfApproximation: " << (this->ErfApproximation == ERF_WINITZKI ? "Winitzki" : "Exact") << "\n";
+  os << indent
+     << "ErfApproximation: " << (this->ErfApproximation == ERF_WINITZKI ? "Winitzki" : "Exact")
+     << "\n";
   os << indent << "ComputeVariance: " << this->ComputeVariance << "\n";
   os << indent << "Component: " << this->Component << "\n";
   os << indent << "Backend: " << this->Backend << " (last run: " << this->LastBackend << ")\n";

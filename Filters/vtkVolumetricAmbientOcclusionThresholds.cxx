@@ -41,7 +41,8 @@ vtkDataArray* vtkVolumetricAmbientOcclusion::GetHistogramThresholds() const
 //------------------------------------------------------------------------------
 vtkSmartPointer<vtkDoubleArray> vtkVolumetricAmbientOcclusion::ComputeHistogramThresholds(int slabs)
 {
-  vtkAlgorithm* producer = this->GetNumberOfInputConnections(0) > 0 ? this->GetInputAlgorithm(0, 0) : nullptr;
+  vtkAlgorithm* producer =
+    this->GetNumberOfInputConnections(0) > 0 ? this->GetInputAlgorithm(0, 0) : nullptr;
   std::string error = vao::checkHistogramBins(this->NumberOfBins);
   std::vector<double> thresholds;
   if (!producer && error.empty())
@@ -53,8 +54,10 @@ vtkSmartPointer<vtkDoubleArray> vtkVolumetricAmbientOcclusion::ComputeHistogramT
     bool read = false;
     try // outside RequestData, so outside the filters' memory guard
     {
-      read = vtkAmbientOcclusionThresholds::ComputeInSlabs(producer, port, slabs, this->NumberOfBins,
-        [&](vtkImageData* image, vao::VolumeView& view, std::string& why) {
+      read = vtkAmbientOcclusionThresholds::ComputeInSlabs(
+        producer, port, slabs, this->NumberOfBins,
+        [&](vtkImageData* image, vao::VolumeView& view, std::string& why)
+        {
           if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
                 this, this->GetInputArrayToProcess(0, image), image, this->Component, scalars, why))
             return false;
@@ -84,7 +87,8 @@ vtkSmartPointer<vtkDoubleArray> vtkVolumetricAmbientOcclusion::ComputeHistogramT
 
 //------------------------------------------------------------------------------
 bool vtkVolumetricAmbientOcclusion::Thresholds(vtkImageData* input, const vao::VolumeView* volume,
-  const vao::ValueScan& scan, const int outExt[6], const int whole[6], bool failed, std::vector<double>& thresholds)
+  const vao::ValueScan& scan, const int outExt[6], const int whole[6], bool failed,
+  std::vector<double>& thresholds)
 {
   std::string error;
   if (this->HistogramThresholds)
@@ -118,4 +122,3 @@ bool vtkVolumetricAmbientOcclusion::Thresholds(vtkImageData* input, const vao::V
   }
   return error.empty() && !failed;
 }
-

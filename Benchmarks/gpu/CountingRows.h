@@ -42,11 +42,14 @@ inline void benchmarkCounting(const vao::VolumeView& view, const std::string& la
     const vao::AmbientOcclusionParameters& p;
     int repeat;
   };
-  for (const Row& row : { Row{ "Histogram CDF (64 bins)", histogram, repeat }, Row{ "Exact Box", exact, 2 } })
+  for (const Row& row :
+    { Row{ "Histogram CDF (64 bins)", histogram, repeat }, Row{ "Exact Box", exact, 2 } })
   {
     const GpuTimes t = timeGpu(
-      [&](vao::cuda::Timing* timing) {
-        return vao::cuda::computeAmbientOcclusion(view, whole, row.p, { openness.data(), nullptr }, {}, timing);
+      [&](vao::cuda::Timing* timing)
+      {
+        return vao::cuda::computeAmbientOcclusion(
+          view, whole, row.p, { openness.data(), nullptr }, {}, timing);
       },
       row.repeat);
     if (!t.ok)
@@ -60,8 +63,8 @@ inline void benchmarkCounting(const vao::VolumeView& view, const std::string& la
       continue;
     if (row.p.method == vao::Method::HistogramCdf && gaussianKernelMs > 0)
       bar(t.kernelMs <= 4.0 * gaussianKernelMs ? "PASS" : "FAIL",
-        format("%s R=10 Histogram CDF kernels %.3f ms <= 4x the Gaussian CDF's (%.3f ms): %.2fx", label.c_str(),
-          t.kernelMs, gaussianKernelMs, t.kernelMs / gaussianKernelMs));
+        format("%s R=10 Histogram CDF kernels %.3f ms <= 4x the Gaussian CDF's (%.3f ms): %.2fx",
+          label.c_str(), t.kernelMs, gaussianKernelMs, t.kernelMs / gaussianKernelMs));
     if (row.p.method == vao::Method::ExactBox)
       bar(t.kernelMs <= 100.0 ? "PASS" : "FAIL",
         format("%s R=10 Exact Box kernels %.3f ms <= 100 ms", label.c_str(), t.kernelMs));
@@ -71,22 +74,26 @@ inline void benchmarkCounting(const vao::VolumeView& view, const std::string& la
   // Equality with the CPU on a slab of 16 slices in the middle (boxes clipped to the whole
   // volume, as in a distributed piece).
   const std::int64_t depth = std::min<std::int64_t>(16, view.dims[2]);
-  const vao::Region slab{ { 0, 0, (view.dims[2] - depth) / 2 }, { view.dims[0], view.dims[1], depth } };
+  const vao::Region slab{ { 0, 0, (view.dims[2] - depth) / 2 },
+    { view.dims[0], view.dims[1], depth } };
   const std::size_t n = static_cast<std::size_t>(slab.voxelCount());
   std::vector<float> gpu(n, -1.0f), cpu(n);
-  const vao::Status device = vao::cuda::computeAmbientOcclusion(view, slab, exact, { gpu.data(), nullptr });
+  const vao::Status device =
+    vao::cuda::computeAmbientOcclusion(view, slab, exact, { gpu.data(), nullptr });
   const vao::Status host = vao::computeAmbientOcclusion(view, slab, exact, { cpu.data(), nullptr });
   if (!device.ok || !host.ok)
   {
-    bar("FAIL", label + " R=10 Exact Box equals the CPU: a call failed: " + (device.ok ? host : device).message);
+    bar("FAIL",
+      label +
+        " R=10 Exact Box equals the CPU: a call failed: " + (device.ok ? host : device).message);
     return;
   }
   std::size_t differ = 0;
   for (std::size_t i = 0; i < n; ++i)
     differ += gpu[i] != cpu[i];
   bar(differ == 0 ? "PASS" : "FAIL",
-    format("%s R=10 Exact Box equals the CPU bit for bit on %lld slices: %zu of %zu voxels differ", label.c_str(),
-      static_cast<long long>(depth), differ, n));
+    format("%s R=10 Exact Box equals the CPU bit for bit on %lld slices: %zu of %zu voxels differ",
+      label.c_str(), static_cast<long long>(depth), differ, n));
 }
 
 } // namespace gpubench

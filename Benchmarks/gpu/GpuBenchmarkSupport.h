@@ -18,15 +18,16 @@ namespace gpubench
 
 inline double millisecondsSince(const std::chrono::steady_clock::time_point& start)
 {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+    .count();
 }
 
 struct GpuTimes
 {
   bool ok = false;
   std::string message;
-  double kernelMs = 0.0; // best of the timed runs
-  double totalMs = 0.0;  // best of the timed runs
+  double kernelMs = 0.0;                     // best of the timed runs
+  double totalMs = 0.0;                      // best of the timed runs
   std::vector<vao::cuda::PassTiming> passes; // of the run with the best kernel time
   double uploadGBs = 0.0;   // host-to-device copies (pinned staging), best run; 0: none
   double downloadGBs = 0.0; // device-to-host
@@ -61,9 +62,11 @@ GpuTimes timeGpu(const Call& call, int repeat)
     }
     times.totalMs = std::min(times.totalMs, timing.totalMilliseconds);
     if (timing.uploadMilliseconds > 0)
-      times.uploadGBs = std::max(times.uploadGBs, timing.uploadBytes / (timing.uploadMilliseconds * 1e6));
+      times.uploadGBs =
+        std::max(times.uploadGBs, timing.uploadBytes / (timing.uploadMilliseconds * 1e6));
     if (timing.downloadMilliseconds > 0)
-      times.downloadGBs = std::max(times.downloadGBs, timing.downloadBytes / (timing.downloadMilliseconds * 1e6));
+      times.downloadGBs =
+        std::max(times.downloadGBs, timing.downloadBytes / (timing.downloadMilliseconds * 1e6));
   }
   times.ok = true;
   return times;

@@ -16,7 +16,8 @@
 namespace gpubench
 {
 
-inline void benchmarkPyramid(const std::vector<std::int16_t>& volume, const vao::Index3& dims, int repeat)
+inline void benchmarkPyramid(
+  const std::vector<std::int16_t>& volume, const vao::Index3& dims, int repeat)
 {
   vao::VolumeView view;
   view.data = volume.data();
@@ -25,15 +26,15 @@ inline void benchmarkPyramid(const std::vector<std::int16_t>& volume, const vao:
   const std::array<double, 3> origin = { 0, 0, 0 }, spacing = { 1, 1, 1 };
   const vao::PyramidParameters parameters; // 4 levels from full resolution
   std::vector<vao::MomentLevel> gpu, cpu;
-  const GpuTimes t = timeGpu(
-    [&](vao::cuda::Timing* timing) {
-      return vao::cuda::buildMomentPyramid(view, origin, spacing, parameters, gpu, {}, timing);
-    },
+  const GpuTimes t = timeGpu([&](vao::cuda::Timing* timing)
+    { return vao::cuda::buildMomentPyramid(view, origin, spacing, parameters, gpu, {}, timing); },
     repeat);
-  const double cpuMs = timeCpu([&] { return vao::buildMomentPyramid(view, origin, spacing, parameters, cpu); },
-    std::min(repeat, 3));
-  std::printf("\n== variance occlusion pyramid, %lldx%lldx%lld int16, 4 levels\n", static_cast<long long>(dims[0]),
-    static_cast<long long>(dims[1]), static_cast<long long>(dims[2]));
+  const double cpuMs =
+    timeCpu([&] { return vao::buildMomentPyramid(view, origin, spacing, parameters, cpu); },
+      std::min(repeat, 3));
+  std::printf("\n== variance occlusion pyramid, %lldx%lldx%lld int16, 4 levels\n",
+    static_cast<long long>(dims[0]), static_cast<long long>(dims[1]),
+    static_cast<long long>(dims[2]));
   if (!t.ok)
   {
     std::printf("  GPU call failed: %s\n", t.message.c_str());
@@ -55,9 +56,11 @@ inline void benchmarkPyramid(const std::vector<std::int16_t>& volume, const vao:
     }
   }
   bar(same && worst <= 1e-5 ? "PASS" : "FAIL",
-    format("pyramid 256^3: the device's levels equal the CPU's to 1e-5 (largest relative difference %.3g%s)", worst,
-      same ? "" : "; the levels' sizes differ"));
-  bar(t.kernelMs <= 2.0 ? "PASS" : "FAIL", format("pyramid 256^3 4 levels kernels %.3f ms <= 2 ms", t.kernelMs));
+    format("pyramid 256^3: the device's levels equal the CPU's to 1e-5 (largest relative "
+           "difference %.3g%s)",
+      worst, same ? "" : "; the levels' sizes differ"));
+  bar(t.kernelMs <= 2.0 ? "PASS" : "FAIL",
+    format("pyramid 256^3 4 levels kernels %.3f ms <= 2 ms", t.kernelMs));
 }
 
 } // namespace gpubench

@@ -103,7 +103,8 @@ double ctValue(double u, double v, double w)
   const double su = u / 0.09, sv = (v - 0.42) / 0.09;
   if (su * su + sv * sv < 1.0)
   {
-    value = std::sin(12.0 * w) > -0.6 ? 750.0 + 200.0 * (1.0 - su * su - sv * sv) : 60.0; // vertebrae, discs
+    value = std::sin(12.0 * w) > -0.6 ? 750.0 + 200.0 * (1.0 - su * su - sv * sv)
+                                      : 60.0; // vertebrae, discs
   }
   const double au = (u + 0.08) / 0.05, av = (v - 0.22) / 0.05;
   if (au * au + av * av < 1.0)
@@ -122,19 +123,21 @@ std::vector<T> generateVolume(const vao::Index3& dims)
   std::vector<std::thread> threads;
   for (unsigned t = 0; t < workers; ++t)
   {
-    threads.emplace_back([&, t] {
-      for (std::int64_t z = t; z < nz; z += workers)
-        for (std::int64_t y = 0; y < ny; ++y)
-          for (std::int64_t x = 0; x < nx; ++x)
-          {
-            const std::int64_t i = (z * ny + y) * nx + x;
-            const double u = 2.0 * (x + 0.5) / nx - 1.0, v = 2.0 * (y + 0.5) / ny - 1.0,
-                         w = 2.0 * (z + 0.5) / nz - 1.0;
-            const double value = ctValue(u, v, w) + 25.0 * noiseAt(static_cast<std::uint64_t>(i));
-            volume[static_cast<std::size_t>(i)] =
-              static_cast<T>(std::is_integral<T>::value ? std::lround(value) : value);
-          }
-    });
+    threads.emplace_back(
+      [&, t]
+      {
+        for (std::int64_t z = t; z < nz; z += workers)
+          for (std::int64_t y = 0; y < ny; ++y)
+            for (std::int64_t x = 0; x < nx; ++x)
+            {
+              const std::int64_t i = (z * ny + y) * nx + x;
+              const double u = 2.0 * (x + 0.5) / nx - 1.0, v = 2.0 * (y + 0.5) / ny - 1.0,
+                           w = 2.0 * (z + 0.5) / nz - 1.0;
+              const double value = ctValue(u, v, w) + 25.0 * noiseAt(static_cast<std::uint64_t>(i));
+              volume[static_cast<std::size_t>(i)] =
+                static_cast<T>(std::is_integral<T>::value ? std::lround(value) : value);
+            }
+      });
   }
   for (auto& thread : threads)
   {
@@ -164,7 +167,8 @@ void reportPasses(const std::string& what, const GpuTimes& times, double copyGBs
   }
   if (times.uploadGBs > 0 || times.downloadGBs > 0)
   {
-    std::printf("      transfers (z slabs, pinned staging, overlapped): up %.1f GB/s, down %.1f GB/s\n",
+    std::printf(
+      "      transfers (z slabs, pinned staging, overlapped): up %.1f GB/s, down %.1f GB/s\n",
       times.uploadGBs, times.downloadGBs);
   }
   if (times.passes.empty())
@@ -243,9 +247,8 @@ template <class T>
 void benchmarkVolume(const Options& options, const vao::Index3& dims, const char* typeName)
 {
   const std::int64_t n = dims[0] * dims[1] * dims[2];
-  const std::string label =
-    format("%lldx%lldx%lld_%s", static_cast<long long>(dims[0]), static_cast<long long>(dims[1]),
-      static_cast<long long>(dims[2]), typeName);
+  const std::string label = format("%lldx%lldx%lld_%s", static_cast<long long>(dims[0]),
+    static_cast<long long>(dims[1]), static_cast<long long>(dims[2]), typeName);
   const bool large = n > 256LL * 256 * 415;
   const bool runCpu = !large || options.cpuAll;
 
@@ -280,24 +283,27 @@ void benchmarkVolume(const Options& options, const vao::Index3& dims, const char
     p.radius = { radius, radius, radius };
     const GpuTimes ao = timeGpu(
       [&](vao::cuda::Timing* t) {
-        return vao::cuda::computeAmbientOcclusion(view, whole, p, { openness.data(), nullptr }, {}, t);
+        return vao::cuda::computeAmbientOcclusion(
+          view, whole, p, { openness.data(), nullptr }, {}, t);
       },
       options.repeat);
-    const GpuTimes stats = timeGpu(
-      [&](vao::cuda::Timing* t) {
-        return vao::cuda::computeBoxStatistics(view, whole, p.radius, statsOutput, {}, t);
-      },
+    const GpuTimes stats = timeGpu([&](vao::cuda::Timing* t)
+      { return vao::cuda::computeBoxStatistics(view, whole, p.radius, statsOutput, {}, t); },
       options.repeat);
     double cpuAo = -1, cpuStats = -1;
     if (runCpu)
     {
-      cpuAo = timeCpu([&] { return vao::computeAmbientOcclusion(view, whole, p, { cpuOpenness.data(), nullptr }); },
+      cpuAo = timeCpu(
+        [&] {
+          return vao::computeAmbientOcclusion(view, whole, p, { cpuOpenness.data(), nullptr });
+        },
         cpuRepeat);
     }
     if (runCpu && stats.ok)
     {
       // Into the same arrays: the GPU's statistics are not needed any more.
-      cpuStats = timeCpu([&] { return vao::computeBoxStatistics(view, whole, p.radius, statsOutput); }, cpuRepeat);
+      cpuStats = timeCpu(
+        [&] { return vao::computeBoxStatistics(view, whole, p.radius, statsOutput); }, cpuRepeat);
     }
 
     struct Row
@@ -306,11 +312,13 @@ void benchmarkVolume(const Options& options, const vao::Index3& dims, const char
       const GpuTimes& gpu;
       double cpu;
     };
-    for (const Row& row : { Row{ "Gaussian CDF openness", ao, cpuAo }, Row{ "box statistics (5 outputs)", stats, cpuStats } })
+    for (const Row& row : { Row{ "Gaussian CDF openness", ao, cpuAo },
+           Row{ "box statistics (5 outputs)", stats, cpuStats } })
     {
       if (!row.gpu.ok)
       {
-        std::printf("  %-26s %3d  GPU call failed: %s\n", row.name, radius, row.gpu.message.c_str());
+        std::printf(
+          "  %-26s %3d  GPU call failed: %s\n", row.name, radius, row.gpu.message.c_str());
         callFailed = true;
         continue;
       }
@@ -330,8 +338,9 @@ void benchmarkVolume(const Options& options, const vao::Index3& dims, const char
       std::printf("    max |GPU - CPU| Gaussian CDF openness: %.3g\n", worst);
       if (worst > 1e-5)
       {
-        bar("FAIL", format("%s R=%d: GPU openness equals the CPU's to 1e-5 (max difference %.3g)",
-                      label.c_str(), radius, worst));
+        bar("FAIL",
+          format("%s R=%d: GPU openness equals the CPU's to 1e-5 (max difference %.3g)",
+            label.c_str(), radius, worst));
       }
     }
     if (ao.ok)
@@ -361,7 +370,8 @@ void benchmarkVolume(const Options& options, const vao::Index3& dims, const char
   }
 
   const auto gaussian10 = aoKernelMs.find(10);
-  benchmarkCounting(view, label, options.repeat, gaussian10 == aoKernelMs.end() ? -1.0 : gaussian10->second,
+  benchmarkCounting(view, label, options.repeat,
+    gaussian10 == aoKernelMs.end() ? -1.0 : gaussian10->second,
     dims[0] == 256 && dims[1] == 256 && dims[2] == 415 && !std::is_same<T, float>::value);
 
   // The peer: cupyx.scipy.ndimage on the same voxels, read back from a raw file.
@@ -372,7 +382,8 @@ void benchmarkVolume(const Options& options, const vao::Index3& dims, const char
   const std::string raw = options.rawDir + "/vao_gpu_" + label + ".raw";
   {
     std::ofstream out(raw, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(volume.data()), static_cast<std::streamsize>(n * sizeof(T)));
+    out.write(
+      reinterpret_cast<const char*>(volume.data()), static_cast<std::streamsize>(n * sizeof(T)));
     if (!out)
     {
       std::printf("  cannot write %s: no cupy comparison\n", raw.c_str());
@@ -391,15 +402,18 @@ void benchmarkVolume(const Options& options, const vao::Index3& dims, const char
     const auto ours = statsKernelMs.find(radius);
     if (it == cupy.milliseconds.end() || ours == statsKernelMs.end())
     {
-      bar("SKIP", format("%s R=%d speed-up of box statistics kernels vs cupy >= 10x: %s", label.c_str(),
-                    radius, ours == statsKernelMs.end() ? "our call failed" : cupy.problem.c_str()));
+      bar("SKIP",
+        format("%s R=%d speed-up of box statistics kernels vs cupy >= 10x: %s", label.c_str(),
+          radius, ours == statsKernelMs.end() ? "our call failed" : cupy.problem.c_str()));
       continue;
     }
     const double speedUp = it->second / ours->second;
-    std::printf("  cupyx.scipy.ndimage R=%d: %.3f ms (uniform x2 float64 + minimum + maximum); ours %.3f ms\n",
+    std::printf("  cupyx.scipy.ndimage R=%d: %.3f ms (uniform x2 float64 + minimum + maximum); "
+                "ours %.3f ms\n",
       radius, it->second, ours->second);
     bar(speedUp >= 10.0 ? "PASS" : "FAIL",
-      format("%s R=%d speed-up of box statistics kernels vs cupy %.1fx >= 10x", label.c_str(), radius, speedUp));
+      format("%s R=%d speed-up of box statistics kernels vs cupy %.1fx >= 10x", label.c_str(),
+        radius, speedUp));
   }
 }
 
@@ -447,8 +461,9 @@ int main(int argc, char* argv[])
     return 0;
   }
   std::printf("VolumetricAO GPU benchmark on %s\n", device.description.c_str());
-  std::printf("best of %d runs after one warm-up (CPU: best of %d, %u threads); kernels: CUDA events; "
-              "end-to-end: the whole call (allocation, transfers, kernels)\n",
+  std::printf(
+    "best of %d runs after one warm-up (CPU: best of %d, %u threads); kernels: CUDA events; "
+    "end-to-end: the whole call (allocation, transfers, kernels)\n",
     options.repeat, std::min(options.repeat, 3), std::max(1u, std::thread::hardware_concurrency()));
 
   std::vector<vao::Index3> sizes = { { 256, 256, 113 } };

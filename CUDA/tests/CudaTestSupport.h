@@ -25,7 +25,6 @@
     }                                                                                              \
   } while (false)
 
-
 namespace vaotest
 {
 
@@ -81,7 +80,8 @@ inline vao::Index3 voxelOf(const vao::Region& region, std::int64_t k)
 
 /// GPU box statistics of the region against the CPU's: count, minimum and maximum
 /// exactly, mean and variance to kStatsTolerance (relative).
-inline void expectStatsMatchCpu(const vao::VolumeView& view, const vao::Region& region, const vao::Radius& r)
+inline void expectStatsMatchCpu(
+  const vao::VolumeView& view, const vao::Region& region, const vao::Radius& r)
 {
   if (detailsLeft() <= 0)
   {
@@ -98,16 +98,17 @@ inline void expectStatsMatchCpu(const vao::VolumeView& view, const vao::Region& 
   for (std::int64_t k = 0; k < n; ++k)
   {
     const bool ok = gpu.count[k] == cpu.count[k] && gpu.minimum[k] == cpu.minimum[k] &&
-      gpu.maximum[k] == cpu.maximum[k] && closeRelative(gpu.mean[k], cpu.mean[k], kStatsTolerance) &&
+      gpu.maximum[k] == cpu.maximum[k] &&
+      closeRelative(gpu.mean[k], cpu.mean[k], kStatsTolerance) &&
       closeRelative(gpu.variance[k], cpu.variance[k], kStatsTolerance);
     if (!ok && failures++ < 5 && mayReportDetail())
     {
       const vao::Index3 p = voxelOf(region, k);
       ADD_FAILURE() << "voxel (" << p[0] << "," << p[1] << "," << p[2] << "), GPU vs CPU: count "
-                    << gpu.count[k] << " vs " << cpu.count[k] << ", mean " << gpu.mean[k]
-                    << " vs " << cpu.mean[k] << ", variance " << gpu.variance[k] << " vs "
-                    << cpu.variance[k] << ", min " << gpu.minimum[k] << " vs " << cpu.minimum[k]
-                    << ", max " << gpu.maximum[k] << " vs " << cpu.maximum[k];
+                    << gpu.count[k] << " vs " << cpu.count[k] << ", mean " << gpu.mean[k] << " vs "
+                    << cpu.mean[k] << ", variance " << gpu.variance[k] << " vs " << cpu.variance[k]
+                    << ", min " << gpu.minimum[k] << " vs " << cpu.minimum[k] << ", max "
+                    << gpu.maximum[k] << " vs " << cpu.maximum[k];
     }
   }
   EXPECT_EQ(failures, 0) << "voxels that differ, of " << n;
@@ -159,15 +160,16 @@ inline void expectOpennessMatchesCpu(const vao::VolumeView& view, const vao::Reg
       const vao::Index3 v = voxelOf(region, k);
       ADD_FAILURE() << "voxel (" << v[0] << "," << v[1] << "," << v[2] << "), GPU vs CPU: openness "
                     << gpuOpen[k] << " vs " << cpuOpen[k] << ", variance "
-                    << (withVariance ? gpuVar[k] : 0.0f) << " vs " << (withVariance ? cpuVar[k] : 0.0f);
+                    << (withVariance ? gpuVar[k] : 0.0f) << " vs "
+                    << (withVariance ? cpuVar[k] : 0.0f);
     }
   }
   EXPECT_EQ(failures, 0) << "voxels that differ, of " << n;
 }
 
 /// Every separable method, with the voxel's value and with an iso-value as the query.
-inline void expectEveryMethodMatchesCpu(const vao::VolumeView& view, const vao::Region& region,
-  const vao::Radius& r, double isoValue)
+inline void expectEveryMethodMatchesCpu(
+  const vao::VolumeView& view, const vao::Region& region, const vao::Radius& r, double isoValue)
 {
   for (const MethodCase& m : kSeparableMethods)
   {

@@ -22,13 +22,15 @@ template <class Blocked>
 double MonteCarloAO(const double n[3], int rays, std::mt19937& rng, Blocked&& blocked)
 {
   // An orthonormal frame (t, b, n).
-  const double helper[3] = { std::abs(n[0]) < 0.9 ? 1.0 : 0.0, std::abs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0 };
+  const double helper[3] = { std::abs(n[0]) < 0.9 ? 1.0 : 0.0, std::abs(n[0]) < 0.9 ? 0.0 : 1.0,
+    0.0 };
   double t[3] = { n[1] * helper[2] - n[2] * helper[1], n[2] * helper[0] - n[0] * helper[2],
     n[0] * helper[1] - n[1] * helper[0] };
   const double tl = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
   for (double& c : t)
     c /= tl;
-  const double b[3] = { n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0] };
+  const double b[3] = { n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2],
+    n[0] * t[1] - n[1] * t[0] };
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   int open = 0;
   for (int ray = 0; ray < rays; ++ray)
@@ -50,7 +52,8 @@ struct Agreement
 };
 
 /// How an estimate follows the reference at the same points (two vectors of one length).
-inline Agreement AgreementOf(const std::vector<double>& estimate, const std::vector<double>& reference)
+inline Agreement AgreementOf(
+  const std::vector<double>& estimate, const std::vector<double>& reference)
 {
   const double n = static_cast<double>(estimate.size());
   double me = 0, mr = 0;

@@ -43,7 +43,8 @@ template <class Kernel>
 void runBlocksOnHost(const Kernel& kernel, bool backwards)
 {
   using Acc = typename Kernel::Acc;
-  std::vector<Acc> shared(static_cast<size_t>((kernel.sharedBytes() + sizeof(Acc) - 1) / sizeof(Acc)));
+  std::vector<Acc> shared(
+    static_cast<size_t>((kernel.sharedBytes() + sizeof(Acc) - 1) / sizeof(Acc)));
   for (Index b = 0; b < kernel.blocks(); ++b)
   {
     std::fill(shared.begin(), shared.end(), std::numeric_limits<Acc>::max() / 3);
@@ -67,7 +68,8 @@ public:
   Buffer<U> allocate(Index count)
   {
     Buffer<U> buffer;
-    buffer.data.assign(static_cast<size_t>(count), static_cast<U>(std::numeric_limits<U>::max() / 3));
+    buffer.data.assign(
+      static_cast<size_t>(count), static_cast<U>(std::numeric_limits<U>::max() / 3));
     return buffer;
   }
 
@@ -151,36 +153,43 @@ struct Emulation
 /// there; shared memory is poisoned for every block.
 template <class T, class Acc>
 void runFusedOnHost(const std::vector<T>& block, const vao::gpu::RegionGeometry& g, Acc shift,
-  const vao::gpu::EstimatorSetting& estimator, const vao::gpu::FinalOutputs& out, bool withExtrema, const Emulation& how)
+  const vao::gpu::EstimatorSetting& estimator, const vao::gpu::FinalOutputs& out, bool withExtrema,
+  const Emulation& how)
 {
   const Index segment = vao::gpu::segmentLength(g.radius[2]);
   const auto plan =
     vao::gpu::planSlabs(g, how.slabSlices > 0 ? how.slabSlices : vao::gpu::slabSlices(g, segment));
   std::vector<T> device(block.size(), std::numeric_limits<T>::max());
-  const vao::gpu::StatisticsWriter<T, Acc> writer{ nullptr, nullptr, device.data(), g, shift, estimator, out };
+  const vao::gpu::StatisticsWriter<T, Acc> writer{ nullptr, nullptr, device.data(), g, shift,
+    estimator, out };
   const Index slice = g.sx * g.sy;
   for (const auto& step : plan)
   {
     std::copy(block.begin() + step.chunkBegin * slice, block.begin() + step.chunkEnd * slice,
       device.begin() + step.chunkBegin * slice);
     if (withExtrema)
-      runBlocksOnHost(vao::gpu::fusedStatisticsWithExtrema(writer, step.sliceBegin, step.sliceEnd, segment), how.backwards);
+      runBlocksOnHost(
+        vao::gpu::fusedStatisticsWithExtrema(writer, step.sliceBegin, step.sliceEnd, segment),
+        how.backwards);
     else
-      runBlocksOnHost(vao::gpu::fusedStatistics(writer, step.sliceBegin, step.sliceEnd, segment), how.backwards);
+      runBlocksOnHost(
+        vao::gpu::fusedStatistics(writer, step.sliceBegin, step.sliceEnd, segment), how.backwards);
   }
 }
 
 /// The pipeline on the host, set up as CudaBackend.cu sets it up on the device.
 template <class T>
 Results emulate(const std::vector<T>& v, const vao::Index3& dims, const vao::Region& region,
-  const vao::Radius& radius, bool statistics, const vao::gpu::EstimatorSetting& estimator, const Emulation& how = {})
+  const vao::Radius& radius, bool statistics, const vao::gpu::EstimatorSetting& estimator,
+  const Emulation& how = {})
 {
   using Acc = typename vao::detail::MomentTraits<T>::Accumulator;
   const auto g = vao::gpu::geometryFor(dims, region, radius);
   const std::vector<T> block = blockOf(v, dims, region, g);
   const vao::detail::TypedVolume<T> volume(viewOf(v, dims));
-  const Acc shift = vao::detail::MomentTraits<T>::exactInteger ? Acc(0)
-                                                               : static_cast<Acc>(vao::detail::sampledMean(volume));
+  const Acc shift = vao::detail::MomentTraits<T>::exactInteger
+    ? Acc(0)
+    : static_cast<Acc>(vao::detail::sampledMean(volume));
   Results r;
   const size_t n = static_cast<size_t>(region.voxelCount());
   vao::gpu::FinalOutputs out{};
@@ -189,7 +198,8 @@ Results emulate(const std::vector<T>& v, const vao::Index3& dims, const vao::Reg
   {
     for (auto* a : { &r.count, &r.mean, &r.varianceD, &r.minimum, &r.maximum })
       a->assign(n, -1.0);
-    out = { nullptr, nullptr, r.count.data(), r.mean.data(), r.varianceD.data(), r.minimum.data(), r.maximum.data() };
+    out = { nullptr, nullptr, r.count.data(), r.mean.data(), r.varianceD.data(), r.minimum.data(),
+      r.maximum.data() };
   }
   else
   {
@@ -210,14 +220,16 @@ Results emulate(const std::vector<T>& v, const vao::Index3& dims, const vao::Reg
 /// The emulated passes against the CPU library: the statistics (minimum and maximum exact)
 /// and the openness of a moment estimator.
 template <class T>
-void expectStatisticsLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, const vao::Region& region,
-  const vao::Radius& radius, const Emulation& how = {})
+void expectStatisticsLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims,
+  const vao::Region& region, const vao::Radius& radius, const Emulation& how = {})
 {
-  const Results gpu = emulate(v, dims, region, radius, true, { vao::Method::GaussianCdf, vao::QueryMode::VoxelValue, 0, vao::ErfMode::Exact }, how);
+  const Results gpu = emulate(v, dims, region, radius, true,
+    { vao::Method::GaussianCdf, vao::QueryMode::VoxelValue, 0, vao::ErfMode::Exact }, how);
   const size_t n = static_cast<size_t>(region.voxelCount());
   std::vector<double> count(n), mean(n), variance(n), minimum(n), maximum(n);
   ASSERT_TRUE(vao::computeBoxStatistics(viewOf(v, dims), region, radius,
-    { count.data(), mean.data(), variance.data(), minimum.data(), maximum.data() }).ok);
+    { count.data(), mean.data(), variance.data(), minimum.data(), maximum.data() })
+                .ok);
   for (size_t k = 0; k < n; ++k)
   {
     ASSERT_EQ(gpu.count[k], count[k]) << k;
@@ -229,10 +241,12 @@ void expectStatisticsLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims
 }
 
 template <class T>
-void expectOpennessLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, const vao::Region& region,
-  const vao::Radius& radius, vao::Method method, vao::QueryMode query, double iso, const Emulation& how = {})
+void expectOpennessLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims,
+  const vao::Region& region, const vao::Radius& radius, vao::Method method, vao::QueryMode query,
+  double iso, const Emulation& how = {})
 {
-  const Results gpu = emulate(v, dims, region, radius, false, { method, query, iso, vao::ErfMode::Exact }, how);
+  const Results gpu =
+    emulate(v, dims, region, radius, false, { method, query, iso, vao::ErfMode::Exact }, how);
   const size_t n = static_cast<size_t>(region.voxelCount());
   std::vector<float> openness(n), variance(n);
   vao::AmbientOcclusionParameters p;
@@ -240,7 +254,9 @@ void expectOpennessLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, 
   p.radius = radius;
   p.queryMode = query;
   p.isoValue = iso;
-  ASSERT_TRUE(vao::computeAmbientOcclusion(viewOf(v, dims), region, p, { openness.data(), variance.data() }).ok);
+  ASSERT_TRUE(
+    vao::computeAmbientOcclusion(viewOf(v, dims), region, p, { openness.data(), variance.data() })
+      .ok);
   for (size_t k = 0; k < n; ++k)
   {
     ASSERT_NEAR(gpu.openness[k], openness[k], 1e-6) << "method " << int(method) << " voxel " << k;

@@ -59,7 +59,8 @@ inline RefLevel refDecimate(const RefLevel& in)
 {
   const vao::Index3 d = in.dims;
   const vao::Index3 m = { (d[0] + 1) / 2, (d[1] + 1) / 2, (d[2] + 1) / 2 };
-  RefLevel out{ m, std::vector<double>(m[0] * m[1] * m[2]), std::vector<double>(m[0] * m[1] * m[2]) };
+  RefLevel out{ m, std::vector<double>(m[0] * m[1] * m[2]),
+    std::vector<double>(m[0] * m[1] * m[2]) };
   for (std::int64_t z = 0; z < m[2]; ++z)
     for (std::int64_t y = 0; y < m[1]; ++y)
       for (std::int64_t x = 0; x < m[0]; ++x)
@@ -97,8 +98,8 @@ std::vector<RefLevel> refPyramid(
   return out;
 }
 
-inline void expectLevelsMatch(const std::vector<vao::MomentLevel>& pyramid, const std::vector<RefLevel>& ref,
-  double shift, double meanTol, double varTol, double varAbs)
+inline void expectLevelsMatch(const std::vector<vao::MomentLevel>& pyramid,
+  const std::vector<RefLevel>& ref, double shift, double meanTol, double varTol, double varAbs)
 {
   ASSERT_EQ(pyramid.size(), ref.size());
   for (std::size_t l = 0; l < ref.size(); ++l)
@@ -130,7 +131,8 @@ struct Field
 
 /// Occupancy-like density of a signed distance (negative inside): 1 inside, 0 outside,
 /// linear across one voxel.
-inline Field makeField(const vao::Index3& dims, const std::function<double(double, double, double)>& sdf)
+inline Field makeField(
+  const vao::Index3& dims, const std::function<double(double, double, double)>& sdf)
 {
   Field f{ dims, { 0, 0, 0 }, { 1, 1, 1 }, std::vector<float>(dims[0] * dims[1] * dims[2]) };
   for (std::int64_t z = 0; z < dims[2]; ++z)
@@ -163,7 +165,8 @@ inline std::vector<float> ao(const Field& f, const std::vector<vao::MomentLevel>
 }
 
 /// Points on a sphere (Fibonacci lattice) and their outward normals.
-inline void spherePoints(const Vec3& c, double r, int n, std::vector<double>& points, std::vector<double>& normals)
+inline void spherePoints(
+  const Vec3& c, double r, int n, std::vector<double>& points, std::vector<double>& normals)
 {
   const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
   for (int i = 0; i < n; ++i)
@@ -185,7 +188,8 @@ template <class F>
 void forEachSurfaceQuery(F&& f)
 {
   for (vao::Method estimator : { vao::Method::Chebyshev, vao::Method::GaussianCdf })
-    for (vao::SurfaceQuery query : { vao::SurfaceQuery::HalfVoxelInside, vao::SurfaceQuery::IsoValue })
+    for (vao::SurfaceQuery query :
+      { vao::SurfaceQuery::HalfVoxelInside, vao::SurfaceQuery::IsoValue })
     {
       vao::SurfaceOcclusionParameters p;
       p.estimator = estimator;

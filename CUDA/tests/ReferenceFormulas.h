@@ -51,7 +51,8 @@ inline double winitzki(double x)
 {
   const double pi = std::acos(-1.0);
   const double a = 8.0 * (pi - 3.0) / (3.0 * pi * (4.0 - pi));
-  const double value = std::sqrt(std::fmax(0.0, 1.0 - std::exp(-x * x * (4.0 / pi + a * x * x) / (1.0 + a * x * x))));
+  const double value =
+    std::sqrt(std::fmax(0.0, 1.0 - std::exp(-x * x * (4.0 / pi + a * x * x) / (1.0 + a * x * x))));
   return x < 0 ? -value : value;
 }
 
@@ -74,8 +75,8 @@ inline double chebyshev(double q, const Statistics& s)
   return 1.0 - s.variance / (s.variance + (q - s.mean) * (q - s.mean));
 }
 
-/// docs/methods.md section 8, Histogram CDF: with F(t) = P(v <= t) over the box, O = 0 when q is below
-/// the lowest threshold, 1 at or above the highest, F(t_k) at q = t_k, and between the two
+/// docs/methods.md section 8, Histogram CDF: with F(t) = P(v <= t) over the box, O = 0 when q is
+/// below the lowest threshold, 1 at or above the highest, F(t_k) at q = t_k, and between the two
 /// enclosing thresholds the straight line through (t_k, F(t_k)) and (t_k+1, F(t_k+1)).
 template <class Fraction>
 double histogramCdf(double q, const std::vector<double>& t, Fraction&& fractionAtOrBelow)

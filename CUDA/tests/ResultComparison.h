@@ -24,7 +24,8 @@ inline bool closeRelative(double a, double b, double tolerance)
 template <class T>
 bool sameBits(const std::vector<T>& a, const std::vector<T>& b)
 {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+  return a.size() == b.size() &&
+    (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 /// The five outputs of computeBoxStatistics for n voxels, each prefilled with `fill` (a
@@ -33,7 +34,11 @@ struct StatsArrays
 {
   std::vector<double> count, mean, variance, minimum, maximum;
   explicit StatsArrays(std::int64_t n, double fill = 0.0)
-    : count(n, fill), mean(n, fill), variance(n, fill), minimum(n, fill), maximum(n, fill)
+    : count(n, fill)
+    , mean(n, fill)
+    , variance(n, fill)
+    , minimum(n, fill)
+    , maximum(n, fill)
   {
   }
   vao::BoxStatisticsOutput output()

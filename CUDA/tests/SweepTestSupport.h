@@ -50,14 +50,14 @@ inline Scene makeScene(const vao::Index3& dims, const Spacing& h, const Sdf& sdf
 
 inline Sdf sphere(double cx, double cy, double cz, double r)
 {
-  return [=](double x, double y, double z) {
-    return std::sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz)) - r;
-  };
+  return [=](double x, double y, double z)
+  { return std::sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz)) - r; };
 }
 
 inline Sdf box(double cx, double cy, double cz, double hx, double hy, double hz)
 {
-  return [=](double x, double y, double z) {
+  return [=](double x, double y, double z)
+  {
     const double qx = std::abs(x - cx) - hx, qy = std::abs(y - cy) - hy, qz = std::abs(z - cz) - hz;
     const double ox = std::max(qx, 0.0), oy = std::max(qy, 0.0), oz = std::max(qz, 0.0);
     return std::sqrt(ox * ox + oy * oy + oz * oz) + std::min(std::max({ qx, qy, qz }), 0.0);
@@ -66,7 +66,8 @@ inline Sdf box(double cx, double cy, double cz, double hx, double hy, double hz)
 
 inline Sdf torus(double cx, double cy, double cz, double major, double minor)
 {
-  return [=](double x, double y, double z) {
+  return [=](double x, double y, double z)
+  {
     const double q = std::hypot(x - cx, y - cy) - major;
     return std::hypot(q, z - cz) - minor;
   };

@@ -15,16 +15,56 @@ namespace vaotest
 
 template <class T>
 vao::ScalarType scalarTypeOf();
-template <> inline vao::ScalarType scalarTypeOf<std::int8_t>() { return vao::ScalarType::Int8; }
-template <> inline vao::ScalarType scalarTypeOf<std::uint8_t>() { return vao::ScalarType::UInt8; }
-template <> inline vao::ScalarType scalarTypeOf<std::int16_t>() { return vao::ScalarType::Int16; }
-template <> inline vao::ScalarType scalarTypeOf<std::uint16_t>() { return vao::ScalarType::UInt16; }
-template <> inline vao::ScalarType scalarTypeOf<std::int32_t>() { return vao::ScalarType::Int32; }
-template <> inline vao::ScalarType scalarTypeOf<std::uint32_t>() { return vao::ScalarType::UInt32; }
-template <> inline vao::ScalarType scalarTypeOf<std::int64_t>() { return vao::ScalarType::Int64; }
-template <> inline vao::ScalarType scalarTypeOf<std::uint64_t>() { return vao::ScalarType::UInt64; }
-template <> inline vao::ScalarType scalarTypeOf<float>() { return vao::ScalarType::Float32; }
-template <> inline vao::ScalarType scalarTypeOf<double>() { return vao::ScalarType::Float64; }
+template <>
+inline vao::ScalarType scalarTypeOf<std::int8_t>()
+{
+  return vao::ScalarType::Int8;
+}
+template <>
+inline vao::ScalarType scalarTypeOf<std::uint8_t>()
+{
+  return vao::ScalarType::UInt8;
+}
+template <>
+inline vao::ScalarType scalarTypeOf<std::int16_t>()
+{
+  return vao::ScalarType::Int16;
+}
+template <>
+inline vao::ScalarType scalarTypeOf<std::uint16_t>()
+{
+  return vao::ScalarType::UInt16;
+}
+template <>
+inline vao::ScalarType scalarTypeOf<std::int32_t>()
+{
+  return vao::ScalarType::Int32;
+}
+template <>
+inline vao::ScalarType scalarTypeOf<std::uint32_t>()
+{
+  return vao::ScalarType::UInt32;
+}
+template <>
+inline vao::ScalarType scalarTypeOf<std::int64_t>()
+{
+  return vao::ScalarType::Int64;
+}
+template <>
+inline vao::ScalarType scalarTypeOf<std::uint64_t>()
+{
+  return vao::ScalarType::UInt64;
+}
+template <>
+inline vao::ScalarType scalarTypeOf<float>()
+{
+  return vao::ScalarType::Float32;
+}
+template <>
+inline vao::ScalarType scalarTypeOf<double>()
+{
+  return vao::ScalarType::Float64;
+}
 
 /// Values drawn uniformly from [lo, hi] (integers) with a few repeated plateaus, so that
 /// flat and two-valued neighbourhoods occur too.
@@ -72,19 +112,26 @@ ReferenceStats bruteForceStats(const std::vector<T>& v, const vao::Index3& d, co
   ReferenceStats s{ 0, 0, 0, 0, 0 };
   long double sum = 0;
   bool first = true;
-  auto forEach = [&](auto&& f) {
+  auto forEach = [&](auto&& f)
+  {
     for (std::int64_t k = std::max<std::int64_t>(0, z - r.z); k <= std::min(d[2] - 1, z + r.z); ++k)
-      for (std::int64_t j = std::max<std::int64_t>(0, y - r.y); j <= std::min(d[1] - 1, y + r.y); ++j)
-        for (std::int64_t i = std::max<std::int64_t>(0, x - r.x); i <= std::min(d[0] - 1, x + r.x); ++i)
+      for (std::int64_t j = std::max<std::int64_t>(0, y - r.y); j <= std::min(d[1] - 1, y + r.y);
+           ++j)
+        for (std::int64_t i = std::max<std::int64_t>(0, x - r.x); i <= std::min(d[0] - 1, x + r.x);
+             ++i)
           f(static_cast<long double>(v[(k * d[1] + j) * d[0] + i]));
   };
-  forEach([&](long double value) {
-    sum += value;
-    s.count += 1;
-    if (first || value < s.minimum) s.minimum = static_cast<double>(value);
-    if (first || value > s.maximum) s.maximum = static_cast<double>(value);
-    first = false;
-  });
+  forEach(
+    [&](long double value)
+    {
+      sum += value;
+      s.count += 1;
+      if (first || value < s.minimum)
+        s.minimum = static_cast<double>(value);
+      if (first || value > s.maximum)
+        s.maximum = static_cast<double>(value);
+      first = false;
+    });
   const long double mean = sum / s.count;
   long double m2 = 0;
   forEach([&](long double value) { m2 += (value - mean) * (value - mean); });
@@ -104,13 +151,17 @@ double bruteForceOpenness(const std::vector<T>& v, const vao::Index3& d, const v
       for (std::int64_t dx = -r.x; dx <= r.x; ++dx)
       {
         const std::int64_t i = x + dx, j = y + dy, k = z + dz;
-        if (i < 0 || j < 0 || k < 0 || i >= d[0] || j >= d[1] || k >= d[2]) continue;
+        if (i < 0 || j < 0 || k < 0 || i >= d[0] || j >= d[1] || k >= d[2])
+          continue;
         if (sphere)
         {
-          auto term = [](std::int64_t delta, int radius) {
-            return radius == 0 ? (delta == 0 ? 0.0 : 2.0) : double(delta) * delta / (double(radius) * radius);
+          auto term = [](std::int64_t delta, int radius)
+          {
+            return radius == 0 ? (delta == 0 ? 0.0 : 2.0)
+                               : double(delta) * delta / (double(radius) * radius);
           };
-          if (term(dx, r.x) + term(dy, r.y) + term(dz, r.z) > 1.0 + 1e-12) continue;
+          if (term(dx, r.x) + term(dy, r.y) + term(dz, r.z) > 1.0 + 1e-12)
+            continue;
         }
         total += 1;
         below += static_cast<double>(v[(k * d[1] + j) * d[0] + i]) <= q ? 1 : 0;

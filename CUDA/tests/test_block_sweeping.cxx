@@ -117,7 +117,6 @@ void runRounds(Sweepers& sweepers, const std::vector<std::array<int, 6>>& neighb
         break;
     }
   }
-
 }
 
 /// The blocks' outputs assembled into whole-volume arrays.
@@ -143,8 +142,9 @@ void assembleOutputs(Sweepers& sweepers, const std::vector<vao::BlockPlacement>&
       for (std::int64_t y = 0; y < size[1]; ++y)
         for (std::int64_t x = 0; x < size[0]; ++x, ++k)
         {
-          const std::int64_t i = ((placement.begin[2] + z) * dims[1] + placement.begin[1] + y) *
-              dims[0] + placement.begin[0] + x;
+          const std::int64_t i =
+            ((placement.begin[2] + z) * dims[1] + placement.begin[1] + y) * dims[0] +
+            placement.begin[0] + x;
           result.distance[i] = d[k];
           result.occlusion[i] = a[k];
           std::copy(v.begin() + 8 * k, v.begin() + 8 * k + 8, result.octants.begin() + 8 * i);
@@ -240,8 +240,8 @@ TEST(BlockSweeping, EverySplitMatchesTheConvergedSerialResult)
     double opacity;
   };
   double worstD = 0, worstA = 0, worstV = 0;
-  for (const Variant variant : { Variant{ false, 1.0 }, Variant{ true, 1.0 },
-         Variant{ false, 0.5 }, Variant{ true, 0.5 } })
+  for (const Variant variant :
+    { Variant{ false, 1.0 }, Variant{ true, 1.0 }, Variant{ false, 0.5 }, Variant{ true, 0.5 } })
   {
     vao::SweepParameters p = convergedTo(1e-6);
     p.useGeometryTerm = variant.geometry;
@@ -252,8 +252,8 @@ TEST(BlockSweeping, EverySplitMatchesTheConvergedSerialResult)
     std::string rounds;
     for (const Blocks& blocks : splits)
     {
-      SCOPED_TRACE(name(blocks) + (variant.geometry ? ", geometry term" : ", mean") +
-        ", opacity " + std::to_string(variant.opacity));
+      SCOPED_TRACE(name(blocks) + (variant.geometry ? ", geometry term" : ", mean") + ", opacity " +
+        std::to_string(variant.opacity));
       const Distributed d = sweepInBlocks(scene, blocks, p);
       ASSERT_TRUE(d.status.ok) << d.status.message;
       EXPECT_LE(d.lastChange, p.tolerance) << "not converged in " << d.rounds << " rounds";
@@ -397,7 +397,8 @@ TEST(BlockSweepingRounds, GeneratedSceneInZSlabs)
   const char* size = std::getenv("VAO_BLOCK_ROUNDS_SIZE");
   const std::int64_t n = size ? std::atoll(size) : 64;
   const vao::Index3 dims = { n, n, n };
-  const std::vector<float> values = SceneVolume(static_cast<int>(n), static_cast<int>(n), static_cast<int>(n));
+  const std::vector<float> values =
+    SceneVolume(static_cast<int>(n), static_cast<int>(n), static_cast<int>(n));
   vao::VolumeView view = viewOf(values, dims);
   vao::SweepParameters p = convergedTo(1e-6);
   p.isoValue = 0.5;

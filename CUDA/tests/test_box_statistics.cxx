@@ -88,7 +88,8 @@ TYPED_TEST(BoxStatisticsTyped, WholeGroupsOfSixteenRowsAndTheirTails)
   const auto v = randomVolume<TypeParam>(dims, lo, lo + 200, 29); // within 8-bit types too
   const vao::Region whole = vao::Region::whole(viewOf(v, dims));
   const vao::Region offset{ { 3, 1, 1 }, { 47, 34, 3 } };
-  for (const vao::Radius& r : { vao::Radius{ 0, 8, 0 }, vao::Radius{ 1, 8, 1 }, vao::Radius{ 4, 9, 0 } })
+  for (const vao::Radius& r :
+    { vao::Radius{ 0, 8, 0 }, vao::Radius{ 1, 8, 1 }, vao::Radius{ 4, 9, 0 } })
   {
     SCOPED_TRACE(testing::Message() << r.x << "," << r.y << "," << r.z);
     expectStatsMatchBruteForce(v, dims, r, whole, 2);
@@ -177,7 +178,8 @@ TEST(BoxStatisticsValidation, RejectsBadArguments)
   StatsArrays out(125);
   const auto whole = vao::Region::whole(viewOf(v, dims));
   EXPECT_FALSE(vao::computeBoxStatistics(viewOf(v, dims), whole, { -1, 1, 1 }, out.output()).ok);
-  EXPECT_FALSE(vao::computeBoxStatistics(viewOf(v, { 0, 5, 5 }), whole, { 1, 1, 1 }, out.output()).ok);
+  EXPECT_FALSE(
+    vao::computeBoxStatistics(viewOf(v, { 0, 5, 5 }), whole, { 1, 1, 1 }, out.output()).ok);
   vao::Region outside{ { 3, 0, 0 }, { 5, 5, 5 } };
   EXPECT_FALSE(vao::computeBoxStatistics(viewOf(v, dims), outside, { 1, 1, 1 }, out.output()).ok);
   vao::VolumeView null = viewOf(v, dims);
@@ -195,7 +197,8 @@ TEST(BoxStatisticsExecution, HonoursCancellationAndReportsProgress)
   execution.threads = 2;
   execution.progress = [&](double p) { progress.push_back(p); };
   const auto whole = vao::Region::whole(viewOf(v, dims));
-  ASSERT_TRUE(vao::computeBoxStatistics(viewOf(v, dims), whole, { 2, 2, 2 }, out.output(), execution).ok);
+  ASSERT_TRUE(
+    vao::computeBoxStatistics(viewOf(v, dims), whole, { 2, 2, 2 }, out.output(), execution).ok);
   ASSERT_FALSE(progress.empty());
   EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
   EXPECT_LE(progress.back(), 1.0);
@@ -229,7 +232,8 @@ TEST(BoxStatistics, BandsOfRowsOnALargeVolumeMatchBruteForce)
         ASSERT_EQ(got.minimum[k], ref.minimum) << x << "," << y << "," << z;
         ASSERT_EQ(got.maximum[k], ref.maximum) << x << "," << y << "," << z;
         ASSERT_TRUE(closeRelative(got.mean[k], ref.mean, 1e-9)) << x << "," << y << "," << z;
-        ASSERT_TRUE(closeRelative(got.variance[k], ref.variance, 1e-9)) << x << "," << y << "," << z;
+        ASSERT_TRUE(closeRelative(got.variance[k], ref.variance, 1e-9))
+          << x << "," << y << "," << z;
       }
 }
 
@@ -245,12 +249,13 @@ void expectFlatExact(T value, std::int64_t side, int radius)
   const std::vector<T> v(side * side, value);
   StatsArrays got(side * side);
   const vao::Region whole = vao::Region::whole(viewOf(v, dims));
-  ASSERT_TRUE(vao::computeBoxStatistics(viewOf(v, dims), whole, { radius, radius, 0 }, got.output()).ok);
+  ASSERT_TRUE(
+    vao::computeBoxStatistics(viewOf(v, dims), whole, { radius, radius, 0 }, got.output()).ok);
   std::int64_t failures = 0;
   for (std::int64_t k = 0; k < side * side; ++k)
     if ((got.mean[k] != double(value) || got.variance[k] != 0.0) && failures++ < 5)
-      ADD_FAILURE() << "radius " << radius << ", voxel " << k << ": mean " << got.mean[k] << ", variance "
-                    << got.variance[k] << ", count " << got.count[k];
+      ADD_FAILURE() << "radius " << radius << ", voxel " << k << ": mean " << got.mean[k]
+                    << ", variance " << got.variance[k] << ", count " << got.count[k];
 }
 
 } // namespace

@@ -21,7 +21,8 @@ namespace
 TEST(CudaBackend, ReportsItsStateWithoutCrashing)
 {
   const vao::cuda::DeviceStatus device = vao::cuda::deviceStatus();
-  EXPECT_FALSE(device.description.empty()) << "deviceStatus() should name the device or say why there is none";
+  EXPECT_FALSE(device.description.empty())
+    << "deviceStatus() should name the device or say why there is none";
   if (!vao::cuda::built())
   {
     EXPECT_FALSE(device.available) << "a build without CUDA cannot have a device";
@@ -54,7 +55,8 @@ TEST(CudaBackend, ReportsItsStateWithoutCrashing)
     EXPECT_TRUE(statsStatus.deviceFailure && aoStatus.deviceFailure)
       << "no device is a device failure: the CPU may still compute it";
     EXPECT_EQ(vao::cuda::measureCopyBandwidth(1 << 24), 0.0);
-    std::cout << "[          ] built() = " << vao::cuda::built() << ", no device: " << device.description
+    std::cout << "[          ] built() = " << vao::cuda::built()
+              << ", no device: " << device.description
               << "\n[          ] computeBoxStatistics says: " << statsStatus.message << std::endl;
   }
 }
@@ -64,7 +66,7 @@ TEST(CudaBackend, EachRankTakesItsNodeLocalRankModuloTheDevices)
   using vao::cuda::chooseDevice;
   EXPECT_EQ(chooseDevice(-1, 4, 0), 0);
   EXPECT_EQ(chooseDevice(-1, 4, 3), 3);
-  EXPECT_EQ(chooseDevice(-1, 4, 6), 2);  // ranks 2 and 6 of a node with 4 devices share one
+  EXPECT_EQ(chooseDevice(-1, 4, 6), 2); // ranks 2 and 6 of a node with 4 devices share one
   EXPECT_EQ(chooseDevice(-1, 1, 5), 0);
   EXPECT_EQ(chooseDevice(-1, 3, -7), 0); // no sensible rank: the first device
   EXPECT_EQ(chooseDevice(2, 4, 3), 2);   // an explicit device wins over the rank
@@ -73,7 +75,8 @@ TEST(CudaBackend, EachRankTakesItsNodeLocalRankModuloTheDevices)
   EXPECT_EQ(chooseDevice(0, 0, 0), -1);
 
   // The launchers' node-local rank, first of the variables that holds one.
-  const char* names[] = { "OMPI_COMM_WORLD_LOCAL_RANK", "MPI_LOCALRANKID", "MV2_COMM_WORLD_LOCAL_RANK", "SLURM_LOCALID" };
+  const char* names[] = { "OMPI_COMM_WORLD_LOCAL_RANK", "MPI_LOCALRANKID",
+    "MV2_COMM_WORLD_LOCAL_RANK", "SLURM_LOCALID" };
   std::vector<std::pair<std::string, std::string>> saved;
   for (const char* name : names)
   {
@@ -108,7 +111,8 @@ TEST(CudaBackend, EachRankTakesItsNodeLocalRankModuloTheDevices)
   const vao::Status status = vao::cuda::computeAmbientOcclusion(
     viewOf(v, dims), vao::Region::whole(viewOf(v, dims)), {}, { open.data(), nullptr }, execution);
   EXPECT_FALSE(status.ok);
-  EXPECT_TRUE(status.deviceFailure) << "a device that is not there is a device failure: the CPU may run";
+  EXPECT_TRUE(status.deviceFailure)
+    << "a device that is not there is a device failure: the CPU may run";
 }
 
 TEST(CudaBackend, AnInjectedFailureIsADeviceFailureOfOneCall)
@@ -124,12 +128,14 @@ TEST(CudaBackend, AnInjectedFailureIsADeviceFailureOfOneCall)
   for (vao::Method method : { vao::Method::GaussianCdf, vao::Method::ExactBox })
   {
     p.method = method;
-    const vao::Status failed = vao::cuda::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
+    const vao::Status failed = vao::cuda::computeAmbientOcclusion(
+      view, vao::Region::whole(view), p, { open.data(), nullptr });
     EXPECT_FALSE(failed.ok);
     EXPECT_TRUE(failed.deviceFailure);
     EXPECT_NE(failed.message.find("injected"), std::string::npos) << failed.message;
   }
-  const vao::Status next = vao::cuda::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
+  const vao::Status next =
+    vao::cuda::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
   EXPECT_TRUE(next.ok) << "the device works again after the injected failures: " << next.message;
 }
 
@@ -139,11 +145,13 @@ TEST(CudaPyramid, EqualsTheCpuLevelByLevel)
   const vao::Index3 dims = { 67, 45, 39 };
   const auto v = randomVolume<std::int16_t>(dims, -1024, 2000, 41);
   const std::array<double, 3> origin = { 1.0, -2.0, 3.0 }, spacing = { 0.5, 0.5, 1.25 };
-  for (const vao::PyramidParameters parameters : { vao::PyramidParameters{ 4, false }, vao::PyramidParameters{ 3, true } })
+  for (const vao::PyramidParameters parameters :
+    { vao::PyramidParameters{ 4, false }, vao::PyramidParameters{ 3, true } })
   {
     std::vector<vao::MomentLevel> cpu, gpu;
     ASSERT_TRUE(vao::buildMomentPyramid(viewOf(v, dims), origin, spacing, parameters, cpu).ok);
-    const vao::Status status = vao::cuda::buildMomentPyramid(viewOf(v, dims), origin, spacing, parameters, gpu);
+    const vao::Status status =
+      vao::cuda::buildMomentPyramid(viewOf(v, dims), origin, spacing, parameters, gpu);
     ASSERT_TRUE(status.ok) << status.message;
     ASSERT_EQ(gpu.size(), cpu.size());
     for (size_t l = 0; l < cpu.size(); ++l)
@@ -152,13 +160,16 @@ TEST(CudaPyramid, EqualsTheCpuLevelByLevel)
       EXPECT_EQ(gpu[l].spacing, cpu[l].spacing);
       for (size_t i = 0; i < cpu[l].mean.size(); ++i)
       {
-        ASSERT_NEAR(gpu[l].mean[i], cpu[l].mean[i], 1e-5 * std::max(1.0f, std::abs(cpu[l].mean[i])));
-        ASSERT_NEAR(gpu[l].variance[i], cpu[l].variance[i], 1e-5 * std::max(1.0f, cpu[l].variance[i]));
+        ASSERT_NEAR(
+          gpu[l].mean[i], cpu[l].mean[i], 1e-5 * std::max(1.0f, std::abs(cpu[l].mean[i])));
+        ASSERT_NEAR(
+          gpu[l].variance[i], cpu[l].variance[i], 1e-5 * std::max(1.0f, cpu[l].variance[i]));
       }
     }
   }
   std::vector<vao::MomentLevel> bad = { vao::MomentLevel{} };
-  const vao::Status rejected = vao::cuda::buildMomentPyramid(viewOf(v, dims), origin, { 0.5, 0.0, 1.0 }, {}, bad);
+  const vao::Status rejected =
+    vao::cuda::buildMomentPyramid(viewOf(v, dims), origin, { 0.5, 0.0, 1.0 }, {}, bad);
   EXPECT_FALSE(rejected.ok);
   EXPECT_FALSE(rejected.deviceFailure) << "a zero spacing is bad input, as on the CPU";
   EXPECT_TRUE(bad.empty());
@@ -177,9 +188,12 @@ TEST(CudaAmbientOcclusion, EverySeparableMethodEveryRadiusZeroToTwelve)
   for (int r = 0; r <= 12; ++r)
   {
     const vao::Radius radius{ r, r, r };
-    expectEveryMethodMatchesCpu(viewOf(v8, dims), vao::Region::whole(viewOf(v8, dims)), radius, 3.0);
-    expectEveryMethodMatchesCpu(viewOf(v16, dims), vao::Region::whole(viewOf(v16, dims)), radius, 100.0);
-    expectEveryMethodMatchesCpu(viewOf(vf, dims), vao::Region::whole(viewOf(vf, dims)), radius, 0.25);
+    expectEveryMethodMatchesCpu(
+      viewOf(v8, dims), vao::Region::whole(viewOf(v8, dims)), radius, 3.0);
+    expectEveryMethodMatchesCpu(
+      viewOf(v16, dims), vao::Region::whole(viewOf(v16, dims)), radius, 100.0);
+    expectEveryMethodMatchesCpu(
+      viewOf(vf, dims), vao::Region::whole(viewOf(vf, dims)), radius, 0.25);
   }
 }
 
@@ -191,14 +205,16 @@ TEST(CudaAmbientOcclusion, AnisotropicRadiiLargeRadiiAndOtherTypes)
   const auto vf = randomVolume<float>(dims, -1, 1, 212);
   const auto vd = randomVolume<double>(dims, 1e6, 1e6 + 10, 213);
   const auto v32 = randomVolume<std::int32_t>(dims, -200000, 200000, 214);
-  for (const vao::Radius& r : { vao::Radius{ 1, 4, 0 }, vao::Radius{ 7, 2, 3 }, vao::Radius{ 12, 0, 5 },
-         vao::Radius{ 50, 50, 50 } })
+  for (const vao::Radius& r : { vao::Radius{ 1, 4, 0 }, vao::Radius{ 7, 2, 3 },
+         vao::Radius{ 12, 0, 5 }, vao::Radius{ 50, 50, 50 } })
   {
     expectEveryMethodMatchesCpu(viewOf(v16, dims), vao::Region::whole(viewOf(v16, dims)), r, 0.0);
     expectEveryMethodMatchesCpu(viewOf(vf, dims), vao::Region::whole(viewOf(vf, dims)), r, -0.5);
   }
-  expectEveryMethodMatchesCpu(viewOf(vd, dims), vao::Region::whole(viewOf(vd, dims)), { 7, 2, 3 }, 1e6 + 5);
-  expectEveryMethodMatchesCpu(viewOf(v32, dims), vao::Region::whole(viewOf(v32, dims)), { 3, 5, 2 }, 1000.0);
+  expectEveryMethodMatchesCpu(
+    viewOf(vd, dims), vao::Region::whole(viewOf(vd, dims)), { 7, 2, 3 }, 1e6 + 5);
+  expectEveryMethodMatchesCpu(
+    viewOf(v32, dims), vao::Region::whole(viewOf(v32, dims)), { 3, 5, 2 }, 1000.0);
 }
 
 TEST(CudaAmbientOcclusion, SubRegionsAndStridedComponent)
@@ -253,7 +269,8 @@ TEST(CudaValidation, RejectsBadArgumentsWithAMessage)
     p.radius = { 1, -1, 1 };
     p.method = method;
     status = vao::cuda::computeAmbientOcclusion(view, whole, p, { open.data(), nullptr });
-    EXPECT_FALSE(status.ok) << "exact method " << static_cast<int>(method) << " accepted a negative radius";
+    EXPECT_FALSE(status.ok) << "exact method " << static_cast<int>(method)
+                            << " accepted a negative radius";
     EXPECT_FALSE(status.deviceFailure) << "bad input is not a device failure";
   }
 
@@ -285,7 +302,8 @@ TEST(CudaTiming, FillsTimingAndRepeatsBitForBit)
   p.radius = { 5, 5, 5 };
   std::vector<float> first(whole.voxelCount()), second(whole.voxelCount());
   vao::cuda::Timing timing;
-  vao::Status status = vao::cuda::computeAmbientOcclusion(view, whole, p, { first.data(), nullptr }, {}, &timing);
+  vao::Status status =
+    vao::cuda::computeAmbientOcclusion(view, whole, p, { first.data(), nullptr }, {}, &timing);
   ASSERT_TRUE(status.ok) << status.message;
   EXPECT_GT(timing.kernelMilliseconds, 0.0);
   EXPECT_GE(timing.totalMilliseconds, timing.kernelMilliseconds);
@@ -298,7 +316,8 @@ TEST(CudaTiming, FillsTimingAndRepeatsBitForBit)
   }
   // A second call with the same Timing starts afresh (no accumulation of passes).
   const std::size_t passCount = timing.passes.size();
-  status = vao::cuda::computeAmbientOcclusion(view, whole, p, { second.data(), nullptr }, {}, &timing);
+  status =
+    vao::cuda::computeAmbientOcclusion(view, whole, p, { second.data(), nullptr }, {}, &timing);
   ASSERT_TRUE(status.ok) << status.message;
   EXPECT_EQ(timing.passes.size(), passCount);
   EXPECT_EQ(first, second) << "two GPU runs differ";
@@ -328,8 +347,8 @@ TEST(CudaTransfers, SlabsThroughPinnedStagingEqualTheCpuAndMoveEachByteOnce)
   p.radius = { 3, 3, 3 };
   std::vector<float> openness(whole.voxelCount()), variance(whole.voxelCount());
   vao::cuda::Timing timing;
-  const vao::Status status =
-    vao::cuda::computeAmbientOcclusion(view, whole, p, { openness.data(), variance.data() }, {}, &timing);
+  const vao::Status status = vao::cuda::computeAmbientOcclusion(
+    view, whole, p, { openness.data(), variance.data() }, {}, &timing);
   ASSERT_TRUE(status.ok) << status.message;
   EXPECT_EQ(timing.uploadBytes, 2.0 * whole.voxelCount());   // each slice once, no halo twice
   EXPECT_EQ(timing.downloadBytes, 8.0 * whole.voxelCount()); // two float outputs
@@ -338,11 +357,13 @@ TEST(CudaTransfers, SlabsThroughPinnedStagingEqualTheCpuAndMoveEachByteOnce)
   // A smaller call after a larger one, and a larger one again, reuse the cached buffers.
   const vao::Index3 small = { 9, 7, 5 };
   const auto f32 = randomVolume<float>(small, -1, 1, 412);
-  expectEveryMethodMatchesCpu(viewOf(f32, small), vao::Region::whole(viewOf(f32, small)), { 2, 2, 2 }, 0.1);
+  expectEveryMethodMatchesCpu(
+    viewOf(f32, small), vao::Region::whole(viewOf(f32, small)), { 2, 2, 2 }, 0.1);
   // A failure after the first upload leaves nothing in flight for the next call.
   vao::cuda::injectDeviceFailures(1);
   std::vector<float> failed(whole.voxelCount());
-  EXPECT_TRUE(vao::cuda::computeAmbientOcclusion(view, whole, p, { failed.data(), nullptr }).deviceFailure);
+  EXPECT_TRUE(
+    vao::cuda::computeAmbientOcclusion(view, whole, p, { failed.data(), nullptr }).deviceFailure);
   expectEveryMethodMatchesCpu(view, whole, { 3, 3, 3 }, 100.0);
 }
 
@@ -361,7 +382,8 @@ void expectCountsLikeTheCpu(const vao::VolumeView& view, const vao::Region& regi
   const size_t n = static_cast<size_t>(region.voxelCount());
   std::vector<float> cpu(n), gpu(n, -1.0f), cpuVar(n), gpuVar(n, -1.0f);
   ASSERT_TRUE(vao::computeAmbientOcclusion(view, region, p, { cpu.data(), cpuVar.data() }).ok);
-  const vao::Status status = vao::cuda::computeAmbientOcclusion(view, region, p, { gpu.data(), gpuVar.data() });
+  const vao::Status status =
+    vao::cuda::computeAmbientOcclusion(view, region, p, { gpu.data(), gpuVar.data() });
   ASSERT_TRUE(status.ok) << status.message;
   for (size_t i = 0; i < n; ++i)
   {
@@ -378,8 +400,9 @@ TEST(CudaAmbientOcclusion, ExactBoxAndSphereEqualTheCpu)
   const vao::Index3 dims = { 67, 45, 39 };
   const auto v16 = randomVolume<std::int16_t>(dims, -40, 40, 221);
   const auto vf = randomVolume<float>(dims, -1, 1, 222);
-  auto check = [&](const vao::VolumeView& view, const vao::Region& region, vao::Radius radius, vao::Method method,
-                 vao::QueryMode query, double iso) {
+  auto check = [&](const vao::VolumeView& view, const vao::Region& region, vao::Radius radius,
+                 vao::Method method, vao::QueryMode query, double iso)
+  {
     vao::AmbientOcclusionParameters p;
     p.method = method;
     p.radius = radius;
@@ -390,7 +413,8 @@ TEST(CudaAmbientOcclusion, ExactBoxAndSphereEqualTheCpu)
   const vao::Region inner{ { 5, 3, 7 }, { 50, 30, 20 } };
   for (auto method : { vao::Method::ExactBox, vao::Method::ExactSphere })
   {
-    check(viewOf(v16, dims), vao::Region::whole(viewOf(v16, dims)), { 5, 5, 5 }, method, vao::QueryMode::VoxelValue, 0.0);
+    check(viewOf(v16, dims), vao::Region::whole(viewOf(v16, dims)), { 5, 5, 5 }, method,
+      vao::QueryMode::VoxelValue, 0.0);
     check(viewOf(vf, dims), inner, { 3, 7, 0 }, method, vao::QueryMode::IsoValue, 0.2);
     check(viewOf(v16, dims), inner, { 12, 12, 12 }, method, vao::QueryMode::VoxelValue, 0.0);
   }
@@ -403,8 +427,9 @@ TEST(CudaAmbientOcclusion, HistogramCdfEqualsTheCpu)
   const auto v16 = randomVolume<std::int16_t>(dims, -1024, 2000, 211);
   const auto v8 = randomVolume<std::uint8_t>(dims, 0, 256, 212);
   const auto vf = randomVolume<float>(dims, -1, 1, 213);
-  auto check = [&](const vao::VolumeView& view, const vao::Region& region, vao::Radius radius, int bins,
-                 vao::QueryMode query, double iso) {
+  auto check = [&](const vao::VolumeView& view, const vao::Region& region, vao::Radius radius,
+                 int bins, vao::QueryMode query, double iso)
+  {
     vao::AmbientOcclusionParameters p;
     p.method = vao::Method::HistogramCdf;
     p.radius = radius;
@@ -416,10 +441,12 @@ TEST(CudaAmbientOcclusion, HistogramCdfEqualsTheCpu)
   const vao::Region inner{ { 5, 3, 7 }, { 50, 30, 20 } };
   for (int bins : { 2, 9, 64, 256 })
   {
-    check(viewOf(v16, dims), vao::Region::whole(viewOf(v16, dims)), { 5, 5, 5 }, bins, vao::QueryMode::VoxelValue, 0.0);
+    check(viewOf(v16, dims), vao::Region::whole(viewOf(v16, dims)), { 5, 5, 5 }, bins,
+      vao::QueryMode::VoxelValue, 0.0);
     check(viewOf(v8, dims), inner, { 3, 7, 2 }, bins, vao::QueryMode::VoxelValue, 0.0);
     check(viewOf(vf, dims), inner, { 10, 10, 10 }, bins, vao::QueryMode::IsoValue, 0.2);
   }
   // 41^3 voxels: more than 16-bit counts hold on the CPU; the device counts in int.
-  check(viewOf(v8, dims), vao::Region::whole(viewOf(v8, dims)), { 20, 20, 19 }, 64, vao::QueryMode::VoxelValue, 0.0);
+  check(viewOf(v8, dims), vao::Region::whole(viewOf(v8, dims)), { 20, 20, 19 }, 64,
+    vao::QueryMode::VoxelValue, 0.0);
 }

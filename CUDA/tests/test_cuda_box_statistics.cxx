@@ -117,17 +117,20 @@ TEST(CudaBoxStatistics, WritesOnlyTheRequestedOutputs)
   StatsArrays cpu(whole.voxelCount(), 0.0), gpu(whole.voxelCount(), -9.0);
   ASSERT_TRUE(vao::computeBoxStatistics(view, whole, r, cpu.output()).ok);
   // Only the mean and the maximum, then only the variance and the minimum.
-  vao::BoxStatisticsOutput meanMax{ nullptr, gpu.mean.data(), nullptr, nullptr, gpu.maximum.data() };
+  vao::BoxStatisticsOutput meanMax{ nullptr, gpu.mean.data(), nullptr, nullptr,
+    gpu.maximum.data() };
   vao::Status status = vao::cuda::computeBoxStatistics(view, whole, r, meanMax);
   ASSERT_TRUE(status.ok) << status.message;
-  vao::BoxStatisticsOutput varMin{ nullptr, nullptr, gpu.variance.data(), gpu.minimum.data(), nullptr };
+  vao::BoxStatisticsOutput varMin{ nullptr, nullptr, gpu.variance.data(), gpu.minimum.data(),
+    nullptr };
   status = vao::cuda::computeBoxStatistics(view, whole, r, varMin);
   ASSERT_TRUE(status.ok) << status.message;
   std::int64_t failures = 0;
   for (std::int64_t k = 0; k < whole.voxelCount(); ++k)
   {
     const bool ok = gpu.count[k] == -9.0 && gpu.minimum[k] == cpu.minimum[k] &&
-      gpu.maximum[k] == cpu.maximum[k] && closeRelative(gpu.mean[k], cpu.mean[k], kStatsTolerance) &&
+      gpu.maximum[k] == cpu.maximum[k] &&
+      closeRelative(gpu.mean[k], cpu.mean[k], kStatsTolerance) &&
       closeRelative(gpu.variance[k], cpu.variance[k], kStatsTolerance);
     if (!ok && failures++ < 5)
     {

@@ -51,7 +51,8 @@ TEST(Estimators, GaussianCdfIsTheNormalCdf)
 TEST(Estimators, FlatNeighbourhoodGivesTheExactAnswerForEveryEstimator)
 {
   const NeighbourhoodStats flat{ 500.0, 0.0, 500.0, 500.0 };
-  for (auto method : { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev })
+  for (auto method :
+    { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev })
     for (auto erf : { ErfMode::Exact, ErfMode::Winitzki })
     {
       EXPECT_EQ(vao::opennessFromStats(method, 500.0, flat, erf), 1.0);
@@ -73,7 +74,8 @@ TEST(Estimators, FlatRuleIgnoresTheRoundingOfTheMean)
   for (double mean : { q * (1 + 4e-16), q * (1 - 4e-16) })
   {
     const NeighbourhoodStats one{ mean, 3e-17, q, q, vao::sumRoundingVariance(1.0) };
-    for (auto method : { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev })
+    for (auto method :
+      { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev })
       for (auto erf : { ErfMode::Exact, ErfMode::Winitzki })
       {
         EXPECT_EQ(vao::opennessFromStats(method, q, one, erf), 1.0) << static_cast<int>(method);
@@ -91,12 +93,14 @@ TEST(Estimators, OpennessIsTheSameAtAnyOffsetAndScale)
   const double sigma = 3.0;
   // Powers of two as scales, so that mu, sigma and q are exact at every offset.
   for (const double offset : { 0.0, 1e8, -1e12 })
-    for (const double scale : { 1.0, std::ldexp(1.0, -34), std::ldexp(1.0, -100), std::ldexp(1.0, 66) })
+    for (const double scale :
+      { 1.0, std::ldexp(1.0, -34), std::ldexp(1.0, -100), std::ldexp(1.0, 66) })
     {
       const double mean = (1000.0 + offset) * scale, s = sigma * scale;
       const NeighbourhoodStats box{ mean, s * s, mean - 4.0 * s, mean + 4.0 * s };
       const double q = mean + 0.5 * s;
-      EXPECT_NEAR(vao::opennessGaussianCdf(q, box, ErfMode::Exact), 0.6914624612740131, 1e-6) << offset << " " << scale;
+      EXPECT_NEAR(vao::opennessGaussianCdf(q, box, ErfMode::Exact), 0.6914624612740131, 1e-6)
+        << offset << " " << scale;
       EXPECT_NEAR(vao::opennessChebyshev(q, box), 0.2, 1e-6) << offset << " " << scale;
     }
 }
@@ -150,7 +154,8 @@ TEST(Estimators, EveryEstimatorStaysInTheUnitInterval)
       {
         const double sd = std::sqrt(variance);
         const NeighbourhoodStats s{ mean, variance, mean - 3 * sd, mean + 2 * sd };
-        for (auto method : { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev })
+        for (auto method :
+          { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev })
           for (auto erf : { ErfMode::Exact, ErfMode::Winitzki })
           {
             const double o = vao::opennessFromStats(method, q, s, erf);

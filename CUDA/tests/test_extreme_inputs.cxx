@@ -28,13 +28,14 @@ vao::SweepParameters sweepWithOctants()
 }
 
 /// D and A of the sweeps of `scene` values at spacing h (isotropic).
-void sweepAt(const std::vector<double>& values, const vao::Index3& dims, double h, std::vector<float>& d,
-  std::vector<float>& a, vao::Status& status)
+void sweepAt(const std::vector<double>& values, const vao::Index3& dims, double h,
+  std::vector<float>& d, std::vector<float>& a, vao::Status& status)
 {
   const std::size_t n = values.size();
   d.assign(n, 0.0f);
   a.assign(n, 0.0f);
-  status = vao::computeOcclusionSweeping(viewOf(values, dims), { h, h, h }, sweepWithOctants(), { d.data(), a.data() });
+  status = vao::computeOcclusionSweeping(
+    viewOf(values, dims), { h, h, h }, sweepWithOctants(), { d.data(), a.data() });
 }
 
 std::vector<double> ballValues(const vao::Index3& dims, double inside, double outside)
@@ -44,7 +45,8 @@ std::vector<double> ballValues(const vao::Index3& dims, double inside, double ou
     for (std::int64_t y = 0; y < dims[1]; ++y)
       for (std::int64_t x = 0; x < dims[0]; ++x)
       {
-        const double r = std::sqrt((x - 9.3) * (x - 9.3) + (y - 8.1) * (y - 8.1) + (z - 10.4) * (z - 10.4));
+        const double r =
+          std::sqrt((x - 9.3) * (x - 9.3) + (y - 8.1) * (y - 8.1) + (z - 10.4) * (z - 10.4));
         v.push_back(r < 5.5 ? inside : outside);
       }
   return v;
@@ -115,10 +117,12 @@ TEST(ExtremeInputs, MomentMethodsRefuseValuesWhoseSquaresOverflow)
   std::vector<float> open(values.size());
   vao::AmbientOcclusionParameters p;
   p.radius = { 2, 2, 2 };
-  for (vao::Method m : { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
+  for (vao::Method m :
+    { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
   {
     p.method = m;
-    const vao::Status s = vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
+    const vao::Status s =
+      vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
     EXPECT_FALSE(s.ok);
     EXPECT_NE(s.message.find("rescale"), std::string::npos) << s.message;
   }
@@ -133,23 +137,28 @@ TEST(ExtremeInputs, MomentMethodsRefuseValuesWhoseSquaresOverflow)
   std::vector<double> unit = ballValues(dims, 1.0, 0.0);
   std::vector<float> openUnit(values.size());
   p.method = vao::Method::GaussianCdf;
-  ASSERT_TRUE(vao::computeAmbientOcclusion(viewOf(values, dims), vao::Region::whole(view), p, { open.data(), nullptr }).ok);
-  ASSERT_TRUE(
-    vao::computeAmbientOcclusion(viewOf(unit, dims), vao::Region::whole(view), p, { openUnit.data(), nullptr }).ok);
+  ASSERT_TRUE(vao::computeAmbientOcclusion(
+    viewOf(values, dims), vao::Region::whole(view), p, { open.data(), nullptr })
+                .ok);
+  ASSERT_TRUE(vao::computeAmbientOcclusion(
+    viewOf(unit, dims), vao::Region::whole(view), p, { openUnit.data(), nullptr })
+                .ok);
   for (std::size_t i = 0; i < open.size(); ++i)
     ASSERT_NEAR(open[i], openUnit[i], 1e-6) << "voxel " << i;
 }
 
 /// The openness of every voxel of `values` (q = its own value) by `method`, R = 2.
 template <class T>
-std::vector<float> opennessOf(const std::vector<T>& values, const vao::Index3& dims, vao::Method method)
+std::vector<float> opennessOf(
+  const std::vector<T>& values, const vao::Index3& dims, vao::Method method)
 {
   vao::AmbientOcclusionParameters p;
   p.radius = { 2, 2, 2 };
   p.method = method;
   std::vector<float> open(values.size(), -1.0f);
   const vao::VolumeView view = viewOf(values, dims);
-  const vao::Status s = vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
+  const vao::Status s =
+    vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr });
   EXPECT_TRUE(s.ok) << s.message;
   return open;
 }
@@ -171,7 +180,8 @@ TEST(ExtremeInputs, MomentMethodsSeeTheSameSceneAtAnyOffsetAndScale)
 {
   const vao::Index3 dims = { 14, 13, 12 };
   const std::vector<std::int16_t> base = randomVolume<std::int16_t>(dims, 990, 1010, 5);
-  for (vao::Method method : { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
+  for (vao::Method method :
+    { vao::Method::GaussianCdf, vao::Method::Chebyshev, vao::Method::CdfReconstruction })
   {
     SCOPED_TRACE(static_cast<int>(method));
     const std::vector<float> expected = opennessOf(base, dims, method);
@@ -199,31 +209,38 @@ TEST(ExtremeInputs, PyramidRefusesSpansItsFloatLevelsCannotHold)
   {
     const std::vector<double> values = ballValues(dims, inside, 0.0);
     std::vector<vao::MomentLevel> pyramid;
-    const vao::Status s = vao::buildMomentPyramid(viewOf(values, dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid);
+    const vao::Status s =
+      vao::buildMomentPyramid(viewOf(values, dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid);
     EXPECT_FALSE(s.ok) << inside;
     EXPECT_NE(s.message.find("rescale"), std::string::npos) << s.message;
     EXPECT_TRUE(pyramid.empty());
   }
   // A constant volume has no variance to lose, whatever its value.
   std::vector<vao::MomentLevel> constant;
-  EXPECT_TRUE(
-    vao::buildMomentPyramid(viewOf(ballValues(dims, 1e-30, 1e-30), dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, constant).ok);
+  EXPECT_TRUE(vao::buildMomentPyramid(
+    viewOf(ballValues(dims, 1e-30, 1e-30), dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, constant)
+                .ok);
 
   const std::vector<double> unit = ballValues(dims, 1.0, 0.0);
   std::vector<vao::MomentLevel> expected;
-  ASSERT_TRUE(vao::buildMomentPyramid(viewOf(unit, dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, expected).ok);
+  ASSERT_TRUE(
+    vao::buildMomentPyramid(viewOf(unit, dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, expected).ok);
   for (const int exponent : { -50, 55 })
   {
     const std::vector<double> scaled = ballValues(dims, std::ldexp(1.0, exponent), 0.0);
     std::vector<vao::MomentLevel> pyramid;
-    const vao::Status s = vao::buildMomentPyramid(viewOf(scaled, dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid);
+    const vao::Status s =
+      vao::buildMomentPyramid(viewOf(scaled, dims), { 0, 0, 0 }, { 1, 1, 1 }, {}, pyramid);
     ASSERT_TRUE(s.ok) << s.message;
     ASSERT_EQ(pyramid.size(), expected.size());
     for (std::size_t l = 0; l < pyramid.size(); ++l)
       for (std::size_t i = 0; i < pyramid[l].mean.size(); ++i)
       {
-        ASSERT_NEAR(std::ldexp(pyramid[l].mean[i], -exponent), expected[l].mean[i], 1e-6) << l << " " << i;
-        ASSERT_NEAR(std::ldexp(pyramid[l].variance[i], -2 * exponent), expected[l].variance[i], 1e-6) << l << " " << i;
+        ASSERT_NEAR(std::ldexp(pyramid[l].mean[i], -exponent), expected[l].mean[i], 1e-6)
+          << l << " " << i;
+        ASSERT_NEAR(
+          std::ldexp(pyramid[l].variance[i], -2 * exponent), expected[l].variance[i], 1e-6)
+          << l << " " << i;
       }
   }
 }

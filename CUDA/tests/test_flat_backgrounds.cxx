@@ -40,14 +40,16 @@ std::vector<T> ballInBackground(double background, double magnitude, unsigned se
         const double r2 = (x - 9.0) * (x - 9.0) + (y - 12.0) * (y - 12.0) + (z - 10.0) * (z - 10.0);
         const bool speck = (x * 7 + y * 13 + z * 29) % 997 == 0;
         if (r2 < 36.0 || speck)
-          v[(z * kSide + y) * kSide + x] = static_cast<T>(background + magnitude * (1.0 + noise(rng)));
+          v[(z * kSide + y) * kSide + x] =
+            static_cast<T>(background + magnitude * (1.0 + noise(rng)));
       }
   return v;
 }
 
 /// The exact openness of voxel (x, y, z) with q = its value, and whether its box is flat.
 template <class T>
-double exactOpenness(const std::vector<T>& v, std::int64_t x, std::int64_t y, std::int64_t z, int r, bool& flat)
+double exactOpenness(
+  const std::vector<T>& v, std::int64_t x, std::int64_t y, std::int64_t z, int r, bool& flat)
 {
   const T q = v[(z * kSide + y) * kSide + x];
   std::int64_t below = 0, total = 0;
@@ -108,7 +110,9 @@ void expectFlatBoxesExact(const std::vector<T>& v, const std::string& label)
       p.erfMode = m.erf;
       p.radius = { r, r, r };
       std::vector<float> open(v.size());
-      ASSERT_TRUE(vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr }).ok);
+      ASSERT_TRUE(
+        vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { open.data(), nullptr })
+          .ok);
       std::int64_t wrong = 0, first = -1;
       for (std::size_t i = 0; i < v.size(); ++i)
         if (flat[i] && open[i] != static_cast<float>(exact[i]))
@@ -116,8 +120,8 @@ void expectFlatBoxesExact(const std::vector<T>& v, const std::string& label)
           first = wrong == 0 ? static_cast<std::int64_t>(i) : first;
           ++wrong;
         }
-      EXPECT_EQ(wrong, 0) << label << ", R = " << r << ", " << m.name << ": " << wrong << " of " << flats
-                          << " flat boxes wrong, the first at index " << first << " (got "
+      EXPECT_EQ(wrong, 0) << label << ", R = " << r << ", " << m.name << ": " << wrong << " of "
+                          << flats << " flat boxes wrong, the first at index " << first << " (got "
                           << (first >= 0 ? open[first] : 0.0f) << ")";
     }
     // The Variance output: exactly 0 on every flat box (double sums leave rounding there,
@@ -125,7 +129,9 @@ void expectFlatBoxesExact(const std::vector<T>& v, const std::string& label)
     vao::AmbientOcclusionParameters p;
     p.radius = { r, r, r };
     std::vector<float> variance(v.size(), -1.0f);
-    ASSERT_TRUE(vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { nullptr, variance.data() }).ok);
+    ASSERT_TRUE(
+      vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { nullptr, variance.data() })
+        .ok);
     std::int64_t nonzero = 0, zero = 0;
     for (std::size_t i = 0; i < v.size(); ++i)
     {
@@ -146,8 +152,9 @@ void expectEveryBackground(const char* type)
     for (double background : { 0.0, 0.37 * magnitude + 3.0 })
     {
       const std::vector<T> v = ballInBackground<T>(background, magnitude, 11);
-      expectFlatBoxesExact(v, std::string(type) + " background " + std::to_string(background) +
-          " magnitude " + std::to_string(magnitude));
+      expectFlatBoxesExact(v,
+        std::string(type) + " background " + std::to_string(background) + " magnitude " +
+          std::to_string(magnitude));
     }
   }
 }
@@ -187,8 +194,8 @@ TEST(FlatBackgrounds, TheReportedFloatCaseHasNoWrongVoxel)
   vao::AmbientOcclusionParameters p;
   p.radius = { 3, 3, 3 };
   std::vector<float> open(v.size());
-  ASSERT_TRUE(vao::computeAmbientOcclusion(viewOf(v, dims), vao::Region::whole(viewOf(v, dims)), p,
-    { open.data(), nullptr })
+  ASSERT_TRUE(vao::computeAmbientOcclusion(
+    viewOf(v, dims), vao::Region::whole(viewOf(v, dims)), p, { open.data(), nullptr })
                 .ok);
   std::int64_t flats = 0, wrong = 0;
   for (std::int64_t z = 0; z < 40; ++z)
@@ -234,12 +241,14 @@ TEST(FlatBackgrounds, SpuriousVarianceStaysWellUnderTheRoundingBound)
               bool flat = false;
               exactOpenness(v, x, y, z, r, flat);
               if (flat)
-                worst = std::max(worst, variance[(z * kSide + y) * kSide + x] /
+                worst = std::max(worst,
+                  variance[(z * kSide + y) * kSide + x] /
                     (2.220446049250313e-16 * deviation * deviation));
             }
       }
     }
-  std::cout << "[ rounding ] largest spurious variance on a flat box: " << worst << " ulps of deviation^2\n";
+  std::cout << "[ rounding ] largest spurious variance on a flat box: " << worst
+            << " ulps of deviation^2\n";
   EXPECT_LT(worst * 4.0, vao::kSumRoundingUlps) << "the rounding bound has too little margin";
 }
 

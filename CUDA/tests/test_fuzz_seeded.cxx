@@ -27,13 +27,15 @@ TEST(FuzzSeeded, RandomInputsThroughEveryEntryPoint)
     vaofuzz::fuzzOnce(bytes.data(), bytes.size());
   }
   std::cout << "[ fuzz     ] " << kInputs << " inputs in "
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s\n";
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+            << " s\n";
 }
 
 TEST(FuzzSeeded, ABrokenPropertyIsReported)
 {
   // The harness must be able to fail: a violated property aborts with its description.
-  EXPECT_DEATH(vaofuzz::check(false, "a deliberately broken property"), "a deliberately broken property");
+  EXPECT_DEATH(
+    vaofuzz::check(false, "a deliberately broken property"), "a deliberately broken property");
 }
 
 } // namespace

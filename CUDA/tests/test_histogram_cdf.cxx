@@ -16,8 +16,9 @@ using namespace vaotest;
 namespace
 {
 
-std::vector<float> histogramOpenness(const vao::VolumeView& view, const vao::Region& region, vao::Radius r,
-  const std::vector<double>& thresholds, vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0.0)
+std::vector<float> histogramOpenness(const vao::VolumeView& view, const vao::Region& region,
+  vao::Radius r, const std::vector<double>& thresholds,
+  vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0.0)
 {
   std::vector<float> out(region.voxelCount(), -1.0f);
   vao::AmbientOcclusionParameters p;
@@ -39,7 +40,8 @@ double fractionAtOrBelow(const std::vector<T>& v, const vao::Index3& d, const va
   double below = 0, total = 0;
   for (std::int64_t k = std::max<std::int64_t>(0, z - r.z); k <= std::min(d[2] - 1, z + r.z); ++k)
     for (std::int64_t j = std::max<std::int64_t>(0, y - r.y); j <= std::min(d[1] - 1, y + r.y); ++j)
-      for (std::int64_t i = std::max<std::int64_t>(0, x - r.x); i <= std::min(d[0] - 1, x + r.x); ++i)
+      for (std::int64_t i = std::max<std::int64_t>(0, x - r.x); i <= std::min(d[0] - 1, x + r.x);
+           ++i)
       {
         total += 1;
         below += static_cast<double>(v[(k * d[1] + j) * d[0] + i]) <= t ? 1 : 0;
@@ -49,7 +51,8 @@ double fractionAtOrBelow(const std::vector<T>& v, const vao::Index3& d, const va
 
 template <class T>
 void expectMatchesDefinition(const std::vector<T>& v, const vao::Index3& dims, vao::Radius r,
-  const std::vector<double>& thresholds, vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0.0)
+  const std::vector<double>& thresholds, vao::QueryMode query = vao::QueryMode::VoxelValue,
+  double iso = 0.0)
 {
   const auto view = viewOf(v, dims);
   const auto got = histogramOpenness(view, vao::Region::whole(view), r, thresholds, query, iso);
@@ -62,7 +65,8 @@ void expectMatchesDefinition(const std::vector<T>& v, const vao::Index3& dims, v
         const double expected = reference::histogramCdf(
           q, thresholds, [&](double t) { return fractionAtOrBelow(v, dims, r, x, y, z, t); });
         if (!(std::abs(got[k] - expected) <= 2e-6) && failures++ < 8)
-          ADD_FAILURE() << "(" << x << "," << y << "," << z << ") q " << q << ": " << got[k] << " vs " << expected;
+          ADD_FAILURE() << "(" << x << "," << y << "," << z << ") q " << q << ": " << got[k]
+                        << " vs " << expected;
       }
   EXPECT_EQ(failures, 0);
 }
@@ -117,7 +121,8 @@ TEST(HistogramCdf, ATieCostsOneThreshold)
     if (x > 0)
       ++perBin[std::lower_bound(t.begin(), t.end(), double(x)) - t.begin()];
   for (size_t k = 2; k + 1 < t.size(); ++k)
-    EXPECT_LT(perBin[k], 13 * static_cast<std::int64_t>(v.size()) / 50 / 31) << "bin " << k << " holds too much";
+    EXPECT_LT(perBin[k], 13 * static_cast<std::int64_t>(v.size()) / 50 / 31)
+      << "bin " << k << " holds too much";
 }
 
 TEST(HistogramCdf, SummariesOfPartsMergeToTheWholeVolumes)
@@ -137,7 +142,9 @@ TEST(HistogramCdf, SummariesOfPartsMergeToTheWholeVolumes)
     for (const auto& slab : { std::array<std::int64_t, 2>{ 20, 10 }, { 0, 7 }, { 7, 13 } })
     {
       auto part = vao::ValueHistogram::forRange(view.type, range[0], range[1]);
-      ASSERT_TRUE(vao::addToValueHistogram(view, { { 0, 0, slab[0] }, { dims[0], dims[1], slab[1] } }, part).ok);
+      ASSERT_TRUE(
+        vao::addToValueHistogram(view, { { 0, 0, slab[0] }, { dims[0], dims[1], slab[1] } }, part)
+          .ok);
       merged.merge(part);
     }
     for (int bins : { 5, 64, 300 })
@@ -195,7 +202,9 @@ TEST(HistogramCdf, SixteenBitCountsWrapSafelyAndWideBoxesUseWiderLanes)
     {
       const std::int64_t x = k % dims[0], y = (k / dims[0]) % dims[1], z = k / (dims[0] * dims[1]);
       const double expected = reference::histogramCdf(double(v[k]), t,
-        [&](double th) { return fractionAtOrBelow(v, dims, { r, r, r }, x, y, z, th); });
+        [&](double th) {
+          return fractionAtOrBelow(v, dims, { r, r, r }, x, y, z, th);
+        });
       ASSERT_NEAR(got[k], expected, 2e-6) << "r " << r << " voxel " << k;
     }
   }
@@ -211,7 +220,8 @@ TEST(HistogramCdf, AtMostKDistinctValuesGiveExactBox)
   auto v16 = randomVolume<std::int16_t>(dims, -1000, 1000, 53);
   for (auto& x : v16)
     x = static_cast<std::int16_t>(x / 50 * 50); // 41 distinct values
-  auto check = [&](auto& v, int bins) {
+  auto check = [&](auto& v, int bins)
+  {
     const auto view = viewOf(v, dims);
     std::vector<double> t;
     ASSERT_TRUE(vao::volumeThresholds(view, bins, t).ok);
@@ -221,7 +231,9 @@ TEST(HistogramCdf, AtMostKDistinctValuesGiveExactBox)
     vao::AmbientOcclusionParameters p;
     p.method = vao::Method::ExactBox;
     p.radius = r;
-    ASSERT_TRUE(vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { exact.data(), nullptr }).ok);
+    ASSERT_TRUE(
+      vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { exact.data(), nullptr })
+        .ok);
     for (std::int64_t k = 0; k < view.voxelCount(); ++k)
       ASSERT_NEAR(got[k], exact[k], 1e-6) << k;
   };
@@ -266,11 +278,13 @@ TEST(HistogramCdf, RefusesBadThresholdsAndBins)
   p.method = vao::Method::HistogramCdf;
   p.radius = { 2, 2, 2 };
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (const auto& t : std::vector<std::vector<double>>{ {}, { 0.5, 0.2 }, { 0.1, 0.1 }, { 0.0, nan },
-         { -std::numeric_limits<double>::infinity(), 1.0 }, std::vector<double>(1025, 0.0) })
+  for (const auto& t :
+    std::vector<std::vector<double>>{ {}, { 0.5, 0.2 }, { 0.1, 0.1 }, { 0.0, nan },
+      { -std::numeric_limits<double>::infinity(), 1.0 }, std::vector<double>(1025, 0.0) })
   {
     p.thresholds = t;
-    const vao::Status status = vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { out.data(), nullptr });
+    const vao::Status status =
+      vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, { out.data(), nullptr });
     EXPECT_FALSE(status.ok);
     EXPECT_NE(status.message.find("threshold"), std::string::npos) << status.message;
   }

@@ -130,7 +130,8 @@ TEST(PyramidSampling, VolumeTrilinearAndClamped)
       for (std::int64_t x = 0; x < d[0]; ++x)
         v.push_back(static_cast<std::int16_t>(x + 10 * y + 100 * z));
   const Vec3 origin = { -1, 0, 2 }, spacing = { 0.5, 2, 1 };
-  EXPECT_NEAR(vao::sampleVolume(viewOf(v, d), origin, spacing, { -0.25, 3.0, 4.5 }), 1.5 + 15 + 250, 1e-9); // index (1.5, 1.5, 2.5)
+  EXPECT_NEAR(vao::sampleVolume(viewOf(v, d), origin, spacing, { -0.25, 3.0, 4.5 }), 1.5 + 15 + 250,
+    1e-9); // index (1.5, 1.5, 2.5)
   EXPECT_NEAR(vao::sampleVolume(viewOf(v, d), origin, spacing, { 100.0, -5.0, 0.0 }), 3.0, 1e-9);
 }
 
@@ -140,14 +141,16 @@ TEST(PyramidValidation, BadInputFailsWithMessage)
   std::vector<float> v(216, 1.0f);
   std::vector<vao::MomentLevel> pyramid;
   const vao::PyramidParameters ok;
-  auto expectFail = [&](const vao::VolumeView& view, const Vec3& spacing, const vao::PyramidParameters& p) {
+  auto expectFail =
+    [&](const vao::VolumeView& view, const Vec3& spacing, const vao::PyramidParameters& p)
+  {
     const vao::Status s = vao::buildMomentPyramid(view, { 0, 0, 0 }, spacing, p, pyramid);
     EXPECT_FALSE(s.ok);
     EXPECT_FALSE(s.message.empty());
   };
-  expectFail(viewOf(v, { 6, 36, 1 }), { 1, 1, 1 }, ok);                              // 2-D
-  expectFail(viewOf(v, d), { 1, 0, 1 }, ok);                                         // zero spacing
-  expectFail(viewOf(v, d), { 1, std::numeric_limits<double>::infinity(), 1 }, ok);   // inf spacing
+  expectFail(viewOf(v, { 6, 36, 1 }), { 1, 1, 1 }, ok);                            // 2-D
+  expectFail(viewOf(v, d), { 1, 0, 1 }, ok);                                       // zero spacing
+  expectFail(viewOf(v, d), { 1, std::numeric_limits<double>::infinity(), 1 }, ok); // inf spacing
   vao::PyramidParameters p = ok;
   p.levels = 0;
   expectFail(viewOf(v, d), { 1, 1, 1 }, p);
@@ -155,7 +158,7 @@ TEST(PyramidValidation, BadInputFailsWithMessage)
   expectFail(viewOf(v, d), { 1, 1, 1 }, p);
   v[100] = std::numeric_limits<float>::quiet_NaN();
   expectFail(viewOf(v, d), { 1, 1, 1 }, ok);
-  const vao::Status s = vao::buildMomentPyramid(viewOf(v, d), { 0, 0, 0 }, { 1, 1, 1 }, ok, pyramid);
+  const vao::Status s =
+    vao::buildMomentPyramid(viewOf(v, d), { 0, 0, 0 }, { 1, 1, 1 }, ok, pyramid);
   EXPECT_NE(s.message.find("non-finite"), std::string::npos) << s.message;
 }
-

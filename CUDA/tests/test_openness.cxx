@@ -1,6 +1,7 @@
 // computeAmbientOcclusion end to end on random volumes: the exact references against an
 // independent brute force, the separable estimators against docs/methods.md's formulas written
-// again in ReferenceFormulas.h, applied to brute-force statistics, the properties of docs/methods.md, and decomposition invariance.
+// again in ReferenceFormulas.h, applied to brute-force statistics, the properties of
+// docs/methods.md, and decomposition invariance.
 #include "ReferenceFormulas.h"
 #include "TestVolumes.h"
 
@@ -41,8 +42,8 @@ std::vector<float> openness(const vao::VolumeView& view, const vao::Region& regi
 }
 
 template <class T>
-void expectMatchesBruteForce(const std::vector<T>& v, const vao::Index3& dims, vao::Radius r,
-  vao::QueryMode query, double iso)
+void expectMatchesBruteForce(
+  const std::vector<T>& v, const vao::Index3& dims, vao::Radius r, vao::QueryMode query, double iso)
 {
   const auto view = viewOf(v, dims);
   const auto whole = vao::Region::whole(view);
@@ -50,8 +51,10 @@ void expectMatchesBruteForce(const std::vector<T>& v, const vao::Index3& dims, v
   const auto exactBox = openness(view, whole, Method::ExactBox, r, query, iso);
   const auto exactSphere = openness(view, whole, Method::ExactSphere, r, query, iso);
   const auto cdf = openness(view, whole, Method::CdfReconstruction, r, query, iso);
-  const auto gauss = openness(view, whole, Method::GaussianCdf, r, query, iso, vao::ErfMode::Exact, &variance);
-  const auto winitzki = openness(view, whole, Method::GaussianCdf, r, query, iso, vao::ErfMode::Winitzki);
+  const auto gauss =
+    openness(view, whole, Method::GaussianCdf, r, query, iso, vao::ErfMode::Exact, &variance);
+  const auto winitzki =
+    openness(view, whole, Method::GaussianCdf, r, query, iso, vao::ErfMode::Winitzki);
   const auto cheb = openness(view, whole, Method::Chebyshev, r, query, iso);
   std::int64_t k = 0, failures = 0;
   for (std::int64_t z = 0; z < dims[2]; ++z)
@@ -62,19 +65,20 @@ void expectMatchesBruteForce(const std::vector<T>& v, const vao::Index3& dims, v
         const auto ref = bruteForceStats(v, dims, r, x, y, z);
         const reference::Statistics s{ ref.mean, ref.variance, ref.minimum, ref.maximum };
         const double expected[] = { bruteForceOpenness(v, dims, r, x, y, z, q, false),
-          bruteForceOpenness(v, dims, r, x, y, z, q, true),
-          reference::cdfReconstruction(q, s), reference::gaussianCdf(q, s, false),
-          reference::gaussianCdf(q, s, true), reference::chebyshev(q, s) };
+          bruteForceOpenness(v, dims, r, x, y, z, q, true), reference::cdfReconstruction(q, s),
+          reference::gaussianCdf(q, s, false), reference::gaussianCdf(q, s, true),
+          reference::chebyshev(q, s) };
         const float got[] = { exactBox[k], exactSphere[k], cdf[k], gauss[k], winitzki[k], cheb[k] };
         for (int m = 0; m < 6; ++m)
         {
           if (std::abs(got[m] - expected[m]) > 2e-6 && failures++ < 8)
-            ADD_FAILURE() << "estimator " << m << " at (" << x << "," << y << "," << z << "): " << got[m]
-                          << " vs " << expected[m];
+            ADD_FAILURE() << "estimator " << m << " at (" << x << "," << y << "," << z
+                          << "): " << got[m] << " vs " << expected[m];
           EXPECT_GE(got[m], 0.0f);
           EXPECT_LE(got[m], 1.0f);
         }
-        if (std::abs(variance[k] - ref.variance) > 1e-6 * std::max(1.0, ref.variance) && failures++ < 8)
+        if (std::abs(variance[k] - ref.variance) > 1e-6 * std::max(1.0, ref.variance) &&
+          failures++ < 8)
           ADD_FAILURE() << "variance at " << k << ": " << variance[k] << " vs " << ref.variance;
         // Cantelli bound: Chebyshev never exceeds the exact box openness.
         if (cheb[k] > exactBox[k] + 1e-6f && failures++ < 8)
@@ -125,8 +129,8 @@ TEST(Openness, ExactSphereIsTheInscribedEllipsoid)
 }
 
 template <class T>
-void expectPieceEqualsWhole(const std::vector<T>& v, const vao::Index3& dims, Method method,
-  vao::Radius r, float tolerance)
+void expectPieceEqualsWhole(
+  const std::vector<T>& v, const vao::Index3& dims, Method method, vao::Radius r, float tolerance)
 {
   // A distributed run hands each rank its piece grown by the radius and clipped to the
   // whole extent; the piece's results must be those of the whole volume.
@@ -149,7 +153,8 @@ void expectPieceEqualsWhole(const std::vector<T>& v, const vao::Index3& dims, Me
   for (std::int64_t z = piece.begin[2]; z < piece.begin[2] + piece.size[2]; ++z)
     for (std::int64_t y = 0; y < dims[1]; ++y)
       for (std::int64_t x = piece.begin[0]; x < piece.begin[0] + piece.size[0]; ++x, ++k)
-        ASSERT_NEAR(part[k], whole[(z * dims[1] + y) * dims[0] + x], tolerance) << x << "," << y << "," << z;
+        ASSERT_NEAR(part[k], whole[(z * dims[1] + y) * dims[0] + x], tolerance)
+          << x << "," << y << "," << z;
 }
 
 TEST(Openness, APieceGrownByTheRadiusGivesTheWholeVolumesNumbers)
@@ -157,7 +162,8 @@ TEST(Openness, APieceGrownByTheRadiusGivesTheWholeVolumesNumbers)
   const vao::Index3 dims = { 15, 9, 17 };
   const auto v16 = randomVolume<std::int16_t>(dims, -500, 500, 31);
   const auto vd = randomVolume<double>(dims, 1e6, 1e6 + 10, 32);
-  for (auto method : { Method::CdfReconstruction, Method::GaussianCdf, Method::Chebyshev, Method::ExactBox, Method::ExactSphere })
+  for (auto method : { Method::CdfReconstruction, Method::GaussianCdf, Method::Chebyshev,
+         Method::ExactBox, Method::ExactSphere })
   {
     expectPieceEqualsWhole(v16, dims, method, { 3, 2, 4 }, 0.0f);
     expectPieceEqualsWhole(vd, dims, method, { 2, 3, 3 }, 1e-6f);
@@ -181,14 +187,17 @@ void expectStridedComponentLikeContiguous(const std::vector<T>& v, const vao::In
   vao::VolumeView strided = viewOf(interleaved, dims, 3);
   strided.data = interleaved.data() + 1;
   const auto contiguous = viewOf(v, dims);
-  for (const vao::Region region : { vao::Region::whole(contiguous), vao::Region{ { 2, 1, 1 }, { 19, 4, 3 } } })
+  for (const vao::Region region :
+    { vao::Region::whole(contiguous), vao::Region{ { 2, 1, 1 }, { 19, 4, 3 } } })
     for (const vao::Radius r : { vao::Radius{ 1, 1, 1 }, vao::Radius{ 3, 2, 1 } })
-      for (const Method method : { Method::CdfReconstruction, Method::GaussianCdf, Method::Chebyshev })
+      for (const Method method :
+        { Method::CdfReconstruction, Method::GaussianCdf, Method::Chebyshev })
         for (const vao::QueryMode query :
           { vao::QueryMode::VoxelValue, vao::QueryMode::IsoValue, vao::QueryMode::SmoothedValue })
-          EXPECT_EQ(openness(strided, region, method, r, query, 3.5), openness(contiguous, region, method, r, query, 3.5))
-            << "method " << int(method) << ", query " << int(query) << ", radius " << r.x << "," << r.y << ","
-            << r.z;
+          EXPECT_EQ(openness(strided, region, method, r, query, 3.5),
+            openness(contiguous, region, method, r, query, 3.5))
+            << "method " << int(method) << ", query " << int(query) << ", radius " << r.x << ","
+            << r.y << "," << r.z;
 }
 
 TEST(Openness, MomentMethodsReadEachVoxelsOwnValueThroughTheStride)
@@ -217,12 +226,14 @@ void expectExactCountsLikeDoubles(const std::vector<T>& values, const std::vecto
     v[i] = values[rng() % values.size()];
     interleaved[2 * i + 1] = v[i];
   }
-  for (const vao::Region region : { vao::Region{ { 3, 1, 1 }, { 39, 3, 3 } }, vao::Region::whole(viewOf(v, dims)) })
+  for (const vao::Region region :
+    { vao::Region{ { 3, 1, 1 }, { 39, 3, 3 } }, vao::Region::whole(viewOf(v, dims)) })
   {
     std::vector<double> query(region.voxelCount());
     for (double& q : query)
       q = queries[rng() % queries.size()];
-    for (const vao::Radius r : { vao::Radius{ 2, 1, 1 }, vao::Radius{ 4, 2, 0 }, vao::Radius{ 7, 1, 1 }, vao::Radius{ 9, 1, 1 } })
+    for (const vao::Radius r : { vao::Radius{ 2, 1, 1 }, vao::Radius{ 4, 2, 0 },
+           vao::Radius{ 7, 1, 1 }, vao::Radius{ 9, 1, 1 } })
       for (const Method method : { Method::ExactBox, Method::ExactSphere })
         for (const std::int64_t stride : { 1, 2 })
         {
@@ -232,7 +243,8 @@ void expectExactCountsLikeDoubles(const std::vector<T>& values, const std::vecto
           std::vector<float> got(region.voxelCount(), -1.0f);
           vao::VolumeView view = stride == 1 ? viewOf(v, dims) : viewOf(interleaved, dims, 2);
           view.data = stride == 1 ? v.data() : interleaved.data() + 1;
-          ASSERT_TRUE(vao::detail::computeExactOpenness(view, region, p, query.data(), got.data(), {}).ok);
+          ASSERT_TRUE(
+            vao::detail::computeExactOpenness(view, region, p, query.data(), got.data(), {}).ok);
           std::int64_t k = 0, failures = 0;
           for (std::int64_t z = region.begin[2]; z < region.begin[2] + region.size[2]; ++z)
             for (std::int64_t y = region.begin[1]; y < region.begin[1] + region.size[1]; ++y)
@@ -241,8 +253,8 @@ void expectExactCountsLikeDoubles(const std::vector<T>& values, const std::vecto
                 const auto expected = static_cast<float>(
                   bruteForceOpenness(v, dims, r, x, y, z, query[k], method == Method::ExactSphere));
                 if (got[k] != expected && failures++ < 5)
-                  ADD_FAILURE() << "stride " << stride << " at (" << x << "," << y << "," << z << ") query "
-                                << query[k] << ": " << got[k] << " vs " << expected;
+                  ADD_FAILURE() << "stride " << stride << " at (" << x << "," << y << "," << z
+                                << ") query " << query[k] << ": " << got[k] << " vs " << expected;
               }
         }
   }
@@ -251,27 +263,36 @@ void expectExactCountsLikeDoubles(const std::vector<T>& values, const std::vecto
 TEST(Openness, ExactReferencesCountAsDoublesOnEveryType)
 {
   const double nan = std::nan(""), inf = INFINITY;
-  const std::vector<double> common = { nan, inf, -inf, 1e300, -1e300, 0.0, -0.0, 0.5, -0.5, 1.0, 7.25 };
-  auto with = [&](std::vector<double> extra) {
+  const std::vector<double> common = { nan, inf, -inf, 1e300, -1e300, 0.0, -0.0, 0.5, -0.5, 1.0,
+    7.25 };
+  auto with = [&](std::vector<double> extra)
+  {
     extra.insert(extra.end(), common.begin(), common.end());
     return extra;
   };
-  expectExactCountsLikeDoubles<std::int8_t>({ -128, 127, -1, 0, 1, 7 }, with({ -128, -128.5, 126.99, 127 }));
-  expectExactCountsLikeDoubles<std::uint8_t>({ 0, 255, 1, 7, 128 }, with({ 254.5, 255, 255.5, 127.9 }));
-  expectExactCountsLikeDoubles<std::int16_t>({ -32768, 32767, -1, 0, 7 }, with({ -32768.5, 32766.5, 32767 }));
+  expectExactCountsLikeDoubles<std::int8_t>(
+    { -128, 127, -1, 0, 1, 7 }, with({ -128, -128.5, 126.99, 127 }));
+  expectExactCountsLikeDoubles<std::uint8_t>(
+    { 0, 255, 1, 7, 128 }, with({ 254.5, 255, 255.5, 127.9 }));
+  expectExactCountsLikeDoubles<std::int16_t>(
+    { -32768, 32767, -1, 0, 7 }, with({ -32768.5, 32766.5, 32767 }));
   expectExactCountsLikeDoubles<std::uint16_t>({ 0, 65535, 1, 7 }, with({ 65534.5, 65535, 65536 }));
   expectExactCountsLikeDoubles<std::int32_t>({ INT32_MIN, INT32_MAX, -1, 0, 7 },
     with({ -2147483648.5, -2147483648.0, 2147483646.5, 2147483647.0 }));
-  expectExactCountsLikeDoubles<std::uint32_t>({ 0, UINT32_MAX, 1, 7 }, with({ 4294967294.5, 4294967295.0 }));
+  expectExactCountsLikeDoubles<std::uint32_t>(
+    { 0, UINT32_MAX, 1, 7 }, with({ 4294967294.5, 4294967295.0 }));
   // 64-bit integers round on the way to double: 2^53 + 1 compares as 2^53, 2^64 - 1 as 2^64.
   const double two53 = 9007199254740992.0, two63 = 9223372036854775808.0;
   const std::int64_t big = (std::int64_t(1) << 53) + 1;
-  expectExactCountsLikeDoubles<std::int64_t>({ INT64_MIN, INT64_MAX, big, big + 2, 0, 7 },
-    with({ two53, two53 + 2, -two63, two63 }));
-  expectExactCountsLikeDoubles<std::uint64_t>({ 0, 7, std::uint64_t(big), UINT64_MAX }, with({ two53, 2 * two63, two63 }));
+  expectExactCountsLikeDoubles<std::int64_t>(
+    { INT64_MIN, INT64_MAX, big, big + 2, 0, 7 }, with({ two53, two53 + 2, -two63, two63 }));
+  expectExactCountsLikeDoubles<std::uint64_t>(
+    { 0, 7, std::uint64_t(big), UINT64_MAX }, with({ two53, 2 * two63, two63 }));
   // Floats: queries between two floats (0.1, 1e-46) and beyond the largest float.
-  const double fmax = std::numeric_limits<float>::max(), tiny = std::numeric_limits<float>::denorm_min();
-  expectExactCountsLikeDoubles<float>({ 0.1f, -0.1f, float(fmax), float(-fmax), float(tiny), 0, INFINITY, -INFINITY, NAN },
+  const double fmax = std::numeric_limits<float>::max(),
+               tiny = std::numeric_limits<float>::denorm_min();
+  expectExactCountsLikeDoubles<float>(
+    { 0.1f, -0.1f, float(fmax), float(-fmax), float(tiny), 0, INFINITY, -INFINITY, NAN },
     with({ 0.1, static_cast<double>(0.1f), -0.1, 1e-46, tiny, 2 * fmax, fmax, -fmax, -2 * fmax }));
   expectExactCountsLikeDoubles<double>({ 0.1, -0.1, 1e308, -1e308, 5e-324, inf, -inf, nan },
     with({ 0.1, std::nextafter(0.1, 1.0), 1e308, 5e-324, 1e-320 }));
@@ -286,7 +307,8 @@ TEST(Openness, RejectsNonFiniteIsoValue)
   p.radius = { 1, 1, 1 };
   p.queryMode = vao::QueryMode::IsoValue;
   p.isoValue = std::nan("");
-  const auto status = vao::computeAmbientOcclusion(viewOf(v, dims), vao::Region::whole(viewOf(v, dims)), p, { out.data(), nullptr });
+  const auto status = vao::computeAmbientOcclusion(
+    viewOf(v, dims), vao::Region::whole(viewOf(v, dims)), p, { out.data(), nullptr });
   EXPECT_FALSE(status.ok);
 }
 

@@ -101,12 +101,17 @@ struct BallScene
   std::int64_t count = 64 * 64 * 64;
 
   BallScene()
-    : field(makeField({ 64, 64, 64 }, [](double x, double y, double z) {
-      return std::sqrt((x - 31.5) * (x - 31.5) + (y - 31.5) * (y - 31.5) + (z - 31.5) * (z - 31.5)) - 12.0;
-    }))
+    : field(makeField({ 64, 64, 64 },
+        [](double x, double y, double z)
+        {
+          return std::sqrt(
+                   (x - 31.5) * (x - 31.5) + (y - 31.5) * (y - 31.5) + (z - 31.5) * (z - 31.5)) -
+            12.0;
+        }))
     , pyramid(pyramidOf(field))
   {
-    spherePoints({ 31.5, 31.5, 31.5 }, 12.0, static_cast<int>(this->count), this->points, this->normals);
+    spherePoints(
+      { 31.5, 31.5, 31.5 }, 12.0, static_cast<int>(this->count), this->points, this->normals);
   }
 };
 
@@ -116,7 +121,8 @@ void expectShortage(const vao::Status& s)
 {
   EXPECT_FALSE(s.ok);
   EXPECT_TRUE(s.outOfMemory) << s.message;
-  EXPECT_TRUE(s.message.find("not enough memory for ") == 0 || s.message == "out of memory") << s.message;
+  EXPECT_TRUE(s.message.find("not enough memory for ") == 0 || s.message == "out of memory")
+    << s.message;
 }
 }
 
@@ -151,20 +157,20 @@ TEST(OutOfMemory, ShadowsOnWholeLevelsReportIt)
   const BallScene scene;
   std::vector<float> shadow(scene.count, -1.0f), again(scene.count, -2.0f);
   const std::array<double, 3> light = { 0.0, 0.6, 0.8 };
-  const vao::Status first =
-    vao::surfaceShadow(scene.pyramid, scene.points.data(), scene.normals.data(), scene.count, light, {}, shadow.data());
+  const vao::Status first = vao::surfaceShadow(scene.pyramid, scene.points.data(),
+    scene.normals.data(), scene.count, light, {}, shadow.data());
   ASSERT_TRUE(first.ok) << first.message;
   if (vao::detail::cpuSimdTier() < vao::detail::SimdTier::Avx2)
     GTEST_SKIP() << "the scalar march makes no cell bounds: nothing of this size to refuse";
   {
     FailingAllocations failing(1 << 20);
-    expectShortage(
-      vao::surfaceShadow(scene.pyramid, scene.points.data(), scene.normals.data(), scene.count, light, {}, again.data()));
+    expectShortage(vao::surfaceShadow(scene.pyramid, scene.points.data(), scene.normals.data(),
+      scene.count, light, {}, again.data()));
   }
   // The same call succeeds afterwards, with the same values.
-  ASSERT_TRUE(
-    vao::surfaceShadow(scene.pyramid, scene.points.data(), scene.normals.data(), scene.count, light, {}, again.data())
-      .ok);
+  ASSERT_TRUE(vao::surfaceShadow(
+    scene.pyramid, scene.points.data(), scene.normals.data(), scene.count, light, {}, again.data())
+                .ok);
   EXPECT_EQ(shadow, again);
 }
 
@@ -174,16 +180,20 @@ TEST(OutOfMemory, SurfacePyramidQueriesReportIt)
   // every allocation of a page or more refuses the tiles' pool and the sweep's order.
   const BallScene scene;
   vao::SurfacePyramid tiled;
-  ASSERT_TRUE(vao::buildSurfacePyramid(scene.field.view(), scene.field.origin, scene.field.spacing, {}, tiled).ok);
+  ASSERT_TRUE(
+    vao::buildSurfacePyramid(scene.field.view(), scene.field.origin, scene.field.spacing, {}, tiled)
+      .ok);
   std::vector<float> out(scene.count, -1.0f);
   {
     FailingAllocations failing(4096);
-    expectShortage(vao::surfaceAmbientOcclusion(tiled, scene.field.view(), scene.field.origin, scene.field.spacing,
-      scene.points.data(), scene.normals.data(), scene.count, {}, out.data()));
-    expectShortage(
-      vao::surfaceShadow(tiled, scene.points.data(), scene.normals.data(), scene.count, { 0, 0, 1 }, {}, out.data()));
+    expectShortage(vao::surfaceAmbientOcclusion(tiled, scene.field.view(), scene.field.origin,
+      scene.field.spacing, scene.points.data(), scene.normals.data(), scene.count, {}, out.data()));
+    expectShortage(vao::surfaceShadow(
+      tiled, scene.points.data(), scene.normals.data(), scene.count, { 0, 0, 1 }, {}, out.data()));
   }
-  EXPECT_TRUE(vao::surfaceShadow(tiled, scene.points.data(), scene.normals.data(), scene.count, { 0, 0, 1 }, {}, out.data()).ok);
+  EXPECT_TRUE(vao::surfaceShadow(
+    tiled, scene.points.data(), scene.normals.data(), scene.count, { 0, 0, 1 }, {}, out.data())
+                .ok);
 }
 
 namespace
@@ -212,7 +222,8 @@ struct SmallVolumes
     for (std::int64_t i = 0; i < n; ++i)
     {
       const std::int64_t x = i % dims[0], y = i / dims[0] % dims[1], z = i / (dims[0] * dims[1]);
-      const double r = std::sqrt(double((x - 20) * (x - 20) + (y - 18) * (y - 18) + (z - 15) * (z - 15)));
+      const double r =
+        std::sqrt(double((x - 20) * (x - 20) + (y - 18) * (y - 18) + (z - 15) * (z - 15)));
       s = s * 1664525u + 1013904223u;
       ct[i] = static_cast<std::int16_t>((r < 11 ? 1200 : -900) + int(s >> 24) - 128);
       density[i] = r < 11 ? 1.0f : 0.0f;
@@ -234,8 +245,10 @@ TEST(OutOfMemory, EveryEntryPointReportsItOrSucceeds)
   std::vector<double> points, normals;
   spherePoints({ 20, 18, 15 }, 11.0, 500, points, normals);
   std::vector<EntryPoint> entries;
-  const auto openness = [&](vao::Method method, vao::QueryMode query) {
-    return [&, method, query](std::vector<float>& out) {
+  const auto openness = [&](vao::Method method, vao::QueryMode query)
+  {
+    return [&, method, query](std::vector<float>& out)
+    {
       vao::AmbientOcclusionParameters p;
       p.method = method;
       p.radius = { 3, 3, 3 };
@@ -248,46 +261,58 @@ TEST(OutOfMemory, EveryEntryPointReportsItOrSucceeds)
           return s;
       }
       std::fill(out.begin(), out.end(), -1.0f);
-      return vao::computeAmbientOcclusion(v.ctView(), vao::Region::whole(v.ctView()), p, { out.data(), out.data() + n });
+      return vao::computeAmbientOcclusion(
+        v.ctView(), vao::Region::whole(v.ctView()), p, { out.data(), out.data() + n });
     };
   };
-  for (const vao::Method m : { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev,
-         vao::Method::ExactBox, vao::Method::ExactSphere, vao::Method::HistogramCdf })
-    entries.push_back({ "computeAmbientOcclusion", std::size_t(2 * n), openness(m, vao::QueryMode::VoxelValue) });
+  for (const vao::Method m :
+    { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev,
+      vao::Method::ExactBox, vao::Method::ExactSphere, vao::Method::HistogramCdf })
+    entries.push_back(
+      { "computeAmbientOcclusion", std::size_t(2 * n), openness(m, vao::QueryMode::VoxelValue) });
   entries.push_back({ "computeAmbientOcclusion, smoothed query", std::size_t(2 * n),
     openness(vao::Method::GaussianCdf, vao::QueryMode::SmoothedValue) });
   std::vector<double> stats(5 * n);
-  entries.push_back({ "computeBoxStatistics", std::size_t(5 * n), [&](std::vector<float>& out) {
-                       std::fill(stats.begin(), stats.end(), -1.0);
-                       const vao::Status s = vao::computeBoxStatistics(v.ctView(), vao::Region::whole(v.ctView()),
-                         { 2, 3, 4 }, { stats.data(), stats.data() + n, stats.data() + 2 * n, stats.data() + 3 * n,
-                                        stats.data() + 4 * n });
-                       std::copy(stats.begin(), stats.end(), out.begin());
-                       return s;
-                     } });
-  entries.push_back({ "computeOcclusionSweeping", std::size_t(10 * n), [&](std::vector<float>& out) {
-                       std::fill(out.begin(), out.end(), -1.0f);
-                       vao::SweepParameters p;
-                       p.isoValue = 0.5;
-                       return vao::computeOcclusionSweeping(
-                         v.densityView(), spacing, p, { out.data(), out.data() + n, out.data() + 2 * n });
-                     } });
-  entries.push_back({ "BlockSweeper", std::size_t(10 * n), [&](std::vector<float>& out) {
-                       std::fill(out.begin(), out.end(), -1.0f);
-                       vao::SweepParameters p;
-                       p.isoValue = 0.5;
-                       vao::BlockPlacement whole;
-                       whole.whole = whole.size = v.dims;
-                       vao::BlockSweeper sweeper(v.densityView(), whole, spacing, p);
-                       vao::Status s = sweeper.initialise();
-                       if (s.ok)
-                         s = sweeper.runRound(1);
-                       if (s.ok)
-                         s = sweeper.finish({ out.data(), out.data() + n, out.data() + 2 * n });
-                       return s;
-                     } });
-  const auto surface = [&](bool tiled, bool shadow) {
-    return [&, tiled, shadow](std::vector<float>& out) {
+  entries.push_back({ "computeBoxStatistics", std::size_t(5 * n),
+    [&](std::vector<float>& out)
+    {
+      std::fill(stats.begin(), stats.end(), -1.0);
+      const vao::Status s =
+        vao::computeBoxStatistics(v.ctView(), vao::Region::whole(v.ctView()), { 2, 3, 4 },
+          { stats.data(), stats.data() + n, stats.data() + 2 * n, stats.data() + 3 * n,
+            stats.data() + 4 * n });
+      std::copy(stats.begin(), stats.end(), out.begin());
+      return s;
+    } });
+  entries.push_back({ "computeOcclusionSweeping", std::size_t(10 * n),
+    [&](std::vector<float>& out)
+    {
+      std::fill(out.begin(), out.end(), -1.0f);
+      vao::SweepParameters p;
+      p.isoValue = 0.5;
+      return vao::computeOcclusionSweeping(
+        v.densityView(), spacing, p, { out.data(), out.data() + n, out.data() + 2 * n });
+    } });
+  entries.push_back({ "BlockSweeper", std::size_t(10 * n),
+    [&](std::vector<float>& out)
+    {
+      std::fill(out.begin(), out.end(), -1.0f);
+      vao::SweepParameters p;
+      p.isoValue = 0.5;
+      vao::BlockPlacement whole;
+      whole.whole = whole.size = v.dims;
+      vao::BlockSweeper sweeper(v.densityView(), whole, spacing, p);
+      vao::Status s = sweeper.initialise();
+      if (s.ok)
+        s = sweeper.runRound(1);
+      if (s.ok)
+        s = sweeper.finish({ out.data(), out.data() + n, out.data() + 2 * n });
+      return s;
+    } });
+  const auto surface = [&](bool tiled, bool shadow)
+  {
+    return [&, tiled, shadow](std::vector<float>& out)
+    {
       std::fill(out.begin(), out.end(), -1.0f);
       const std::int64_t count = static_cast<std::int64_t>(out.size());
       if (tiled)
@@ -295,24 +320,30 @@ TEST(OutOfMemory, EveryEntryPointReportsItOrSucceeds)
         vao::SurfacePyramid pyramid;
         vao::Status s = vao::buildSurfacePyramid(v.ctView(), origin, spacing, {}, pyramid);
         if (s.ok)
-          s = shadow ? vao::surfaceShadow(pyramid, points.data(), normals.data(), count, { 0, 0, 1 }, {}, out.data())
-                     : vao::surfaceAmbientOcclusion(pyramid, v.ctView(), origin, spacing, points.data(),
-                         normals.data(), count, {}, out.data());
+          s = shadow ? vao::surfaceShadow(
+                         pyramid, points.data(), normals.data(), count, { 0, 0, 1 }, {}, out.data())
+                     : vao::surfaceAmbientOcclusion(pyramid, v.ctView(), origin, spacing,
+                         points.data(), normals.data(), count, {}, out.data());
         return s;
       }
       std::vector<vao::MomentLevel> pyramid;
       vao::Status s = vao::buildMomentPyramid(v.ctView(), origin, spacing, {}, pyramid);
       if (s.ok)
-        s = shadow ? vao::surfaceShadow(pyramid, points.data(), normals.data(), count, { 0, 0, 1 }, {}, out.data())
-                   : vao::surfaceAmbientOcclusion(
-                       pyramid, v.ctView(), origin, spacing, points.data(), normals.data(), count, {}, out.data());
+        s = shadow ? vao::surfaceShadow(
+                       pyramid, points.data(), normals.data(), count, { 0, 0, 1 }, {}, out.data())
+                   : vao::surfaceAmbientOcclusion(pyramid, v.ctView(), origin, spacing,
+                       points.data(), normals.data(), count, {}, out.data());
       return s;
     };
   };
-  entries.push_back({ "buildMomentPyramid + surfaceAmbientOcclusion", points.size() / 3, surface(false, false) });
-  entries.push_back({ "buildMomentPyramid + surfaceShadow", points.size() / 3, surface(false, true) });
-  entries.push_back({ "buildSurfacePyramid + surfaceAmbientOcclusion", points.size() / 3, surface(true, false) });
-  entries.push_back({ "buildSurfacePyramid + surfaceShadow", points.size() / 3, surface(true, true) });
+  entries.push_back(
+    { "buildMomentPyramid + surfaceAmbientOcclusion", points.size() / 3, surface(false, false) });
+  entries.push_back(
+    { "buildMomentPyramid + surfaceShadow", points.size() / 3, surface(false, true) });
+  entries.push_back(
+    { "buildSurfacePyramid + surfaceAmbientOcclusion", points.size() / 3, surface(true, false) });
+  entries.push_back(
+    { "buildSurfacePyramid + surfaceShadow", points.size() / 3, surface(true, true) });
 
   for (std::size_t e = 0; e < entries.size(); ++e)
   {
@@ -321,8 +352,8 @@ TEST(OutOfMemory, EveryEntryPointReportsItOrSucceeds)
     const vao::Status free = entries[e].run(expected);
     ASSERT_TRUE(free.ok) << free.message;
     std::size_t refused = 0;
-    for (const std::size_t from : { std::size_t(1), std::size_t(64), std::size_t(1024), std::size_t(16384),
-           std::size_t(262144), std::size_t(4 << 20) })
+    for (const std::size_t from : { std::size_t(1), std::size_t(64), std::size_t(1024),
+           std::size_t(16384), std::size_t(262144), std::size_t(4 << 20) })
     {
       SCOPED_TRACE("allocations of " + std::to_string(from) + " bytes and more refused");
       vao::Status s;

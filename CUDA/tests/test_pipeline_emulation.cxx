@@ -1,15 +1,15 @@
-// The GPU pipeline (src/cuda/box_statistics/Pipeline.h) run on the host: every kernel's per-thread code
-// in a loop, the transposes as plain loops. It checks the indexing, layouts, segments
-// and van Herk blocks of the CUDA backend against the CPU library on machines without a
-// GPU; test_cuda.cxx checks the real device where there is one.
+// The GPU pipeline (src/cuda/box_statistics/Pipeline.h) run on the host: every kernel's per-thread
+// code in a loop, the transposes as plain loops. It checks the indexing, layouts, segments and van
+// Herk blocks of the CUDA backend against the CPU library on machines without a GPU; test_cuda.cxx
+// checks the real device where there is one.
 #include "PipelineEmulation.h"
 
 #include "cpu/exact_reference/ExactReference.h"
-#include "cuda/exact_reference/ExactPipeline.h"
 #include "cpu/moment_pyramid/PyramidPlan.h"
+#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/exact_reference/ExactPipeline.h"
 #include "cuda/histogram_cdf/HistogramPipeline.h"
 #include "cuda/moment_pyramid/PyramidPipeline.h"
-#include "cuda/box_statistics/Pipeline.h"
 
 #include "vao/HistogramCdf.h"
 #include "vao/VarianceOcclusionMap.h"
@@ -48,7 +48,8 @@ TEST(GpuPipelineOnHost, StatisticsEqualTheCpuForEveryRadiusAndType)
       expectStatisticsLikeTheCpu(f32, dims, whole, { r, r, r }, how);
     }
     expectStatisticsLikeTheCpu(f64, dims, whole, { 2, 3, 1 }, how);
-    for (const vao::Radius& r : { vao::Radius{ 1, 4, 0 }, vao::Radius{ 7, 2, 3 }, vao::Radius{ 12, 0, 5 }, vao::Radius{ 30, 1, 40 } })
+    for (const vao::Radius& r : { vao::Radius{ 1, 4, 0 }, vao::Radius{ 7, 2, 3 },
+           vao::Radius{ 12, 0, 5 }, vao::Radius{ 30, 1, 40 } })
       expectStatisticsLikeTheCpu(i16, dims, whole, r, how);
   }
 }
@@ -57,15 +58,16 @@ TEST(GpuPipelineOnHost, SubRegionsEqualTheCpu)
 {
   const vao::Index3 dims = { 41, 17, 21 };
   const auto i16 = randomVolume<std::int16_t>(dims, -500, 500, 5);
-  for (const vao::Region& region : { vao::Region{ { 3, 2, 5 }, { 35, 7, 11 } }, vao::Region{ { 0, 16, 0 }, { 41, 1, 21 } },
-         vao::Region{ { 40, 0, 20 }, { 1, 17, 1 } }, vao::Region{ { 33, 8, 0 }, { 8, 9, 21 } } })
+  for (const vao::Region& region :
+    { vao::Region{ { 3, 2, 5 }, { 35, 7, 11 } }, vao::Region{ { 0, 16, 0 }, { 41, 1, 21 } },
+      vao::Region{ { 40, 0, 20 }, { 1, 17, 1 } }, vao::Region{ { 33, 8, 0 }, { 8, 9, 21 } } })
     for (const Emulation& how : kBothPipelines)
     {
       expectStatisticsLikeTheCpu(i16, dims, region, { 4, 2, 3 }, how);
       expectOpennessLikeTheCpu(i16, dims, region, { 4, 2, 3 }, vao::Method::CdfReconstruction,
         vao::QueryMode::VoxelValue, 0, how);
-      expectOpennessLikeTheCpu(i16, dims, region, { 4, 2, 3 }, vao::Method::GaussianCdf, vao::QueryMode::IsoValue, 40,
-        how);
+      expectOpennessLikeTheCpu(i16, dims, region, { 4, 2, 3 }, vao::Method::GaussianCdf,
+        vao::QueryMode::IsoValue, 40, how);
     }
   const vao::Index3 thin = { 1, 70, 2 };
   const auto u8 = randomVolume<std::uint8_t>(thin, 0, 255, 16);
@@ -80,11 +82,14 @@ TEST(GpuPipelineOnHost, EveryEstimatorEqualsTheCpu)
   const auto f32 = randomVolume<float>(dims, -1, 1, 7);
   const auto whole = vao::Region::whole(viewOf(i16, dims));
   for (const Emulation& how : kBothPipelines)
-    for (auto method : { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev })
+    for (auto method :
+      { vao::Method::CdfReconstruction, vao::Method::GaussianCdf, vao::Method::Chebyshev })
       for (int r : { 0, 1, 3, 6, 12 })
       {
-        expectOpennessLikeTheCpu(i16, dims, whole, { r, r, r }, method, vao::QueryMode::VoxelValue, 0, how);
-        expectOpennessLikeTheCpu(f32, dims, whole, { r, r, r }, method, vao::QueryMode::IsoValue, 0.2, how);
+        expectOpennessLikeTheCpu(
+          i16, dims, whole, { r, r, r }, method, vao::QueryMode::VoxelValue, 0, how);
+        expectOpennessLikeTheCpu(
+          f32, dims, whole, { r, r, r }, method, vao::QueryMode::IsoValue, 0.2, how);
       }
 }
 
@@ -95,8 +100,8 @@ namespace
 
 /// Histogram CDF through the GPU pipeline on the host against the CPU library.
 template <class T>
-void expectHistogramLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, const vao::Region& region,
-  const vao::Radius& radius, int bins, bool iso, double isoValue)
+void expectHistogramLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims,
+  const vao::Region& region, const vao::Radius& radius, int bins, bool iso, double isoValue)
 {
   const auto view = viewOf(v, dims);
   vao::AmbientOcclusionParameters p;
@@ -111,8 +116,8 @@ void expectHistogramLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims,
   const std::vector<T> block = blockOf(v, dims, region, g);
   std::vector<float> gpu(region.voxelCount(), -1.0f);
   HostExecutor ex;
-  vao::gpu::runHistogramPasses<T>(ex, block.data(), g, p.thresholds.data(), static_cast<int>(p.thresholds.size()),
-    iso, isoValue, gpu.data());
+  vao::gpu::runHistogramPasses<T>(ex, block.data(), g, p.thresholds.data(),
+    static_cast<int>(p.thresholds.size()), iso, isoValue, gpu.data());
   for (size_t i = 0; i < cpu.size(); ++i)
     ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " bins " << bins;
 }
@@ -120,8 +125,9 @@ void expectHistogramLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims,
 /// Exact Box or Exact Sphere through the device's passes equals the CPU reference voxel
 /// for voxel; `visitsPerLaunch` small splits the region into slabs of one or a few slices.
 template <class T>
-void expectExactLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, const vao::Region& region,
-  const vao::Radius& radius, vao::Method method, bool iso, double isoValue, double visitsPerLaunch)
+void expectExactLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims,
+  const vao::Region& region, const vao::Radius& radius, vao::Method method, bool iso,
+  double isoValue, double visitsPerLaunch)
 {
   const auto view = viewOf(v, dims);
   vao::AmbientOcclusionParameters p;
@@ -136,8 +142,8 @@ void expectExactLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, con
   std::vector<float> gpu(region.voxelCount(), -1.0f);
   HostExecutor ex;
   vao::gpu::runExactPasses<T>(ex, block.data(), g,
-    vao::detail::neighbourhoodRowHalfWidths(radius, method == vao::Method::ExactSphere), iso, isoValue, gpu.data(), 0.0,
-    1.0, visitsPerLaunch);
+    vao::detail::neighbourhoodRowHalfWidths(radius, method == vao::Method::ExactSphere), iso,
+    isoValue, gpu.data(), 0.0, 1.0, visitsPerLaunch);
   for (size_t i = 0; i < cpu.size(); ++i)
     ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " method " << static_cast<int>(method);
 }
@@ -146,7 +152,8 @@ void expectExactLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, con
 /// levels, dims and geometry, the moments equal but for the rounding of the CPU's fused
 /// multiply-adds (1e-5 is the device's bar; they agree far closer).
 template <class T>
-void expectPyramidLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, const vao::PyramidParameters& parameters)
+void expectPyramidLikeTheCpu(
+  const std::vector<T>& v, const vao::Index3& dims, const vao::PyramidParameters& parameters)
 {
   const std::array<double, 3> origin = { -3.0, 2.5, 7.0 }, spacing = { 0.8, 1.1, 2.0 };
   std::vector<vao::MomentLevel> cpu;
@@ -173,8 +180,10 @@ void expectPyramidLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims, c
     ASSERT_GT(varianceScale, 0.0);
     for (size_t i = 0; i < cpu[l].mean.size(); ++i)
     {
-      ASSERT_NEAR(gpu[l].mean[i], cpu[l].mean[i], 1e-6 * meanScale) << "level " << l << " voxel " << i;
-      ASSERT_NEAR(gpu[l].variance[i], cpu[l].variance[i], 1e-6 * varianceScale + cpu[l].roundingVariance)
+      ASSERT_NEAR(gpu[l].mean[i], cpu[l].mean[i], 1e-6 * meanScale)
+        << "level " << l << " voxel " << i;
+      ASSERT_NEAR(
+        gpu[l].variance[i], cpu[l].variance[i], 1e-6 * varianceScale + cpu[l].roundingVariance)
         << "level " << l << " voxel " << i;
     }
   }
@@ -228,7 +237,8 @@ TEST(GpuPipelineOnHost, HistogramCdfEqualsTheCpu)
   expectHistogramLikeTheCpu(u8, dims, whole, { 2, 3, 2 }, 256, false, 0.0);
   // A tile and halo beyond a block's shared memory: the separate passes.
   const auto g = vao::gpu::geometryFor(dims, whole, { 70, 70, 2 });
-  ASSERT_FALSE((vao::gpu::fusedPassFits<int, vao::gpu::Bin>(g, false, HostExecutor().sharedLimit())));
+  ASSERT_FALSE(
+    (vao::gpu::fusedPassFits<int, vao::gpu::Bin>(g, false, HostExecutor().sharedLimit())));
   expectHistogramLikeTheCpu(i16, dims, whole, { 70, 70, 2 }, 7, false, 0.0);
   expectHistogramLikeTheCpu(f32, dims, inner, { 70, 70, 2 }, 64, true, 0.1);
 }

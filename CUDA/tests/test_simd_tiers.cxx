@@ -7,8 +7,8 @@
 #include "PyramidTestSupport.h"
 #include "ResultComparison.h"
 
-#include "cpu/simd/CpuDispatch.h"
 #include "cpu/box_statistics/RunningTotals.h"
+#include "cpu/simd/CpuDispatch.h"
 
 #include "vao/HistogramCdf.h"
 
@@ -32,7 +32,8 @@ struct TierCap
 };
 
 template <class T>
-std::vector<vao::MomentLevel> pyramidAtTier(SimdTier tier, const std::vector<T>& v, const vao::Index3& d, bool half)
+std::vector<vao::MomentLevel> pyramidAtTier(
+  SimdTier tier, const std::vector<T>& v, const vao::Index3& d, bool half)
 {
   const TierCap cap(tier);
   vao::PyramidParameters p;
@@ -61,8 +62,10 @@ void expectPyramidTiersEqual(const vao::Index3& d, double lo, double hi)
     ASSERT_EQ(avx512.size(), avx2.size());
     for (std::size_t l = 0; l < avx2.size(); ++l)
     {
-      const auto bits = [](const vao::LevelArray& a) { return std::vector<float>(a.begin(), a.end()); };
-      EXPECT_TRUE(sameBits(bits(avx512[l].mean), bits(avx2[l].mean))) << "mean, level " << l << ", half " << half;
+      const auto bits = [](const vao::LevelArray& a)
+      { return std::vector<float>(a.begin(), a.end()); };
+      EXPECT_TRUE(sameBits(bits(avx512[l].mean), bits(avx2[l].mean)))
+        << "mean, level " << l << ", half " << half;
       EXPECT_TRUE(sameBits(bits(avx512[l].variance), bits(avx2[l].variance)))
         << "variance, level " << l << ", half " << half;
     }
@@ -70,7 +73,8 @@ void expectPyramidTiersEqual(const vao::Index3& d, double lo, double hi)
 }
 
 std::vector<float> opennessAtTier(SimdTier tier, const vao::VolumeView& view, vao::Method method,
-  const std::vector<double>& thresholds, vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0.0)
+  const std::vector<double>& thresholds, vao::QueryMode query = vao::QueryMode::VoxelValue,
+  double iso = 0.0)
 {
   const TierCap cap(tier);
   vao::AmbientOcclusionParameters p;
@@ -88,13 +92,15 @@ std::vector<float> opennessAtTier(SimdTier tier, const vao::VolumeView& view, va
 
 /// The box statistics (with the extrema: van Herk rows on vectors) at one tier.
 template <class T>
-std::vector<std::vector<double>> boxStatisticsAtTier(SimdTier tier, const std::vector<T>& v, const vao::Index3& d)
+std::vector<std::vector<double>> boxStatisticsAtTier(
+  SimdTier tier, const std::vector<T>& v, const vao::Index3& d)
 {
   const TierCap cap(tier);
   const vao::Region region{ { 1, 2, 0 }, { d[0] - 2, d[1] - 3, d[2] - 1 } };
-  std::vector<std::vector<double>> fields(5, std::vector<double>(static_cast<std::size_t>(region.voxelCount())));
-  const vao::BoxStatisticsOutput out{ fields[0].data(), fields[1].data(), fields[2].data(), fields[3].data(),
-    fields[4].data() };
+  std::vector<std::vector<double>> fields(
+    5, std::vector<double>(static_cast<std::size_t>(region.voxelCount())));
+  const vao::BoxStatisticsOutput out{ fields[0].data(), fields[1].data(), fields[2].data(),
+    fields[3].data(), fields[4].data() };
   const vao::Status s = vao::computeBoxStatistics(viewOf(v, d), region, { 4, 2, 3 }, out);
   EXPECT_TRUE(s.ok) << s.message;
   return fields;
@@ -166,14 +172,16 @@ struct ScanWithThresholds
 };
 
 /// The openness of `method` at every tier equals the baseline's, bit for bit.
-void expectOpennessTiersEqual(const vao::VolumeView& view, vao::Method method, const std::vector<double>& thresholds,
-  vao::QueryMode query = vao::QueryMode::VoxelValue, double iso = 0.0)
+void expectOpennessTiersEqual(const vao::VolumeView& view, vao::Method method,
+  const std::vector<double>& thresholds, vao::QueryMode query = vao::QueryMode::VoxelValue,
+  double iso = 0.0)
 {
   const auto baseline = opennessAtTier(SimdTier::Baseline, view, method, thresholds, query, iso);
   for (SimdTier tier : kTiers)
   {
     EXPECT_TRUE(sameBits(opennessAtTier(tier, view, method, thresholds, query, iso), baseline))
-      << "method " << int(method) << ", query " << int(query) << ", iso " << iso << ", tier " << int(tier);
+      << "method " << int(method) << ", query " << int(query) << ", iso " << iso << ", tier "
+      << int(tier);
   }
 }
 
@@ -194,9 +202,11 @@ TEST(SimdTiers, HistogramCdfOfEveryQueryCaseEqualsTheBaselineBitForBit)
   const ScanWithThresholds scan({ 23, 9, 8 }, -500.0, 900.0, 9u);
   const std::vector<double>& t = scan.thresholds;
   ASSERT_EQ(t.size(), 16u);
-  const double isoValues[] = { t.front() - 1.0, t[3], 0.5 * (t[5] + t[6]), t.back(), t.back() + 1.0 };
+  const double isoValues[] = { t.front() - 1.0, t[3], 0.5 * (t[5] + t[6]), t.back(),
+    t.back() + 1.0 };
   for (double iso : isoValues)
-    expectOpennessTiersEqual(scan.view, vao::Method::HistogramCdf, t, vao::QueryMode::IsoValue, iso);
+    expectOpennessTiersEqual(
+      scan.view, vao::Method::HistogramCdf, t, vao::QueryMode::IsoValue, iso);
   expectOpennessTiersEqual(scan.view, vao::Method::HistogramCdf, t, vao::QueryMode::SmoothedValue);
 }
 
@@ -214,7 +224,8 @@ TEST(SimdTiers, RunningTotalsEqualTheSumsOneByOne)
       std::int64_t totalA = 0, totalB = 0;
       for (std::int64_t i = 0; i < n; ++i)
       {
-        a[i] = static_cast<std::int64_t>(rng() % (std::uint64_t(1) << 41)) - (std::int64_t(1) << 40);
+        a[i] =
+          static_cast<std::int64_t>(rng() % (std::uint64_t(1) << 41)) - (std::int64_t(1) << 40);
         b[i] = static_cast<std::int64_t>(rng() % 1000);
         expectedA[i] = totalA += a[i];
         expectedB[i] = totalB += b[i];
@@ -239,9 +250,12 @@ TEST(SimdTiers, RunningTotalsEqualTheSumsOneByOne)
       ASSERT_EQ(a, expectedA) << "tier " << static_cast<int>(tier) << ", n " << n;
       ASSERT_EQ(b, expectedB) << "tier " << static_cast<int>(tier) << ", n " << n;
       ASSERT_EQ(single, expectedA) << "one row, tier " << static_cast<int>(tier) << ", n " << n;
-      ASSERT_EQ(narrow, expectedNarrow) << "32 bits, tier " << static_cast<int>(tier) << ", n " << n;
-      ASSERT_EQ(narrowB, expectedNarrowB) << "32 bits, second row, tier " << static_cast<int>(tier) << ", n " << n;
-      ASSERT_EQ(narrowSingle, expectedNarrow) << "32 bits, one row, tier " << static_cast<int>(tier) << ", n " << n;
+      ASSERT_EQ(narrow, expectedNarrow)
+        << "32 bits, tier " << static_cast<int>(tier) << ", n " << n;
+      ASSERT_EQ(narrowB, expectedNarrowB)
+        << "32 bits, second row, tier " << static_cast<int>(tier) << ", n " << n;
+      ASSERT_EQ(narrowSingle, expectedNarrow)
+        << "32 bits, one row, tier " << static_cast<int>(tier) << ", n " << n;
     }
   }
 }

@@ -23,13 +23,15 @@ using Vec3 = std::array<double, 3>;
 /// The trilinear value at world p of a grid of `dims` values get(i, j, k), p clamped to
 /// the grid: linear along x on the cell's four x edges, then along y, then along z.
 template <class Get>
-double nestedTrilinear(const vao::Index3& dims, const Vec3& origin, const Vec3& spacing, const Vec3& p, Get get)
+double nestedTrilinear(
+  const vao::Index3& dims, const Vec3& origin, const Vec3& spacing, const Vec3& p, Get get)
 {
   std::int64_t lower[3], upper[3];
   double t[3];
   for (int a = 0; a < 3; ++a)
   {
-    const double u = std::min(std::max((p[a] - origin[a]) / spacing[a], 0.0), static_cast<double>(dims[a] - 1));
+    const double u =
+      std::min(std::max((p[a] - origin[a]) / spacing[a], 0.0), static_cast<double>(dims[a] - 1));
     lower[a] = static_cast<std::int64_t>(std::floor(u));
     upper[a] = std::min<std::int64_t>(lower[a] + 1, dims[a] - 1);
     t[a] = u - std::floor(u);
@@ -58,7 +60,8 @@ void checkRawLanes(T low, T high, int components)
   std::uniform_real_distribution<double> fraction(0.0, 1.0);
   const double lowest = static_cast<double>(low), span = static_cast<double>(high) - lowest;
   for (T& v : values) // the far ends of the type, and values between
-    v = fraction(rng) < 0.2 ? (fraction(rng) < 0.5 ? low : high) : static_cast<T>(lowest + fraction(rng) * span);
+    v = fraction(rng) < 0.2 ? (fraction(rng) < 0.5 ? low : high)
+                            : static_cast<T>(lowest + fraction(rng) * span);
   vao::VolumeView view;
   view.data = values.data();
   view.dims = dims;
@@ -73,10 +76,11 @@ void checkRawLanes(T low, T high, int components)
     for (int k = 0; k < W; ++k)
     {
       x[k] = k == 0 ? origin[0] + (dims[0] - 1) * spacing[0] : where(rng); // on the last x face
-      y[k] = k == 1 ? std::nan("") : where(rng);                            // NaN: the first voxel
+      y[k] = k == 1 ? std::nan("") : where(rng);                           // NaN: the first voxel
       z[k] = k == 2 ? origin[2] : where(rng);
     }
-    for (const vao::detail::SimdTier tier : { vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
+    for (const vao::detail::SimdTier tier :
+      { vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
     {
       vao::detail::limitSimdTier(tier);
       vao::detail::rawLanes(sampler, x, y, z, vector);
@@ -84,14 +88,17 @@ void checkRawLanes(T low, T high, int components)
       for (int k = 0; k < W; ++k)
       {
         const double scalar = sampler({ x[k], y[k], z[k] });
-        EXPECT_EQ(vector[k], scalar) << "lane " << k << ", tier " << static_cast<int>(tier) << ", " << sizeof(T)
-                                     << " bytes";
+        EXPECT_EQ(vector[k], scalar)
+          << "lane " << k << ", tier " << static_cast<int>(tier) << ", " << sizeof(T) << " bytes";
         const Vec3 p{ x[k], std::isnan(y[k]) ? origin[1] : y[k], z[k] };
-        const auto value = [&](std::int64_t i, std::int64_t j, std::int64_t l) {
-          return static_cast<double>(values[static_cast<std::size_t>(components * ((l * dims[1] + j) * dims[0] + i))]);
+        const auto value = [&](std::int64_t i, std::int64_t j, std::int64_t l)
+        {
+          return static_cast<double>(
+            values[static_cast<std::size_t>(components * ((l * dims[1] + j) * dims[0] + i))]);
         };
         const double reference = nestedTrilinear(dims, origin, spacing, p, value);
-        EXPECT_NEAR(vector[k], reference, 1e-12 * std::max(1.0, static_cast<double>(high))) << "lane " << k;
+        EXPECT_NEAR(vector[k], reference, 1e-12 * std::max(1.0, static_cast<double>(high)))
+          << "lane " << k;
       }
     }
   }
@@ -107,8 +114,8 @@ TEST(SurfaceLanes, RawQueryLanesEqualTheScalarSamplerForEveryType)
     checkRawLanes<std::uint8_t>(0, 255, components);
     checkRawLanes<std::int16_t>(-32768, 32767, components);
     checkRawLanes<std::uint16_t>(0, 65535, components);
-    checkRawLanes<std::int32_t>(
-      std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max(), components);
+    checkRawLanes<std::int32_t>(std::numeric_limits<std::int32_t>::min(),
+      std::numeric_limits<std::int32_t>::max(), components);
     checkRawLanes<std::uint32_t>(0, std::numeric_limits<std::uint32_t>::max(), components);
     checkRawLanes<std::int64_t>(-(std::int64_t(1) << 62), std::int64_t(1) << 62, components);
     checkRawLanes<std::uint64_t>(0, std::uint64_t(1) << 63, components);
@@ -143,18 +150,23 @@ TEST(SurfaceLanes, MeanLanesEqualTheTrilinearSample)
         y[k] = where(rng);
         z[k] = where(rng);
       }
-      for (const vao::detail::SimdTier tier : { vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
+      for (const vao::detail::SimdTier tier :
+        { vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
       {
         vao::detail::limitSimdTier(tier);
         vao::detail::meanLanes(grid, x, y, z, vector);
         vao::detail::limitSimdTier(vao::detail::SimdTier::Avx512);
         for (int k = 0; k < W; ++k)
         {
-          const auto mean = [&](std::int64_t i, std::int64_t j, std::int64_t l) {
-            return static_cast<double>(level.mean[static_cast<std::size_t>((l * dims[1] + j) * dims[0] + i)]);
+          const auto mean = [&](std::int64_t i, std::int64_t j, std::int64_t l)
+          {
+            return static_cast<double>(
+              level.mean[static_cast<std::size_t>((l * dims[1] + j) * dims[0] + i)]);
           };
-          const double reference = nestedTrilinear(dims, level.origin, level.spacing, { x[k], y[k], z[k] }, mean);
-          EXPECT_NEAR(vector[k], reference, 1e-12) << "lane " << k << ", tier " << static_cast<int>(tier);
+          const double reference =
+            nestedTrilinear(dims, level.origin, level.spacing, { x[k], y[k], z[k] }, mean);
+          EXPECT_NEAR(vector[k], reference, 1e-12)
+            << "lane " << k << ", tier " << static_cast<int>(tier);
         }
       }
     }
@@ -168,7 +180,8 @@ TEST(SurfaceLanes, RayBoundsHoldEveryCellBoundAheadOnTheRay)
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> value(-50.0, 50.0), unit(0.0, 1.0), direction(-1.0, 1.0);
   int checked = 0;
-  for (const vao::Index3 dims : { vao::Index3{ 9, 7, 5 }, vao::Index3{ 1, 6, 4 }, vao::Index3{ 8, 1, 1 } })
+  for (const vao::Index3 dims :
+    { vao::Index3{ 9, 7, 5 }, vao::Index3{ 1, 6, 4 }, vao::Index3{ 8, 1, 1 } })
   {
     vao::MomentLevel level;
     level.dims = dims;
@@ -188,10 +201,12 @@ TEST(SurfaceLanes, RayBoundsHoldEveryCellBoundAheadOnTheRay)
     {
       Vec3 light = { direction(rng), direction(rng), direction(rng) };
       if (trial < 6) // along an axis, either way
-        light = { trial / 2 == 0 ? 1.0 : 0.0, trial / 2 == 1 ? 1.0 : 0.0, trial / 2 == 2 ? 1.0 : 0.0 };
+        light = { trial / 2 == 0 ? 1.0 : 0.0, trial / 2 == 1 ? 1.0 : 0.0,
+          trial / 2 == 2 ? 1.0 : 0.0 };
       if (trial < 6 && trial % 2)
         light = { -light[0], -light[1], -light[2] };
-      const double length = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
+      const double length =
+        std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
       for (double& c : light)
         c /= length;
       const double step = trial % 3 == 0 ? 0.3 : trial % 3 == 1 ? 1.7 : 4.5;
@@ -204,11 +219,13 @@ TEST(SurfaceLanes, RayBoundsHoldEveryCellBoundAheadOnTheRay)
           from[a] = level.origin[a] + (unit(rng) * 1.4 - 0.2) * dims[a] * level.spacing[a];
         // The cell of a world position: its lower corner, clamped (the last x voxel is the
         // upper corner of the cell below it where a row has two or more).
-        const auto cellOf = [&](const Vec3& p) {
+        const auto cellOf = [&](const Vec3& p)
+        {
           std::int64_t c[3];
           for (int a = 0; a < 3; ++a)
           {
-            const double u = std::clamp((p[a] - level.origin[a]) / level.spacing[a], 0.0, dims[a] - 1.0);
+            const double u =
+              std::clamp((p[a] - level.origin[a]) / level.spacing[a], 0.0, dims[a] - 1.0);
             c[a] = static_cast<std::int64_t>(std::floor(u));
           }
           if (dims[0] >= 2)
@@ -219,10 +236,13 @@ TEST(SurfaceLanes, RayBoundsHoldEveryCellBoundAheadOnTheRay)
         double t = 0.0;
         for (int k = 0; k < 30; ++k, t += step)
         {
-          const Vec3 at = { from[0] + t * light[0], from[1] + t * light[1], from[2] + t * light[2] };
+          const Vec3 at = { from[0] + t * light[0], from[1] + t * light[1],
+            from[2] + t * light[2] };
           const std::int64_t c = cellOf(at);
-          EXPECT_LE(grid.cellBounds[2 * c], rays.data()[2 * first]) << "trial " << trial << ", step " << k;
-          EXPECT_LE(grid.cellBounds[2 * c + 1], rays.data()[2 * first + 1]) << "trial " << trial << ", step " << k;
+          EXPECT_LE(grid.cellBounds[2 * c], rays.data()[2 * first])
+            << "trial " << trial << ", step " << k;
+          EXPECT_LE(grid.cellBounds[2 * c + 1], rays.data()[2 * first + 1])
+            << "trial " << trial << ", step " << k;
           ++checked;
         }
       }

@@ -3,8 +3,8 @@
 // voxels), on every SIMD tier, for every query, and it must build only part of level 0.
 #include "PyramidTestSupport.h"
 
-#include "cpu/simd/CpuDispatch.h"
 #include "cpu/moment_pyramid/LevelTiles.h"
+#include "cpu/simd/CpuDispatch.h"
 
 #include <random>
 
@@ -17,11 +17,16 @@ using namespace vaotest;
 Field shellScene(const vao::Index3& d)
 {
   const Vec3 c = { 0.47 * d[0], 0.52 * d[1], 0.5 * d[2] };
-  Field f = makeField(d, [&](double x, double y, double z) {
-    const double sphere = std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) - 5.5;
-    const double m = std::max(std::fabs(x - c[0]), std::max(std::fabs(y - c[1]), std::fabs(z - c[2])));
-    return std::min(sphere, std::max(11.0 - m, m - 14.0));
-  });
+  Field f = makeField(d,
+    [&](double x, double y, double z)
+    {
+      const double sphere =
+        std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) -
+        5.5;
+      const double m =
+        std::max(std::fabs(x - c[0]), std::max(std::fabs(y - c[1]), std::fabs(z - c[2])));
+      return std::min(sphere, std::max(11.0 - m, m - 14.0));
+    });
   f.origin = { -3.25, 1.5, 0.75 };
   f.spacing = { 0.8, 1.1, 0.95 };
   return f;
@@ -31,8 +36,8 @@ Field shellScene(const vao::Index3& d)
 /// volume, with normals of every direction and length.
 void scenePoints(const Field& f, std::vector<double>& points, std::vector<double>& normals)
 {
-  const Vec3 c = { f.origin[0] + 0.47 * f.dims[0] * f.spacing[0], f.origin[1] + 0.52 * f.dims[1] * f.spacing[1],
-    f.origin[2] + 0.5 * f.dims[2] * f.spacing[2] };
+  const Vec3 c = { f.origin[0] + 0.47 * f.dims[0] * f.spacing[0],
+    f.origin[1] + 0.52 * f.dims[1] * f.spacing[1], f.origin[2] + 0.5 * f.dims[2] * f.spacing[2] };
   spherePoints(c, 5.5, 301, points, normals);
   std::mt19937 random(7);
   std::uniform_real_distribution<double> unit(-0.05, 1.05), direction(-1.0, 1.0);
@@ -81,8 +86,8 @@ TEST(SurfacePyramid, TilesHoldTheWholeLevelsVoxels)
       for (std::int64_t z = 0; z < level.dims[2]; ++z)
         for (std::int64_t y = 0; y < level.dims[1]; ++y)
           for (std::int64_t x = 0; x < level.dims[0]; ++x)
-            built.markAround(level.origin[0] + x * level.spacing[0], level.origin[1] + y * level.spacing[1],
-              level.origin[2] + z * level.spacing[2]);
+            built.markAround(level.origin[0] + x * level.spacing[0],
+              level.origin[1] + y * level.spacing[1], level.origin[2] + z * level.spacing[2]);
     }
     ASSERT_TRUE(tiles.buildMarked({}));
     for (int l = 0; l < 2; ++l)
@@ -90,11 +95,13 @@ TEST(SurfacePyramid, TilesHoldTheWholeLevelsVoxels)
       const vao::MomentLevel& level = whole[l];
       EXPECT_EQ(surface.builtTiles(l), surface.tileCount(l));
       const vao::detail::LevelGrid grid = tiles.at(l)->grid();
-      const std::int64_t tx = (level.dims[0] + 7) / 8, ty = (level.dims[1] + 7) / 8, tz = (level.dims[2] + 7) / 8;
+      const std::int64_t tx = (level.dims[0] + 7) / 8, ty = (level.dims[1] + 7) / 8,
+                         tz = (level.dims[2] + 7) / 8;
       std::int64_t checked = 0;
       for (std::int64_t tile = 0; tile < tx * ty * tz; ++tile)
       {
-        const std::int64_t first[3] = { 8 * (tile % tx), 8 * ((tile / tx) % ty), 8 * (tile / (tx * ty)) };
+        const std::int64_t first[3] = { 8 * (tile % tx), 8 * ((tile / tx) % ty),
+          8 * (tile / (tx * ty)) };
         for (std::int64_t k = 0; k < 9 && first[2] + k < level.dims[2]; ++k)
           for (std::int64_t j = 0; j < 9 && first[1] + j < level.dims[1]; ++j)
             for (std::int64_t i = 0; i < 9 && first[0] + i < level.dims[0]; ++i)
@@ -102,13 +109,15 @@ TEST(SurfacePyramid, TilesHoldTheWholeLevelsVoxels)
               const std::int64_t at = grid.tileOffsets[tile] + 2 * ((k * 9 + j) * 9 + i);
               const std::int64_t x = first[0] + i, y = first[1] + j, z = first[2] + k;
               const std::int64_t v = (z * level.dims[1] + y) * level.dims[0] + x;
-              ASSERT_EQ(grid.mean[at], level.mean[v]) << "level " << l << " half " << half << " voxel " << x << " " << y << " " << z;
+              ASSERT_EQ(grid.mean[at], level.mean[v])
+                << "level " << l << " half " << half << " voxel " << x << " " << y << " " << z;
               ASSERT_EQ(grid.mean[at + 1], level.variance[v])
                 << "level " << l << " half " << half << " voxel " << x << " " << y << " " << z;
               ++checked;
             }
       }
-      EXPECT_GT(checked, level.dims[0] * level.dims[1] * level.dims[2]); // the shared ninth voxels too
+      EXPECT_GT(
+        checked, level.dims[0] * level.dims[1] * level.dims[2]); // the shared ninth voxels too
     }
     for (int l = 2; l < 4; ++l)
     {
@@ -131,7 +140,8 @@ TEST(SurfacePyramid, QueriesEqualTheWholePyramidBitForBitOnEveryTier)
   std::vector<double> points, normals;
   scenePoints(f, points, normals);
   const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
-  const std::vector<std::array<double, 3>> lights = { { 0.2, -0.5, 1 }, { -1, 0, 0 }, { 0, 0, -1 }, { 0.7, 0.7, -0.1 } };
+  const std::vector<std::array<double, 3>> lights = { { 0.2, -0.5, 1 }, { -1, 0, 0 }, { 0, 0, -1 },
+    { 0.7, 0.7, -0.1 } };
   for (vao::detail::SimdTier tier :
     { vao::detail::SimdTier::Baseline, vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
   {
@@ -144,43 +154,57 @@ TEST(SurfacePyramid, QueriesEqualTheWholePyramidBitForBitOnEveryTier)
         pp.startAtHalfResolution = half;
         std::vector<vao::MomentLevel> whole;
         ASSERT_TRUE(vao::buildMomentPyramid(f.view(), f.origin, f.spacing, pp, whole).ok);
-        forEachSurfaceQuery([&](vao::SurfaceOcclusionParameters p) {
+        forEachSurfaceQuery(
+          [&](vao::SurfaceOcclusionParameters p)
+          {
             p.offsetFactor = levels == 2 ? 1.7 : 1.0;
             std::vector<float> expected(n, -1.0f), got(n, -2.0f);
-            ASSERT_TRUE(vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing, points.data(),
-              normals.data(), n, p, expected.data()).ok);
+            ASSERT_TRUE(vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing,
+              points.data(), normals.data(), n, p, expected.data())
+                          .ok);
             vao::SurfacePyramid surface = surfacePyramidOf(f, pp);
-            const vao::Status s = vao::surfaceAmbientOcclusion(surface, f.view(), f.origin, f.spacing, points.data(),
-              normals.data(), n, p, got.data());
+            const vao::Status s = vao::surfaceAmbientOcclusion(surface, f.view(), f.origin,
+              f.spacing, points.data(), normals.data(), n, p, got.data());
             ASSERT_TRUE(s.ok) << s.message;
             for (std::int64_t i = 0; i < n; ++i)
-              ASSERT_EQ(got[i], expected[i]) << "AO, tier " << int(tier) << " levels " << levels << " half " << half
-                                             << " point " << i;
+              ASSERT_EQ(got[i], expected[i]) << "AO, tier " << int(tier) << " levels " << levels
+                                             << " half " << half << " point " << i;
             for (const auto& light : lights)
             {
-              ASSERT_TRUE(
-                vao::surfaceShadow(whole, points.data(), normals.data(), n, light, p, expected.data()).ok);
+              ASSERT_TRUE(vao::surfaceShadow(
+                whole, points.data(), normals.data(), n, light, p, expected.data())
+                            .ok);
               vao::SurfacePyramid fresh = surfacePyramidOf(f, pp);
-              ASSERT_TRUE(vao::surfaceShadow(fresh, points.data(), normals.data(), n, light, p, got.data()).ok);
+              ASSERT_TRUE(
+                vao::surfaceShadow(fresh, points.data(), normals.data(), n, light, p, got.data())
+                  .ok);
               for (std::int64_t i = 0; i < n; ++i)
-                ASSERT_EQ(got[i], expected[i]) << "shadow, tier " << int(tier) << " levels " << levels << " half "
-                                               << half << " light " << light[0] << " " << light[1] << " " << light[2]
-                                               << " point " << i;
+                ASSERT_EQ(got[i], expected[i])
+                  << "shadow, tier " << int(tier) << " levels " << levels << " half " << half
+                  << " light " << light[0] << " " << light[1] << " " << light[2] << " point " << i;
             }
             // A query of fewer levels than the pyramid has: its march stays longer on the
             // tiled levels (on level 0 alone to the volume's border with one level).
             for (int used = 1; used < levels; ++used)
             {
               p.levels = used;
-              ASSERT_TRUE(vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing, points.data(),
-                normals.data(), n, p, expected.data()).ok);
+              ASSERT_TRUE(vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing,
+                points.data(), normals.data(), n, p, expected.data())
+                            .ok);
               vao::SurfacePyramid fresh = surfacePyramidOf(f, pp);
-              ASSERT_TRUE(vao::surfaceAmbientOcclusion(fresh, f.view(), f.origin, f.spacing, points.data(),
-                normals.data(), n, p, got.data()).ok);
-              ASSERT_EQ(got, expected) << "AO of " << used << " levels, tier " << int(tier) << " pyramid " << levels;
-              ASSERT_TRUE(vao::surfaceShadow(whole, points.data(), normals.data(), n, lights[0], p, expected.data()).ok);
-              ASSERT_TRUE(vao::surfaceShadow(fresh, points.data(), normals.data(), n, lights[0], p, got.data()).ok);
-              ASSERT_EQ(got, expected) << "shadow of " << used << " levels, tier " << int(tier) << " pyramid " << levels;
+              ASSERT_TRUE(vao::surfaceAmbientOcclusion(fresh, f.view(), f.origin, f.spacing,
+                points.data(), normals.data(), n, p, got.data())
+                            .ok);
+              ASSERT_EQ(got, expected)
+                << "AO of " << used << " levels, tier " << int(tier) << " pyramid " << levels;
+              ASSERT_TRUE(vao::surfaceShadow(
+                whole, points.data(), normals.data(), n, lights[0], p, expected.data())
+                            .ok);
+              ASSERT_TRUE(vao::surfaceShadow(
+                fresh, points.data(), normals.data(), n, lights[0], p, got.data())
+                            .ok);
+              ASSERT_EQ(got, expected)
+                << "shadow of " << used << " levels, tier " << int(tier) << " pyramid " << levels;
             }
           });
       }
@@ -194,9 +218,13 @@ TEST(SurfacePyramid, BuildsOnlyTheTilesASurfaceReachesAndKeepsThem)
   // second query of the same kind builds nothing more, another light only what it adds.
   const vao::Index3 d = { 96, 96, 96 };
   const Vec3 c = { 48.3, 47.6, 48.1 };
-  const Field f = makeField(d, [&](double x, double y, double z) {
-    return std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) - 9.0;
-  });
+  const Field f = makeField(d,
+    [&](double x, double y, double z)
+    {
+      return std::sqrt(
+               (x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) -
+        9.0;
+    });
   std::vector<double> points, normals;
   spherePoints(c, 9.0, 2000, points, normals);
   const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
@@ -207,16 +235,20 @@ TEST(SurfacePyramid, BuildsOnlyTheTilesASurfaceReachesAndKeepsThem)
   EXPECT_EQ(surface.tileCount(2), 0); // whole
   EXPECT_EQ(surface.builtTiles(0) + surface.builtTiles(1), 0);
   std::vector<float> out(n);
-  ASSERT_TRUE(vao::surfaceAmbientOcclusion(surface, f.view(), f.origin, f.spacing, points.data(), normals.data(), n,
-    {}, out.data()).ok);
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(
+    surface, f.view(), f.origin, f.spacing, points.data(), normals.data(), n, {}, out.data())
+                .ok);
   const std::int64_t afterAo = surface.builtTiles(0);
   EXPECT_GT(afterAo, 0);
   EXPECT_GT(surface.builtTiles(1), 0);
-  EXPECT_LE(afterAo, 4 * 4 * 4); // the AO samples lie on a sphere of radius 11 voxels: 4 tiles a side
-  ASSERT_TRUE(vao::surfaceAmbientOcclusion(surface, f.view(), f.origin, f.spacing, points.data(), normals.data(), n,
-    {}, out.data()).ok);
+  EXPECT_LE(
+    afterAo, 4 * 4 * 4); // the AO samples lie on a sphere of radius 11 voxels: 4 tiles a side
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(
+    surface, f.view(), f.origin, f.spacing, points.data(), normals.data(), n, {}, out.data())
+                .ok);
   EXPECT_EQ(surface.builtTiles(0), afterAo);
-  ASSERT_TRUE(vao::surfaceShadow(surface, points.data(), normals.data(), n, { 0, 0, 1 }, {}, out.data()).ok);
+  ASSERT_TRUE(
+    vao::surfaceShadow(surface, points.data(), normals.data(), n, { 0, 0, 1 }, {}, out.data()).ok);
   const std::int64_t afterShadow = surface.builtTiles(0);
   EXPECT_GE(afterShadow, afterAo);
   EXPECT_LT(afterShadow, surface.tileCount(0) / 10);
@@ -234,12 +266,14 @@ TEST(SurfacePyramid, SweepsInSlabsHoldingLittleMoreThanItKeeps)
   const Field f = shellScene({ 30, 28, 90 });
   std::vector<double> points, normals;
   scenePoints(f, points, normals);
-  const Vec3 c = { f.origin[0] + 15 * f.spacing[0], f.origin[1] + 14 * f.spacing[1], f.origin[2] + 45 * f.spacing[2] };
+  const Vec3 c = { f.origin[0] + 15 * f.spacing[0], f.origin[1] + 14 * f.spacing[1],
+    f.origin[2] + 45 * f.spacing[2] };
   // A tall cylinder of points through the scene.
   for (int i = 0; i < 4000; ++i)
   {
     const double angle = 0.37 * i, height = (i % 400) / 400.0 * 86 * f.spacing[2];
-    points.insert(points.end(), { c[0] + 6 * std::cos(angle), c[1] + 6 * std::sin(angle), f.origin[2] + height });
+    points.insert(points.end(),
+      { c[0] + 6 * std::cos(angle), c[1] + 6 * std::sin(angle), f.origin[2] + height });
     normals.insert(normals.end(), { std::cos(angle), std::sin(angle), 0.1 });
   }
   const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
@@ -248,20 +282,26 @@ TEST(SurfacePyramid, SweepsInSlabsHoldingLittleMoreThanItKeeps)
   ASSERT_TRUE(vao::buildMomentPyramid(f.view(), f.origin, f.spacing, pp, whole).ok);
   std::vector<float> expectedAo(n), expectedShadow(n), ao(n, -1.0f), shadow(n, -1.0f);
   const std::array<double, 3> light = { 0.3, -0.2, 1.0 };
-  ASSERT_TRUE(vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing, points.data(), normals.data(), n,
-    {}, expectedAo.data()).ok);
-  ASSERT_TRUE(vao::surfaceShadow(whole, points.data(), normals.data(), n, light, {}, expectedShadow.data()).ok);
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(
+    whole, f.view(), f.origin, f.spacing, points.data(), normals.data(), n, {}, expectedAo.data())
+                .ok);
+  ASSERT_TRUE(
+    vao::surfaceShadow(whole, points.data(), normals.data(), n, light, {}, expectedShadow.data())
+      .ok);
   auto held = [](const vao::SurfacePyramid& s) { return s.builtTiles(0) + s.builtTiles(1); };
-  auto made = [](vao::SurfacePyramid& s) {
+  auto made = [](vao::SurfacePyramid& s)
+  {
     const auto& tiles = *vao::SurfacePyramidAccess::tiles(s);
     return tiles.at(0)->madeTiles() + tiles.at(1)->madeTiles();
   };
 
   vao::SurfacePyramid unlimited = surfacePyramidOf(f, pp);
   unlimited.setKeptTileBytes(static_cast<std::size_t>(-1));
-  ASSERT_TRUE(vao::surfaceAmbientOcclusion(unlimited, f.view(), f.origin, f.spacing, points.data(), normals.data(),
-    n, {}, ao.data()).ok);
-  ASSERT_TRUE(vao::surfaceShadow(unlimited, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(
+    unlimited, f.view(), f.origin, f.spacing, points.data(), normals.data(), n, {}, ao.data())
+                .ok);
+  ASSERT_TRUE(
+    vao::surfaceShadow(unlimited, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
   const std::int64_t reached = held(unlimited);
   EXPECT_EQ(made(unlimited), reached);
   ASSERT_EQ(unlimited.tileCount(0), 4 * 4 * 12);
@@ -276,9 +316,12 @@ TEST(SurfacePyramid, SweepsInSlabsHoldingLittleMoreThanItKeeps)
   watched.progress = [&](double) { peak = std::max(peak, held(streamed)); };
   std::fill(ao.begin(), ao.end(), -1.0f);
   std::fill(shadow.begin(), shadow.end(), -1.0f);
-  ASSERT_TRUE(vao::surfaceAmbientOcclusion(streamed, f.view(), f.origin, f.spacing, points.data(), normals.data(),
-    n, {}, ao.data(), watched).ok);
-  ASSERT_TRUE(vao::surfaceShadow(streamed, points.data(), normals.data(), n, light, {}, shadow.data(), watched).ok);
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(streamed, f.view(), f.origin, f.spacing, points.data(),
+    normals.data(), n, {}, ao.data(), watched)
+                .ok);
+  ASSERT_TRUE(vao::surfaceShadow(
+    streamed, points.data(), normals.data(), n, light, {}, shadow.data(), watched)
+                .ok);
   EXPECT_EQ(ao, expectedAo);
   EXPECT_EQ(shadow, expectedShadow);
   EXPECT_GT(peak, 0);
@@ -286,14 +329,17 @@ TEST(SurfacePyramid, SweepsInSlabsHoldingLittleMoreThanItKeeps)
   EXPECT_LT(held(streamed), reached / 2);
 
   vao::SurfacePyramid half = surfacePyramidOf(f, pp);
-  const std::size_t kept = static_cast<std::size_t>(reached / 2) * vao::detail::PyramidTiles::kTileBytes;
+  const std::size_t kept =
+    static_cast<std::size_t>(reached / 2) * vao::detail::PyramidTiles::kTileBytes;
   half.setKeptTileBytes(kept);
   EXPECT_EQ(half.keptTileBytes(), kept);
-  ASSERT_TRUE(vao::surfaceShadow(half, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
+  ASSERT_TRUE(
+    vao::surfaceShadow(half, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
   EXPECT_EQ(shadow, expectedShadow);
   EXPECT_LE(static_cast<std::size_t>(held(half)) * vao::detail::PyramidTiles::kTileBytes, kept);
   const std::int64_t first = made(half);
-  ASSERT_TRUE(vao::surfaceShadow(half, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
+  ASSERT_TRUE(
+    vao::surfaceShadow(half, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
   EXPECT_EQ(shadow, expectedShadow);
   EXPECT_LT(made(half) - first, first * 3 / 4) << "the second query finds the tiles the first kept";
 }
@@ -316,9 +362,12 @@ TEST(SurfacePyramid, AQueryAfterAnAbortedOneLosesNothing)
   const std::int64_t sphere = n - 150; // scenePoints: the sphere's, then 150 anywhere
   std::vector<float> expectedAo(n), expectedShadow(n), got(n);
   const std::array<double, 3> light = { 0.3, -0.2, 1.0 };
-  ASSERT_TRUE(vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing, points.data(), normals.data(), n,
-    {}, expectedAo.data()).ok);
-  ASSERT_TRUE(vao::surfaceShadow(whole, points.data(), normals.data(), n, light, {}, expectedShadow.data()).ok);
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(
+    whole, f.view(), f.origin, f.spacing, points.data(), normals.data(), n, {}, expectedAo.data())
+                .ok);
+  ASSERT_TRUE(
+    vao::surfaceShadow(whole, points.data(), normals.data(), n, light, {}, expectedShadow.data())
+      .ok);
   for (std::size_t kept : { static_cast<std::size_t>(-1), std::size_t(0) })
   {
     int aborted = 0;
@@ -330,8 +379,9 @@ TEST(SurfacePyramid, AQueryAfterAnAbortedOneLosesNothing)
       vao::Execution abort;
       abort.threads = 2;
       abort.abortRequested = [&] { return ++calls > checks; };
-      if (vao::surfaceAmbientOcclusion(surface, f.view(), f.origin, f.spacing, points.data(), normals.data(), n, {},
-            got.data(), abort).ok)
+      if (vao::surfaceAmbientOcclusion(surface, f.view(), f.origin, f.spacing, points.data(),
+            normals.data(), n, {}, got.data(), abort)
+            .ok)
         break;
       ++aborted;
       for (bool shadow : { false, true })
@@ -339,15 +389,19 @@ TEST(SurfacePyramid, AQueryAfterAnAbortedOneLosesNothing)
         vao::SurfacePyramid again = surfacePyramidOf(f, pp);
         again.setKeptTileBytes(kept);
         calls = 0;
-        ASSERT_FALSE(vao::surfaceAmbientOcclusion(again, f.view(), f.origin, f.spacing, points.data(),
-          normals.data(), n, {}, got.data(), abort).ok);
+        ASSERT_FALSE(vao::surfaceAmbientOcclusion(again, f.view(), f.origin, f.spacing,
+          points.data(), normals.data(), n, {}, got.data(), abort)
+                       .ok);
         std::fill(got.begin(), got.end(), -1.0f);
         const std::int64_t m = shadow ? sphere : n;
-        ASSERT_TRUE(shadow ? vao::surfaceShadow(again, points.data(), normals.data(), m, light, {}, got.data()).ok
-                           : vao::surfaceAmbientOcclusion(again, f.view(), f.origin, f.spacing, points.data(),
-                               normals.data(), m, {}, got.data()).ok);
+        ASSERT_TRUE(shadow
+            ? vao::surfaceShadow(again, points.data(), normals.data(), m, light, {}, got.data()).ok
+            : vao::surfaceAmbientOcclusion(again, f.view(), f.origin, f.spacing, points.data(),
+                normals.data(), m, {}, got.data())
+                .ok);
         const std::vector<float>& expected = shadow ? expectedShadow : expectedAo;
-        ASSERT_TRUE(std::equal(got.begin(), got.begin() + m, expected.begin())) << "after an abort at check " << checks;
+        ASSERT_TRUE(std::equal(got.begin(), got.begin() + m, expected.begin()))
+          << "after an abort at check " << checks;
         const std::int64_t held = again.builtTiles(0) + again.builtTiles(1);
         if (kept == 0)
           ASSERT_EQ(held, 0) << "after an abort at check " << checks << ", shadow " << shadow;
@@ -366,7 +420,8 @@ TEST(SurfacePyramid, BadInputFailsWithMessage)
   const double p[3] = { 1, 1, 1 }, nrm[3] = { 0, 0, 1 };
   float out = 0;
   const Field f = shellScene({ 12, 12, 12 });
-  vao::Status s = vao::surfaceAmbientOcclusion(empty, f.view(), f.origin, f.spacing, p, nrm, 1, {}, &out);
+  vao::Status s =
+    vao::surfaceAmbientOcclusion(empty, f.view(), f.origin, f.spacing, p, nrm, 1, {}, &out);
   EXPECT_FALSE(s.ok);
   EXPECT_NE(s.message.find("empty"), std::string::npos) << s.message;
   s = vao::surfaceShadow(empty, p, nrm, 1, { 0, 0, 1 }, {}, &out);

@@ -24,7 +24,8 @@ using Vec3 = std::array<double, 3>;
 /// Trilinear value of a grid of `dims` values at world p (clamped): the sum over the 8
 /// corners of the product of the per-axis weights.
 template <class Get>
-double refTrilinear(const vao::Index3& dims, const Vec3& origin, const Vec3& spacing, const Vec3& p, Get get)
+double refTrilinear(
+  const vao::Index3& dims, const Vec3& origin, const Vec3& spacing, const Vec3& p, Get get)
 {
   std::int64_t lo[3], hi[3];
   double w[3];
@@ -55,13 +56,17 @@ double refTrilinear(const vao::Index3& dims, const Vec3& origin, const Vec3& spa
 /// Occluder fraction of q for a level sample: Cantelli's bound or the Gaussian tail.
 double refOcclusion(const vao::MomentLevel& level, const Vec3& p, double q, vao::Method estimator)
 {
-  auto at = [&](const vao::LevelArray& a) {
-    return [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-      return static_cast<double>(a[static_cast<std::size_t>((z * level.dims[1] + y) * level.dims[0] + x)]);
+  auto at = [&](const vao::LevelArray& a)
+  {
+    return [&](std::int64_t x, std::int64_t y, std::int64_t z)
+    {
+      return static_cast<double>(
+        a[static_cast<std::size_t>((z * level.dims[1] + y) * level.dims[0] + x)]);
     };
   };
   const double mu = refTrilinear(level.dims, level.origin, level.spacing, p, at(level.mean));
-  const double s2 = std::max(0.0, refTrilinear(level.dims, level.origin, level.spacing, p, at(level.variance)));
+  const double s2 =
+    std::max(0.0, refTrilinear(level.dims, level.origin, level.spacing, p, at(level.variance)));
   if (estimator == vao::Method::GaussianCdf)
     return 1.0 - 0.5 * std::erfc(-(q - mu) / std::sqrt(2.0 * s2));
   return q <= mu ? 1.0 : s2 / (s2 + (q - mu) * (q - mu));
@@ -133,15 +138,19 @@ double refAo(const Scene& s, int i, const vao::SurfaceOcclusionParameters& p)
   const double q = p.query == vao::SurfaceQuery::IsoValue
     ? p.isoValue
     : refTrilinear(s.dims, s.origin, s.spacing, along(x, n, -h / 2),
-        [&](std::int64_t a, std::int64_t b, std::int64_t c) {
-          return static_cast<double>(s.values[static_cast<std::size_t>((c * s.dims[1] + b) * s.dims[0] + a)]);
+        [&](std::int64_t a, std::int64_t b, std::int64_t c)
+        {
+          return static_cast<double>(
+            s.values[static_cast<std::size_t>((c * s.dims[1] + b) * s.dims[0] + a)]);
         });
   const int levels = static_cast<int>(s.pyramid.size());
   double combined = 0.0;
   for (int l = 0; l < levels; ++l)
   {
-    const double o = refOcclusion(s.pyramid[l], along(x, n, p.offsetFactor * s.pyramid[l].kernelRadius), q, p.estimator);
-    combined = p.combination == vao::LevelCombination::Mean ? combined + o / levels : std::max(combined, o);
+    const double o = refOcclusion(
+      s.pyramid[l], along(x, n, p.offsetFactor * s.pyramid[l].kernelRadius), q, p.estimator);
+    combined =
+      p.combination == vao::LevelCombination::Mean ? combined + o / levels : std::max(combined, o);
   }
   return 1.0 - std::clamp(combined, 0.0, 1.0);
 }
@@ -155,9 +164,12 @@ double refShadow(const Scene& s, int i, const Vec3& light, const vao::SurfaceOcc
   if (p.query == vao::SurfaceQuery::HalfVoxelInside) // level 0's mean half a voxel inside
   {
     const Vec3 inside = along(x, n, -h / 2);
-    q = refTrilinear(base.dims, base.origin, base.spacing, inside, [&](std::int64_t a, std::int64_t b, std::int64_t c) {
-      return static_cast<double>(base.mean[static_cast<std::size_t>((c * base.dims[1] + b) * base.dims[0] + a)]);
-    });
+    q = refTrilinear(base.dims, base.origin, base.spacing, inside,
+      [&](std::int64_t a, std::int64_t b, std::int64_t c)
+      {
+        return static_cast<double>(
+          base.mean[static_cast<std::size_t>((c * base.dims[1] + b) * base.dims[0] + a)]);
+      });
   }
   const double length = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
   const Vec3 l = { light[0] / length, light[1] / length, light[2] / length };
@@ -176,12 +188,14 @@ double refShadow(const Scene& s, int i, const Vec3& light, const vao::SurfaceOcc
     {
       // The volume's box, faces included to two float32 ulps (surface points are floats).
       const double lo = base.origin[a], hi = base.origin[a] + (base.dims[a] - 1) * base.spacing[a];
-      const double slack = 2.0 * std::numeric_limits<float>::epsilon() * std::max(std::abs(lo), std::abs(hi));
+      const double slack =
+        2.0 * std::numeric_limits<float>::epsilon() * std::max(std::abs(lo), std::abs(hi));
       inside = inside && at[a] >= lo - slack && at[a] <= hi + slack;
     }
     if (!inside)
       break;
-    const int level = std::clamp(static_cast<int>(std::floor(std::log2(1.0 + u))), 0, levels - 1); // u = t / r0
+    const int level =
+      std::clamp(static_cast<int>(std::floor(std::log2(1.0 + u))), 0, levels - 1); // u = t / r0
     occlusion = std::max(occlusion, refOcclusion(s.pyramid[level], at, q, p.estimator));
     if (occlusion >= 0.999)
       break;
@@ -201,11 +215,14 @@ TEST(SurfaceReference, AmbientOcclusionAndShadowsMatchTheDefinition)
     // The same queries on a SurfacePyramid (levels 0 and 1 in tiles, kept from query to
     // query) against the same definition.
     vao::SurfacePyramid tiled;
-    ASSERT_TRUE(
-      vao::buildSurfacePyramid(s.view(), s.origin, s.spacing, { static_cast<int>(s.pyramid.size()), false }, tiled).ok);
+    ASSERT_TRUE(vao::buildSurfacePyramid(
+      s.view(), s.origin, s.spacing, { static_cast<int>(s.pyramid.size()), false }, tiled)
+                  .ok);
     for (vao::Method estimator : { vao::Method::Chebyshev, vao::Method::GaussianCdf })
-      for (vao::SurfaceQuery query : { vao::SurfaceQuery::HalfVoxelInside, vao::SurfaceQuery::IsoValue })
-        for (vao::LevelCombination combination : { vao::LevelCombination::MaximumOcclusion, vao::LevelCombination::Mean })
+      for (vao::SurfaceQuery query :
+        { vao::SurfaceQuery::HalfVoxelInside, vao::SurfaceQuery::IsoValue })
+        for (vao::LevelCombination combination :
+          { vao::LevelCombination::MaximumOcclusion, vao::LevelCombination::Mean })
         {
           vao::SurfaceOcclusionParameters p;
           p.estimator = estimator;
@@ -214,20 +231,29 @@ TEST(SurfaceReference, AmbientOcclusionAndShadowsMatchTheDefinition)
           p.combination = combination;
           p.offsetFactor = 0.8;
           std::vector<float> ao(count, -1.0f), shadow(count, -1.0f);
-          ASSERT_TRUE(vao::surfaceAmbientOcclusion(s.pyramid, s.view(), s.origin, s.spacing, s.points.data(),
-            s.normals.data(), count, p, ao.data()).ok);
+          ASSERT_TRUE(vao::surfaceAmbientOcclusion(s.pyramid, s.view(), s.origin, s.spacing,
+            s.points.data(), s.normals.data(), count, p, ao.data())
+                        .ok);
           const Vec3 light = { 0.3, -1.0, 0.7 };
-          ASSERT_TRUE(vao::surfaceShadow(s.pyramid, s.points.data(), s.normals.data(), count, light, p, shadow.data()).ok);
+          ASSERT_TRUE(vao::surfaceShadow(
+            s.pyramid, s.points.data(), s.normals.data(), count, light, p, shadow.data())
+                        .ok);
           std::vector<float> tiledAo(count, -1.0f), tiledShadow(count, -1.0f);
-          ASSERT_TRUE(vao::surfaceAmbientOcclusion(tiled, s.view(), s.origin, s.spacing, s.points.data(),
-            s.normals.data(), count, p, tiledAo.data()).ok);
-          ASSERT_TRUE(vao::surfaceShadow(tiled, s.points.data(), s.normals.data(), count, light, p, tiledShadow.data()).ok);
+          ASSERT_TRUE(vao::surfaceAmbientOcclusion(tiled, s.view(), s.origin, s.spacing,
+            s.points.data(), s.normals.data(), count, p, tiledAo.data())
+                        .ok);
+          ASSERT_TRUE(vao::surfaceShadow(
+            tiled, s.points.data(), s.normals.data(), count, light, p, tiledShadow.data())
+                        .ok);
           for (int i = 0; i < count; ++i)
           {
             EXPECT_NEAR(ao[i], refAo(s, i, p), 2e-5) << "AO, point " << i << " of " << count;
-            EXPECT_NEAR(shadow[i], refShadow(s, i, light, p), 2e-5) << "shadow, point " << i << " of " << count;
-            EXPECT_NEAR(tiledAo[i], refAo(s, i, p), 2e-5) << "tiled AO, point " << i << " of " << count;
-            EXPECT_NEAR(tiledShadow[i], refShadow(s, i, light, p), 2e-5) << "tiled shadow, point " << i << " of " << count;
+            EXPECT_NEAR(shadow[i], refShadow(s, i, light, p), 2e-5)
+              << "shadow, point " << i << " of " << count;
+            EXPECT_NEAR(tiledAo[i], refAo(s, i, p), 2e-5)
+              << "tiled AO, point " << i << " of " << count;
+            EXPECT_NEAR(tiledShadow[i], refShadow(s, i, light, p), 2e-5)
+              << "tiled shadow, point " << i << " of " << count;
             ++compared;
           }
         }
@@ -239,7 +265,8 @@ TEST(SurfaceLanes, VectorPathEqualsThePlainLoop)
 {
   // Positions inside, on the faces and outside (clamped), on levels with a one-voxel axis
   // (x: the cells have no x pair, the vector path gathers corner by corner).
-  for (const vao::Index3 dims : { vao::Index3{ 9, 7, 5 }, vao::Index3{ 6, 1, 4 }, vao::Index3{ 1, 5, 3 } })
+  for (const vao::Index3 dims :
+    { vao::Index3{ 9, 7, 5 }, vao::Index3{ 6, 1, 4 }, vao::Index3{ 1, 5, 3 } })
   {
     vao::MomentLevel level;
     level.dims = dims;
@@ -254,32 +281,37 @@ TEST(SurfaceLanes, VectorPathEqualsThePlainLoop)
     for (std::size_t i = 0; i < n; ++i)
     {
       level.mean[i] = static_cast<float>(value(rng));
-      level.variance[i] = i % 5 == 0 ? 0.0f : static_cast<float>(std::fabs(value(rng))); // some flat corners
+      level.variance[i] =
+        i % 5 == 0 ? 0.0f : static_cast<float>(std::fabs(value(rng))); // some flat corners
     }
     const vao::detail::LevelGrid grid(level);
     std::uniform_real_distribution<double> where(-4.0, 16.0);
     int lanesCompared = 0;
     for (int batch = 0; batch < 200; ++batch)
     {
-      double x[vao::detail::kLanes], y[vao::detail::kLanes], z[vao::detail::kLanes], q[vao::detail::kLanes];
+      double x[vao::detail::kLanes], y[vao::detail::kLanes], z[vao::detail::kLanes],
+        q[vao::detail::kLanes];
       for (int k = 0; k < vao::detail::kLanes; ++k)
       {
         x[k] = where(rng);
         y[k] = where(rng);
-        z[k] = k == 3 ? level.origin[2] + (dims[2] - 1) * level.spacing[2] : where(rng); // on the last face
+        z[k] = k == 3 ? level.origin[2] + (dims[2] - 1) * level.spacing[2]
+                      : where(rng); // on the last face
         q[k] = value(rng);
       }
       double plain[vao::detail::kLanes], vector[vao::detail::kLanes];
       vao::detail::occlusionLanesPlain(grid, vao::Method::Chebyshev, x, y, z, q, plain);
       // Each vector tier (where the processor has it; above, the widest it has).
-      for (const vao::detail::SimdTier tier : { vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
+      for (const vao::detail::SimdTier tier :
+        { vao::detail::SimdTier::Avx2, vao::detail::SimdTier::Avx512 })
       {
         vao::detail::limitSimdTier(tier);
         vao::detail::occlusionLanes(grid, vao::Method::Chebyshev, x, y, z, q, vector);
         vao::detail::limitSimdTier(vao::detail::SimdTier::Avx512);
         for (int k = 0; k < vao::detail::kLanes; ++k)
         {
-          EXPECT_NEAR(vector[k], plain[k], 1e-12) << "lane " << k << ", tier " << static_cast<int>(tier);
+          EXPECT_NEAR(vector[k], plain[k], 1e-12)
+            << "lane " << k << ", tier " << static_cast<int>(tier);
           ++lanesCompared;
         }
       }
@@ -290,7 +322,8 @@ TEST(SurfaceLanes, VectorPathEqualsThePlainLoop)
 
 TEST(SurfaceLanes, CellBoundsHoldTheLargestCornerValues)
 {
-  for (const vao::Index3 dims : { vao::Index3{ 7, 6, 5 }, vao::Index3{ 1, 4, 3 }, vao::Index3{ 5, 1, 1 } })
+  for (const vao::Index3 dims :
+    { vao::Index3{ 7, 6, 5 }, vao::Index3{ 1, 4, 3 }, vao::Index3{ 5, 1, 1 } })
   {
     vao::MomentLevel level;
     level.dims = dims;
@@ -306,7 +339,8 @@ TEST(SurfaceLanes, CellBoundsHoldTheLargestCornerValues)
     }
     vao::detail::LevelGrid grid(level);
     const vao::detail::CellBounds bounds(level, grid);
-    auto index = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return (z * dims[1] + y) * dims[0] + x; };
+    auto index = [&](std::int64_t x, std::int64_t y, std::int64_t z)
+    { return (z * dims[1] + y) * dims[0] + x; };
     for (std::int64_t z = 0; z < dims[2]; ++z)
       for (std::int64_t y = 0; y < dims[1]; ++y)
         for (std::int64_t x = 0; x < dims[0]; ++x)
@@ -315,7 +349,8 @@ TEST(SurfaceLanes, CellBoundsHoldTheLargestCornerValues)
           for (std::int64_t c = 0; c < 8; ++c) // the cell's corners, clamped to the level
           {
             const std::int64_t i = index(std::min<std::int64_t>(x + (c & 1), dims[0] - 1),
-              std::min<std::int64_t>(y + ((c >> 1) & 1), dims[1] - 1), std::min<std::int64_t>(z + (c >> 2), dims[2] - 1));
+              std::min<std::int64_t>(y + ((c >> 1) & 1), dims[1] - 1),
+              std::min<std::int64_t>(z + (c >> 2), dims[2] - 1));
             mean = std::max(mean, level.mean[i]);
             variance = std::max(variance, level.variance[i]);
           }
@@ -366,20 +401,25 @@ TEST(SurfaceLanes, MarchPassingOverBoundedCellsEqualsTheFullMarch)
       q[k] = query(rng);
     }
     Vec3 light = { direction(rng), direction(rng), direction(rng) };
-    const double length = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
+    const double length =
+      std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
     for (double& c : light)
       c /= length;
     const double* start[3] = { x, y, z };
     const int levels = 1 + batch % 4;
-    const std::vector<vao::detail::MarchStep> schedule = vao::detail::marchSchedule(radius.data(), levels, 1e9);
+    const std::vector<vao::detail::MarchStep> schedule =
+      vao::detail::marchSchedule(radius.data(), levels, 1e9);
     using vao::detail::SimdTier;
-    vao::detail::chebyshevMarch(SimdTier::Avx2, bare.data(), schedule, lo, hi, start, light.data(), q, full);
-    vao::detail::chebyshevMarch(SimdTier::Avx2, bounded.data(), schedule, lo, hi, start, light.data(), q, passed);
-    // Lanes stopped where nothing ahead can raise them: the same maxima.
-    const vao::detail::RayBounds rays(bounded[levels - 1], vao::detail::kMarchStepFraction * radius[levels - 1], light);
-    double stopped[W];
     vao::detail::chebyshevMarch(
-      SimdTier::Avx2, bounded.data(), schedule, lo, hi, start, light.data(), q, stopped, rays.data(), levels - 1);
+      SimdTier::Avx2, bare.data(), schedule, lo, hi, start, light.data(), q, full);
+    vao::detail::chebyshevMarch(
+      SimdTier::Avx2, bounded.data(), schedule, lo, hi, start, light.data(), q, passed);
+    // Lanes stopped where nothing ahead can raise them: the same maxima.
+    const vao::detail::RayBounds rays(
+      bounded[levels - 1], vao::detail::kMarchStepFraction * radius[levels - 1], light);
+    double stopped[W];
+    vao::detail::chebyshevMarch(SimdTier::Avx2, bounded.data(), schedule, lo, hi, start,
+      light.data(), q, stopped, rays.data(), levels - 1);
     for (int k = 0; k < W; ++k)
     {
       EXPECT_NEAR(passed[k], full[k], 1e-12) << "batch " << batch << ", lane " << k;
@@ -391,8 +431,8 @@ TEST(SurfaceLanes, MarchPassingOverBoundedCellsEqualsTheFullMarch)
     if (vao::detail::cpuSimdTier() == SimdTier::Avx512)
     {
       double wide[W];
-      vao::detail::chebyshevMarch(SimdTier::Avx512, bounded.data(), schedule, lo, hi, start, light.data(), q, wide,
-        rays.data(), levels - 1);
+      vao::detail::chebyshevMarch(SimdTier::Avx512, bounded.data(), schedule, lo, hi, start,
+        light.data(), q, wide, rays.data(), levels - 1);
       for (int k = 0; k < W; ++k)
         EXPECT_EQ(wide[k], passed[k]) << "AVX-512, batch " << batch << ", lane " << k;
       ++wideBatches;

@@ -13,17 +13,19 @@ TEST(SurfaceAO, SphereInAirIsOpenAndDarkerInsideABox)
   const vao::Index3 d = { 48, 48, 48 };
   const Vec3 c = { 23.5, 23.5, 23.5 };
   const double r = 6.0;
-  auto sphere = [&](double x, double y, double z) {
-    return std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) - r;
+  auto sphere = [&](double x, double y, double z)
+  {
+    return std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) -
+      r;
   };
   auto box = [&](double x, double y, double z) { // hollow shell, inner half-width 13, 3 thick
-    const double m = std::max(std::fabs(x - c[0]), std::max(std::fabs(y - c[1]), std::fabs(z - c[2])));
+    const double m =
+      std::max(std::fabs(x - c[0]), std::max(std::fabs(y - c[1]), std::fabs(z - c[2])));
     return std::max(13.0 - m, m - 16.0);
   };
   const Field air = makeField(d, sphere);
-  const Field boxed = makeField(d, [&](double x, double y, double z) {
-    return std::min(sphere(x, y, z), box(x, y, z));
-  });
+  const Field boxed = makeField(
+    d, [&](double x, double y, double z) { return std::min(sphere(x, y, z), box(x, y, z)); });
   std::vector<double> points, normals;
   spherePoints(c, r, 200, points, normals);
   const auto open = ao(air, pyramidOf(air), points, normals);
@@ -58,7 +60,8 @@ TEST(SurfaceAO, DecreasesTowardsAWall)
 {
   const vao::Index3 d = { 64, 24, 40 };
   // Floor z < 10, wall x < 8.
-  const Field f = makeField(d, [](double x, double, double z) { return std::min(z - 10.0, x - 8.0); });
+  const Field f =
+    makeField(d, [](double x, double, double z) { return std::min(z - 10.0, x - 8.0); });
   const auto pyramid = pyramidOf(f);
   std::vector<double> points, normals;
   const double xs[] = { 50, 40, 32, 26, 21, 17, 14, 12, 10.5 };
@@ -134,7 +137,9 @@ TEST(SurfaceAO, FlatRegionsOfLargeMagnitudeDataAreOpen)
         const double points[6] = { 33.0, 32.0, 31.0, 36.5, 30.0, 35.0 };
         const double normals[6] = { 0, 0, 1, 1, 0, 0 };
         float out[2] = { -1, -1 };
-        ASSERT_TRUE(vao::surfaceAmbientOcclusion(pyramid, view, { 0, 0, 0 }, { 1, 1, 1 }, points, normals, 2, p, out).ok);
+        ASSERT_TRUE(vao::surfaceAmbientOcclusion(
+          pyramid, view, { 0, 0, 0 }, { 1, 1, 1 }, points, normals, 2, p, out)
+                      .ok);
         EXPECT_EQ(out[0], 1.0f) << "magnitude " << magnitude << (type ? " float64" : " float32");
         EXPECT_EQ(out[1], 1.0f) << "magnitude " << magnitude << (type ? " float64" : " float32");
       }
@@ -147,9 +152,10 @@ TEST(SurfaceAO, BadInputFailsWithMessage)
   const auto pyramid = pyramidOf(f, 2);
   float out = 0;
   auto expectFail = [&](const std::vector<vao::MomentLevel>& pyr, const double* point,
-                      const double* normal, const vao::SurfaceOcclusionParameters& p) {
-    const vao::Status s = vao::surfaceAmbientOcclusion(
-      pyr, f.view(), f.origin, f.spacing, point, normal, 1, p, &out);
+                      const double* normal, const vao::SurfaceOcclusionParameters& p)
+  {
+    const vao::Status s =
+      vao::surfaceAmbientOcclusion(pyr, f.view(), f.origin, f.spacing, point, normal, 1, p, &out);
     EXPECT_FALSE(s.ok);
     EXPECT_FALSE(s.message.empty());
   };
@@ -172,8 +178,9 @@ TEST(SurfaceAO, BadInputFailsWithMessage)
   p.levels = 0;
   expectFail(pyramid, point, up, p);
   // And the valid call succeeds.
-  EXPECT_TRUE(vao::surfaceAmbientOcclusion(
-    pyramid, f.view(), f.origin, f.spacing, point, up, 1, ok, &out).ok);
+  EXPECT_TRUE(
+    vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing, point, up, 1, ok, &out)
+      .ok);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -183,7 +190,8 @@ TEST(Shadow, SlabDarkensTheFarSideAndSwapsWithTheLight)
 {
   const vao::Index3 d = { 32, 32, 48 };
   // Opaque slab 20 <= z <= 26.
-  const Field f = makeField(d, [](double, double, double z) { return std::max(20.0 - z, z - 26.0); });
+  const Field f =
+    makeField(d, [](double, double, double z) { return std::max(20.0 - z, z - 26.0); });
   const auto pyramid = pyramidOf(f);
   // Below the slab (z = 8) and above it (z = 38): small spheres' worth of upward facing points.
   std::vector<double> below, above, normals;
@@ -198,7 +206,8 @@ TEST(Shadow, SlabDarkensTheFarSideAndSwapsWithTheLight)
   p.query = vao::SurfaceQuery::IsoValue;
   p.isoValue = 0.5;
   const std::int64_t n = static_cast<std::int64_t>(below.size() / 3);
-  auto shadow = [&](const std::vector<double>& points, const Vec3& light) {
+  auto shadow = [&](const std::vector<double>& points, const Vec3& light)
+  {
     std::vector<float> out(n, -1.0f);
     const vao::Status s =
       vao::surfaceShadow(pyramid, points.data(), normals.data(), n, light, p, out.data());
@@ -253,30 +262,43 @@ TEST(SurfacePoints, FloatPointsGiveTheBitsOfTheirDoubles)
   // bit for bit, AO and shadows, with both queries and the estimators of both levels' paths.
   const vao::Index3 d = { 40, 36, 44 };
   const Vec3 c = { 19.3, 17.6, 21.1 };
-  const Field f = makeField(d, [&](double x, double y, double z) {
-    const double sphere = std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) - 5.5;
-    const double m = std::max(std::fabs(x - c[0]), std::max(std::fabs(y - c[1]), std::fabs(z - c[2])));
-    return std::min(sphere, std::max(11.0 - m, m - 14.0));
-  });
+  const Field f = makeField(d,
+    [&](double x, double y, double z)
+    {
+      const double sphere =
+        std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) -
+        5.5;
+      const double m =
+        std::max(std::fabs(x - c[0]), std::max(std::fabs(y - c[1]), std::fabs(z - c[2])));
+      return std::min(sphere, std::max(11.0 - m, m - 14.0));
+    });
   const auto pyramid = pyramidOf(f);
   std::vector<double> points, normals;
   spherePoints(c, 5.5, 333, points, normals); // 333: the last batch of lanes is partial
   for (std::size_t i = 0; i < normals.size(); ++i)
     normals[i] *= 0.5 + (i % 5); // not unit
-  std::vector<float> pointsF(points.begin(), points.end()), normalsF(normals.begin(), normals.end());
+  std::vector<float> pointsF(points.begin(), points.end()),
+    normalsF(normals.begin(), normals.end());
   const std::vector<double> widenedPoints(pointsF.begin(), pointsF.end());
   const std::vector<double> widenedNormals(normalsF.begin(), normalsF.end());
   const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
-  forEachSurfaceQuery([&](const vao::SurfaceOcclusionParameters& p) {
-      std::vector<float> fromFloat(n, -1.0f), fromDouble(n, -2.0f), shadowFloat(n, -1.0f), shadowDouble(n, -2.0f);
-      ASSERT_TRUE(vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing, pointsF.data(),
-        normalsF.data(), n, p, fromFloat.data()).ok);
-      ASSERT_TRUE(vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing, widenedPoints.data(),
-        widenedNormals.data(), n, p, fromDouble.data()).ok);
-      ASSERT_TRUE(vao::surfaceShadow(pyramid, pointsF.data(), normalsF.data(), n, { 0.2, -0.5, 1 }, p,
-        shadowFloat.data()).ok);
-      ASSERT_TRUE(vao::surfaceShadow(pyramid, widenedPoints.data(), widenedNormals.data(), n, { 0.2, -0.5, 1 }, p,
-        shadowDouble.data()).ok);
+  forEachSurfaceQuery(
+    [&](const vao::SurfaceOcclusionParameters& p)
+    {
+      std::vector<float> fromFloat(n, -1.0f), fromDouble(n, -2.0f), shadowFloat(n, -1.0f),
+        shadowDouble(n, -2.0f);
+      ASSERT_TRUE(vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing,
+        pointsF.data(), normalsF.data(), n, p, fromFloat.data())
+                    .ok);
+      ASSERT_TRUE(vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing,
+        widenedPoints.data(), widenedNormals.data(), n, p, fromDouble.data())
+                    .ok);
+      ASSERT_TRUE(vao::surfaceShadow(
+        pyramid, pointsF.data(), normalsF.data(), n, { 0.2, -0.5, 1 }, p, shadowFloat.data())
+                    .ok);
+      ASSERT_TRUE(vao::surfaceShadow(pyramid, widenedPoints.data(), widenedNormals.data(), n,
+        { 0.2, -0.5, 1 }, p, shadowDouble.data())
+                    .ok);
       for (std::int64_t i = 0; i < n; ++i)
       {
         ASSERT_EQ(fromFloat[i], fromDouble[i]) << "AO, point " << i;
@@ -284,14 +306,17 @@ TEST(SurfacePoints, FloatPointsGiveTheBitsOfTheirDoubles)
       }
       EXPECT_GT(average(fromFloat), 0.05); // open and shadowed points both
       EXPECT_LT(average(fromFloat), 0.95);
-      const auto range = std::minmax_element(shadowFloat.begin(), shadowFloat.end()); // inside the shell
+      const auto range =
+        std::minmax_element(shadowFloat.begin(), shadowFloat.end()); // inside the shell
       EXPECT_GT(*range.second - *range.first, 0.05f);
     });
   // Bad float input is named as with doubles.
-  const float bad[3] = { 8, std::numeric_limits<float>::quiet_NaN(), 8 }, up[3] = { 0, 0, 1 }, zero[3] = { 0, 0, 0 };
+  const float bad[3] = { 8, std::numeric_limits<float>::quiet_NaN(), 8 }, up[3] = { 0, 0, 1 },
+              zero[3] = { 0, 0, 0 };
   const float tiny[3] = { 0, 0, 1e-30f }; // its square is 0 in float, not in double
   float out = 0;
-  vao::Status s = vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing, bad, up, 1, {}, &out);
+  vao::Status s =
+    vao::surfaceAmbientOcclusion(pyramid, f.view(), f.origin, f.spacing, bad, up, 1, {}, &out);
   EXPECT_FALSE(s.ok);
   EXPECT_NE(s.message.find("point 0"), std::string::npos) << s.message;
   s = vao::surfaceShadow(pyramid, up, zero, 1, { 0, 0, 1 }, {}, &out);

@@ -236,9 +236,10 @@ TEST(SweepOcclusion, ThreadCountDoesNotChangeAnyBitWithoutKeptOctants)
   // more threads than cores make that overlap likely; the result must stay bit for bit.
   const Sdf a = sphere(4.1, 3.2, 12.3, 3.1), b = sphere(3.7, 2.9, 31.6, 2.4),
             c = box(4.2, 3.1, 48.2, 2.5, 9.0, 4.1);
-  const Scene scene = makeScene({ 9, 7, 61 }, { 1, 1, 1 }, [=](double x, double y, double z) {
-    return std::min({ a(x, y, z), b(x, y, z), c(x, y, z) });
-  });
+  const Scene scene = makeScene({ 9, 7, 61 }, { 1, 1, 1 },
+    [=](double x, double y, double z) {
+      return std::min({ a(x, y, z), b(x, y, z), c(x, y, z) });
+    });
   vao::SweepParameters p = withIterations(2);
   const Result one = sweep(scene.view(), scene.spacing, p, 1, false);
   for (int repeat = 0; repeat < 20; ++repeat)

@@ -31,7 +31,8 @@ std::array<double, 3> randomUnit(std::mt19937_64& rng)
 double quadrature(int s, const std::array<double, 3>& n, bool twoSided)
 {
   constexpr int K = 1200;
-  static const std::vector<std::array<double, 4>> grid = [] {
+  static const std::vector<std::array<double, 4>> grid = []
+  {
     std::vector<std::array<double, 4>> g;
     const double step = 0.5 * kPi / K;
     for (int i = 0; i < K; ++i)

@@ -29,9 +29,8 @@ std::array<double, 3> normalOf(const Result& r, const vao::Index3& d, const Spac
     std::int64_t lo[3] = { x, y, z }, hi[3] = { x, y, z };
     lo[a] = std::max<std::int64_t>(0, p[a] - 1);
     hi[a] = std::min<std::int64_t>(d[a] - 1, p[a] + 1);
-    auto at = [&](const std::int64_t* q) {
-      return double(r.distance[(q[2] * d[1] + q[1]) * d[0] + q[0]]);
-    };
+    auto at = [&](const std::int64_t* q)
+    { return double(r.distance[(q[2] * d[1] + q[1]) * d[0] + q[0]]); };
     n[a] = (at(hi) - at(lo)) / ((hi[a] - lo[a]) * h[a]);
     length += n[a] * n[a];
   }
@@ -120,7 +119,8 @@ TEST(SweepValidation, RejectsBadArgumentsWithAReason)
   const Spacing h{ 1, 1, 1 };
   auto expectRejected = [&](const vao::VolumeView& view, const Spacing& spacing,
                           const vao::SweepParameters& p, const vao::SweepOutput& o,
-                          const char* what) {
+                          const char* what)
+  {
     const vao::Status status = vao::computeOcclusionSweeping(view, spacing, p, o);
     EXPECT_FALSE(status.ok) << what;
     EXPECT_FALSE(status.aborted) << what;
@@ -138,7 +138,8 @@ TEST(SweepValidation, RejectsBadArgumentsWithAReason)
   for (const Spacing& bad :
     { Spacing{ 0, 1, 1 }, Spacing{ 1, -1, 1 }, Spacing{ 1, 1, inf }, Spacing{ nan, 1, 1 } })
     expectRejected(viewOf(values, dims), bad, good, output, "spacing");
-  auto rejects = [&](auto change, const char* what, const vao::SweepOutput& o) {
+  auto rejects = [&](auto change, const char* what, const vao::SweepOutput& o)
+  {
     vao::SweepParameters p;
     change(p);
     return expectRejected(viewOf(values, dims), h, p, o, what);

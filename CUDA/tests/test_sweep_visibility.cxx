@@ -88,9 +88,8 @@ TEST(SweepVisibility, FloorBlocksTheOctantsBelow)
   p.isoValue = 0.5;
   const Result r = sweep(viewOf(values, dims), { 1, 1, 1 }, p);
   ASSERT_TRUE(r.status.ok);
-  auto at = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-    return (z * dims[1] + y) * dims[0] + x;
-  };
+  auto at = [&](std::int64_t x, std::int64_t y, std::int64_t z)
+  { return (z * dims[1] + y) * dims[0] + x; };
   double below = 0, count = 0;
   for (std::int64_t z = 5; z < dims[2]; ++z)
     for (std::int64_t y = 0; y < dims[1]; ++y)
@@ -192,7 +191,8 @@ public:
     , D(d)
     , Alpha(opacity)
     , HMin(std::min({ h[0], h[1], h[2] }))
-  {}
+  {
+  }
 
   double operator()(int s, std::int64_t x, std::int64_t y, std::int64_t z)
   {

@@ -28,7 +28,8 @@ std::array<double, 3> SceneNormal(double x, double y, double z)
 {
   const double e = 1e-3;
   std::array<double, 3> n = { SceneDistance(x + e, y, z) - SceneDistance(x - e, y, z),
-    SceneDistance(x, y + e, z) - SceneDistance(x, y - e, z), SceneDistance(x, y, z + e) - SceneDistance(x, y, z - e) };
+    SceneDistance(x, y + e, z) - SceneDistance(x, y - e, z),
+    SceneDistance(x, y, z + e) - SceneDistance(x, y, z - e) };
   const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   for (double& c : n)
     c /= length;
@@ -71,7 +72,9 @@ TEST(SweepValidation, AgreesWithMonteCarloRayTracedAmbientOcclusionOnTheFig3Scen
   parameters.isoValue = 0.5;
   parameters.useGeometryTerm = true;
   std::vector<float> distance(volume.size()), ao(volume.size());
-  ASSERT_TRUE(vao::computeOcclusionSweeping(view, { 1.0, 1.0, 1.0 }, parameters, { distance.data(), ao.data(), nullptr }).ok);
+  ASSERT_TRUE(vao::computeOcclusionSweeping(
+    view, { 1.0, 1.0, 1.0 }, parameters, { distance.data(), ao.data(), nullptr })
+                .ok);
 
   // Surface voxels: the grid points just outside the surface.
   std::mt19937 rng(2009);
@@ -90,9 +93,10 @@ TEST(SweepValidation, AgreesWithMonteCarloRayTracedAmbientOcclusionOnTheFig3Scen
       }
   ASSERT_GT(swept.size(), 3000u);
   const vaotest::Agreement agreement = vaotest::AgreementOf(swept, traced);
-  const double correlation = agreement.correlation, ms = agreement.meanEstimate, mt = agreement.meanReference;
-  std::cout << swept.size() << " surface voxels: correlation " << correlation << ", mean sweeping " << ms
-            << ", mean Monte Carlo " << mt << ", mean difference " << ms - mt << std::endl;
+  const double correlation = agreement.correlation, ms = agreement.meanEstimate,
+               mt = agreement.meanReference;
+  std::cout << swept.size() << " surface voxels: correlation " << correlation << ", mean sweeping "
+            << ms << ", mean Monte Carlo " << mt << ", mean difference " << ms - mt << std::endl;
   EXPECT_GT(correlation, kMinimumCorrelation);
   EXPECT_LT(std::abs(ms - mt), kMaximumMeanDifference);
 }

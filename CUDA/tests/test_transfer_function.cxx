@@ -44,7 +44,8 @@ double bruteForceOpenness(const std::vector<T>& v, const vao::Index3& d, const v
   std::int64_t count = 0;
   for (std::int64_t k = std::max<std::int64_t>(0, z - r.z); k <= std::min(d[2] - 1, z + r.z); ++k)
     for (std::int64_t j = std::max<std::int64_t>(0, y - r.y); j <= std::min(d[1] - 1, y + r.y); ++j)
-      for (std::int64_t i = std::max<std::int64_t>(0, x - r.x); i <= std::min(d[0] - 1, x + r.x); ++i, ++count)
+      for (std::int64_t i = std::max<std::int64_t>(0, x - r.x); i <= std::min(d[0] - 1, x + r.x);
+           ++i, ++count)
         sum += linearOpacity(f, static_cast<double>(v[(k * d[1] + j) * d[0] + i]));
   return static_cast<double>(1.0L - sum / count);
 }
@@ -53,7 +54,8 @@ vao::OpacityFunction nonMonotone(double lo, double hi, bool clamping)
 {
   vao::OpacityFunction f;
   const double w = hi - lo;
-  f.nodes = { { lo + 0.1 * w, 0.2 }, { lo + 0.35 * w, 0.9 }, { lo + 0.5 * w, 0.05 }, { lo + 0.8 * w, 0.6 } };
+  f.nodes = { { lo + 0.1 * w, 0.2 }, { lo + 0.35 * w, 0.9 }, { lo + 0.5 * w, 0.05 },
+    { lo + 0.8 * w, 0.6 } };
   f.clamping = clamping;
   return f;
 }
@@ -65,7 +67,8 @@ void checkAgainstBruteForce(double lo, double hi, unsigned seed)
   const std::vector<T> v = vaotest::randomVolume<T>(dims, lo, hi, seed);
   const vao::VolumeView view = vaotest::viewOf(v, dims);
   const vao::Region region{ { 2, 1, 3 }, { 9, 8, 5 } };
-  for (const vao::Radius radius : { vao::Radius{ 1, 1, 1 }, vao::Radius{ 3, 1, 2 }, vao::Radius{ 0, 4, 6 } })
+  for (const vao::Radius radius :
+    { vao::Radius{ 1, 1, 1 }, vao::Radius{ 3, 1, 2 }, vao::Radius{ 0, 4, 6 } })
     for (const bool clamping : { true, false })
     {
       vao::AmbientOcclusionParameters p;
@@ -82,12 +85,13 @@ void checkAgainstBruteForce(double lo, double hi, unsigned seed)
         for (std::int64_t j = 0; j < region.size[1]; ++j)
           for (std::int64_t i = 0; i < region.size[0]; ++i)
           {
-            const double expected = bruteForceOpenness(v, dims, radius, p.opacity, region.begin[0] + i,
-              region.begin[1] + j, region.begin[2] + k);
-            worst = std::max(worst, std::abs(out[(k * region.size[1] + j) * region.size[0] + i] - expected));
+            const double expected = bruteForceOpenness(v, dims, radius, p.opacity,
+              region.begin[0] + i, region.begin[1] + j, region.begin[2] + k);
+            worst = std::max(
+              worst, std::abs(out[(k * region.size[1] + j) * region.size[0] + i] - expected));
           }
-      EXPECT_LE(worst, 1e-6) << "radius " << radius.x << "," << radius.y << "," << radius.z << " clamping "
-                             << clamping;
+      EXPECT_LE(worst, 1e-6) << "radius " << radius.x << "," << radius.y << "," << radius.z
+                             << " clamping " << clamping;
     }
 }
 
@@ -173,14 +177,16 @@ TEST(TransferFunction, RefusesBadFunctions)
   std::vector<float> out(512, -7.0f);
   vao::AmbientOcclusionOutput o;
   o.openness = out.data();
-  const auto run = [&](const vao::OpacityFunction& f) {
+  const auto run = [&](const vao::OpacityFunction& f)
+  {
     vao::AmbientOcclusionParameters p;
     p.method = vao::Method::TransferFunction;
     p.radius = { 2, 2, 2 };
     p.opacity = f;
     return vao::computeAmbientOcclusion(view, vao::Region::whole(view), p, o);
   };
-  const auto expectRefused = [&](const vao::OpacityFunction& f, const std::string& words) {
+  const auto expectRefused = [&](const vao::OpacityFunction& f, const std::string& words)
+  {
     const vao::Status s = run(f);
     EXPECT_FALSE(s.ok);
     EXPECT_NE(s.message.find(words), std::string::npos) << s.message;

@@ -2,9 +2,9 @@
 // it leaves to VTK (no tuple, a NaN, an infinity).
 #include "vao/ValueRanges.h"
 
-#include "vao/AmbientOcclusion.h"
 #include "cpu/common/ConcurrentRange.h"
 #include "cpu/simd/CpuDispatch.h"
+#include "vao/AmbientOcclusion.h"
 
 #include <gtest/gtest.h>
 
@@ -30,14 +30,16 @@ TEST(ValueRanges, EqualAPlainScanPerComponentAndOfTheNorm)
       {
         const int c = static_cast<int>(i % components);
         // Component c spans a range of its own: a wrong component index shows.
-        values[i] = std::uniform_real_distribution<float>(-10.0f * c - 1.0f, 100.0f * c + 0.5f)(random);
+        values[i] =
+          std::uniform_real_distribution<float>(-10.0f * c - 1.0f, 100.0f * c + 0.5f)(random);
       }
       for (int threads : { 1, 2, 3 })
       {
-        SCOPED_TRACE(::testing::Message() << components << " components, " << tuples << " tuples, " << threads
-                                          << " threads");
+        SCOPED_TRACE(::testing::Message()
+          << components << " components, " << tuples << " tuples, " << threads << " threads");
         vao::ValueRanges ranges;
-        ASSERT_TRUE(vao::computeFiniteValueRanges(values.data(), tuples, components, ranges, threads));
+        ASSERT_TRUE(
+          vao::computeFiniteValueRanges(values.data(), tuples, components, ranges, threads));
         ASSERT_EQ(ranges.components.size(), static_cast<std::size_t>(2 * components));
         double lowestSquare = std::numeric_limits<double>::max(), highestSquare = 0.0;
         for (std::int64_t t = 0; t < tuples; ++t)
@@ -82,14 +84,15 @@ TEST(ValueRanges, LeaveNoTuplesNaNAndInfinityToTheCaller)
   std::vector<float> values(3000, 1.0f);
   EXPECT_FALSE(vao::computeFiniteValueRanges(values.data(), 0, 3, ranges));
   EXPECT_FALSE(vao::computeFiniteValueRanges(nullptr, 10, 3, ranges));
-  for (float bad : { std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
-         -std::numeric_limits<float>::infinity() })
+  for (float bad : { std::numeric_limits<float>::quiet_NaN(),
+         std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity() })
   {
     for (std::size_t at : { std::size_t(0), std::size_t(1501), values.size() - 1 })
     {
       std::vector<float> spoiled = values;
       spoiled[at] = bad;
-      EXPECT_FALSE(vao::computeFiniteValueRanges(spoiled.data(), 1000, 3, ranges, 2)) << bad << " at " << at;
+      EXPECT_FALSE(vao::computeFiniteValueRanges(spoiled.data(), 1000, 3, ranges, 2))
+        << bad << " at " << at;
     }
   }
   // The largest finite floats square to finite doubles: still a range.
@@ -127,7 +130,8 @@ TEST(KeptRanges, RowExtremesOnEveryTierEqualAPlainScan)
         EXPECT_EQ(lo, *std::min_element(v.begin(), v.end())) << "n " << n;
         EXPECT_EQ(hi, *std::max_element(v.begin(), v.end())) << "n " << n;
       }
-      for (const float bad : { std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity() })
+      for (const float bad :
+        { std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity() })
         for (std::int64_t at = 0; at < n; at += 7)
         {
           std::vector<float> w = v;
@@ -146,7 +150,8 @@ TEST(KeptRanges, OpennessRangeOfTheMomentMethodsEqualsAScan)
   std::vector<std::int16_t> values(static_cast<std::size_t>(dims[0] * dims[1] * dims[2]));
   std::mt19937 random(3);
   for (std::size_t i = 0; i < values.size(); ++i)
-    values[i] = static_cast<std::int16_t>(i % 11 == 0 ? 900 : std::uniform_int_distribution<int>(-50, 50)(random));
+    values[i] = static_cast<std::int16_t>(
+      i % 11 == 0 ? 900 : std::uniform_int_distribution<int>(-50, 50)(random));
   std::vector<float> floats(values.begin(), values.end());
   for (const bool asFloat : { false, true })
   {
@@ -188,8 +193,10 @@ TEST(KeptRanges, OpennessRangeOfTheMomentMethodsEqualsAScan)
         continue;
       }
       ASSERT_TRUE(range.known) << static_cast<int>(method);
-      EXPECT_EQ(range.lowest, *std::min_element(out.begin(), out.end())) << static_cast<int>(method);
-      EXPECT_EQ(range.highest, *std::max_element(out.begin(), out.end())) << static_cast<int>(method);
+      EXPECT_EQ(range.lowest, *std::min_element(out.begin(), out.end()))
+        << static_cast<int>(method);
+      EXPECT_EQ(range.highest, *std::max_element(out.begin(), out.end()))
+        << static_cast<int>(method);
       EXPECT_LT(range.lowest, range.highest); // a scene with both open and occluded voxels
     }
   }

@@ -1,8 +1,8 @@
 // The one threading primitive (src/cpu/common/Parallel.h): persistent workers, teams, nesting,
 // exceptions, and the default thread count.
-#include "cpu/common/Parallel.h"
 #include "SweepTestSupport.h"
 #include "TestVolumes.h"
+#include "cpu/common/Parallel.h"
 #include "vao/AmbientOcclusion.h"
 #include "vao/BlockSweeping.h"
 
@@ -35,17 +35,19 @@ TEST(WorkerPool, EveryIndexOnceAndTheTeamRunsAtTheSameTime)
   std::atomic<int> arrived{ 0 };
   std::set<std::thread::id> ids;
   std::mutex idsMutex;
-  parallelFor(static_cast<std::int64_t>(visits.size()), kTeam, kTeam, [&](std::int64_t begin, std::int64_t end) {
-    // Every member waits for the others: this finishes only if all run concurrently,
-    // which the sweep's wavefront relies on.
-    ++arrived;
-    while (arrived.load() < kTeam)
-      std::this_thread::yield();
-    for (std::int64_t i = begin; i < end; ++i)
-      ++visits[i];
-    std::lock_guard<std::mutex> lock(idsMutex);
-    ids.insert(std::this_thread::get_id());
-  });
+  parallelFor(static_cast<std::int64_t>(visits.size()), kTeam, kTeam,
+    [&](std::int64_t begin, std::int64_t end)
+    {
+      // Every member waits for the others: this finishes only if all run concurrently,
+      // which the sweep's wavefront relies on.
+      ++arrived;
+      while (arrived.load() < kTeam)
+        std::this_thread::yield();
+      for (std::int64_t i = begin; i < end; ++i)
+        ++visits[i];
+      std::lock_guard<std::mutex> lock(idsMutex);
+      ids.insert(std::this_thread::get_id());
+    });
   for (const auto& v : visits)
     ASSERT_EQ(v.load(), 1);
   EXPECT_EQ(ids.size(), std::size_t(kTeam));
@@ -54,18 +56,23 @@ TEST(WorkerPool, EveryIndexOnceAndTheTeamRunsAtTheSameTime)
 TEST(WorkerPool, ANestedLoopRunsInOrderOnItsCaller)
 {
   std::vector<std::int64_t> inner(4 * 50, -1);
-  parallelFor(4, 4, 2, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t outer = begin; outer < end; ++outer)
+  parallelFor(4, 4, 2,
+    [&](std::int64_t begin, std::int64_t end)
     {
-      std::int64_t next = 0;
-      const std::thread::id caller = std::this_thread::get_id();
-      parallelFor(50, 50, 4, [&](std::int64_t b, std::int64_t e) {
-        EXPECT_EQ(std::this_thread::get_id(), caller) << "a nested loop must not wait on the busy pool";
-        for (std::int64_t i = b; i < e; ++i)
-          inner[outer * 50 + i] = next++; // in order: 0, 1, 2, ...
-      });
-    }
-  });
+      for (std::int64_t outer = begin; outer < end; ++outer)
+      {
+        std::int64_t next = 0;
+        const std::thread::id caller = std::this_thread::get_id();
+        parallelFor(50, 50, 4,
+          [&](std::int64_t b, std::int64_t e)
+          {
+            EXPECT_EQ(std::this_thread::get_id(), caller)
+              << "a nested loop must not wait on the busy pool";
+            for (std::int64_t i = b; i < e; ++i)
+              inner[outer * 50 + i] = next++; // in order: 0, 1, 2, ...
+          });
+      }
+    });
   for (std::int64_t outer = 0; outer < 4; ++outer)
     for (std::int64_t i = 0; i < 50; ++i)
       ASSERT_EQ(inner[outer * 50 + i], i);
@@ -74,16 +81,19 @@ TEST(WorkerPool, ANestedLoopRunsInOrderOnItsCaller)
 TEST(WorkerPool, AnExceptionInAChunkReachesTheCallerAndThePoolStaysUsable)
 {
   EXPECT_THROW(parallelFor(8, 8, 2,
-                 [](std::int64_t begin, std::int64_t) {
+                 [](std::int64_t begin, std::int64_t)
+                 {
                    if (begin == 5)
                      throw std::bad_alloc();
                  }),
     std::bad_alloc);
   std::atomic<std::int64_t> sum{ 0 };
-  parallelFor(100, 4, 2, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t i = begin; i < end; ++i)
-      sum += i;
-  });
+  parallelFor(100, 4, 2,
+    [&](std::int64_t begin, std::int64_t end)
+    {
+      for (std::int64_t i = begin; i < end; ++i)
+        sum += i;
+    });
   EXPECT_EQ(sum.load(), 4950);
 }
 
@@ -94,7 +104,8 @@ TEST(WorkerPool, AChunkThatThrowsStopsTheMembersThatWaitOnIt)
   // (Chunk 1 may also never start, when the stop comes first.)
   std::atomic<bool> oneTimedOut{ false };
   EXPECT_THROW(parallelFor(2, 2, 2, vao::Execution{},
-                 [&](std::int64_t begin, std::int64_t, ChunkProgress& progress) {
+                 [&](std::int64_t begin, std::int64_t, ChunkProgress& progress)
+                 {
                    if (begin == 0)
                      throw std::bad_alloc();
                    const auto start = std::chrono::steady_clock::now();
@@ -120,7 +131,8 @@ TEST(WorkerPool, CancellationStopsTheLoop)
   execution.abortRequested = [&] { return ++polls >= 3; };
   std::atomic<int> done{ 0 };
   const bool finished = parallelFor(1000, 1000, 2, execution,
-    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
+    {
       for (std::int64_t i = begin; i < end && progress.advance(); ++i)
         ++done;
     });
@@ -142,8 +154,8 @@ TEST(WorkerPool, OneAmbientOcclusionRunStartsAtMostTheWorkersOfItsTeam)
   const std::int64_t before = workerThreadsStarted();
   for (int run = 0; run < 3; ++run)
   {
-    ASSERT_TRUE(vao::computeAmbientOcclusion(viewOf(values, dims), vao::Region::whole(viewOf(values, dims)), p,
-      { open.data(), nullptr }, execution)
+    ASSERT_TRUE(vao::computeAmbientOcclusion(viewOf(values, dims),
+      vao::Region::whole(viewOf(values, dims)), p, { open.data(), nullptr }, execution)
                   .ok);
   }
   EXPECT_LE(workerThreadsStarted() - before, kThreads - 1);
@@ -207,15 +219,18 @@ TEST(WorkerPool, AForkedChildRunsItsLoopsWithoutItsParentsWorkers)
   {
     alarm(20); // a hang ends the child with SIGALRM instead of the test run
     std::atomic<std::int64_t> sum{ 0 };
-    parallelFor(100, 4, 3, [&](std::int64_t begin, std::int64_t end) {
-      for (std::int64_t i = begin; i < end; ++i)
-        sum += i;
-    });
+    parallelFor(100, 4, 3,
+      [&](std::int64_t begin, std::int64_t end)
+      {
+        for (std::int64_t i = begin; i < end; ++i)
+          sum += i;
+      });
     _exit(sum.load() == 4950 ? 0 : 1);
   }
   int status = 0;
   ASSERT_EQ(waitpid(child, &status, 0), child);
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "the child's loop hung or went wrong";
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
+    << "the child's loop hung or went wrong";
 }
 
 TEST(WorkerPool, DefaultThreadsDivideTheNodeByItsRanks)
@@ -224,7 +239,8 @@ TEST(WorkerPool, DefaultThreadsDivideTheNodeByItsRanks)
   EXPECT_EQ(defaultThreadCount(16, false, 1), 16);
   EXPECT_EQ(defaultThreadCount(16, false, 4), 4);
   EXPECT_EQ(defaultThreadCount(2, false, 4), 1) << "never below one thread";
-  EXPECT_EQ(defaultThreadCount(3, true, 4), 3) << "a launcher that bound the process has divided already";
+  EXPECT_EQ(defaultThreadCount(3, true, 4), 3)
+    << "a launcher that bound the process has divided already";
   EXPECT_EQ(vao::detail::resolveThreadCount(5), 5) << "an explicit count wins";
 }
 

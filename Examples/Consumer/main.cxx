@@ -21,14 +21,12 @@ int main()
 
   vtkNew<vtkVolumetricAmbientOcclusion> occlusion;
   occlusion->SetInputConnection(source->GetOutputPort());
-  occlusion->SetInputArrayToProcess(
-    0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "RTData");
+  occlusion->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "RTData");
   occlusion->SetRadius(3);
   occlusion->Update();
 
   vtkImageData* output = occlusion->GetOutput();
-  vtkDataArray* array =
-    output ? output->GetPointData()->GetArray("AmbientOcclusion") : nullptr;
+  vtkDataArray* array = output ? output->GetPointData()->GetArray("AmbientOcclusion") : nullptr;
   if (!array)
   {
     std::cerr << "FAIL: no point-data array \"AmbientOcclusion\" in the output\n";
@@ -45,8 +43,8 @@ int main()
     output->GetNumberOfPoints() != 21 * 21 * 21)
   {
     std::cerr << "FAIL: \"AmbientOcclusion\" has " << array->GetNumberOfTuples() << " x "
-              << array->GetNumberOfComponents() << " values for "
-              << output->GetNumberOfPoints() << " points (expected 9261 x 1)\n";
+              << array->GetNumberOfComponents() << " values for " << output->GetNumberOfPoints()
+              << " points (expected 9261 x 1)\n";
     return 1;
   }
 

@@ -54,15 +54,17 @@ inline const std::array<MethodInfo, 8> Methods = { {
   { vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF, "Histogram CDF", "HistogramCDF" },
   { vtkVolumetricAmbientOcclusion::EXACT_BOX, "Exact Box", "ExactBox" },
   { vtkVolumetricAmbientOcclusion::EXACT_SPHERE, "Exact Sphere", "ExactSphere" },
-  { vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF, "Histogram CDF, smooth q", "HistogramCDFSmoothed", Smoothed },
+  { vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF, "Histogram CDF, smooth q", "HistogramCDFSmoothed",
+    Smoothed },
   { vtkVolumetricAmbientOcclusion::EXACT_BOX, "Exact Box, smooth q", "ExactBoxSmoothed", Smoothed },
 } };
 
 /// The row of method `id` with query mode `query`.
-inline const MethodInfo& MethodWithId(int id, int query = vtkVolumetricAmbientOcclusion::VOXEL_VALUE)
+inline const MethodInfo& MethodWithId(
+  int id, int query = vtkVolumetricAmbientOcclusion::VOXEL_VALUE)
 {
-  return *std::find_if(
-    Methods.begin(), Methods.end(), [id, query](const MethodInfo& m) { return m.id == id && m.query == query; });
+  return *std::find_if(Methods.begin(), Methods.end(),
+    [id, query](const MethodInfo& m) { return m.id == id && m.query == query; });
 }
 
 /// The oracle a row is compared with (docs/methods.md): Exact Box with the same query.
@@ -94,7 +96,10 @@ public:
   ErrorLog& operator=(const ErrorLog&) = delete;
 
   /// The messages so far, or `fallback` when there were none.
-  std::string Text(const std::string& fallback) const { return this->Messages.empty() ? fallback : this->Messages; }
+  std::string Text(const std::string& fallback) const
+  {
+    return this->Messages.empty() ? fallback : this->Messages;
+  }
 
 private:
   void OnError(vtkObject*, unsigned long, void* callData)
@@ -145,7 +150,8 @@ inline double SecondsSince(std::chrono::steady_clock::time_point start)
 /// One filter run: its openness array named "<key>_R<radius>", or with `variance` its
 
 /// The computation of `method` at `radius` (it must exist).
-inline const Computation& Find(const std::vector<Computation>& results, const MethodInfo* method, int radius)
+inline const Computation& Find(
+  const std::vector<Computation>& results, const MethodInfo* method, int radius)
 {
   for (const Computation& c : results)
   {

@@ -43,7 +43,10 @@ struct Raster
   {
   }
   float& At(int x, int y) { return this->values[static_cast<std::size_t>(y) * this->width + x]; }
-  float At(int x, int y) const { return this->values[static_cast<std::size_t>(y) * this->width + x]; }
+  float At(int x, int y) const
+  {
+    return this->values[static_cast<std::size_t>(y) * this->width + x];
+  }
 };
 
 /// Which volume axes run across and up the picture for each slice axis. Head at the top
@@ -83,7 +86,8 @@ Raster ExtractSlice(vtkImageData* image, vtkDataArray* values, int sliceAxis)
     for (int x = 0; x < slice.width; ++x)
     {
       ijk[view.across] = x;
-      const vtkIdType id = ijk[0] + static_cast<vtkIdType>(dims[0]) * (ijk[1] + static_cast<vtkIdType>(dims[1]) * ijk[2]);
+      const vtkIdType id = ijk[0] +
+        static_cast<vtkIdType>(dims[0]) * (ijk[1] + static_cast<vtkIdType>(dims[1]) * ijk[2]);
       slice.At(x, y) = static_cast<float>(values->GetComponent(id, 0));
     }
   }
@@ -100,7 +104,8 @@ struct LinearTap
 
 LinearTap TapFor(int targetIndex, int targetSize, int sourceSize)
 {
-  const double u = std::clamp((targetIndex + 0.5) * sourceSize / targetSize - 0.5, 0.0, sourceSize - 1.0);
+  const double u =
+    std::clamp((targetIndex + 0.5) * sourceSize / targetSize - 0.5, 0.0, sourceSize - 1.0);
   const int first = static_cast<int>(u);
   return { first, std::min(first + 1, sourceSize - 1), static_cast<float>(u - first) };
 }
@@ -116,9 +121,10 @@ Raster Resample(const Raster& source, int width, int height)
     for (int x = 0; x < width; ++x)
     {
       const LinearTap tx = TapFor(x, width, source.width);
-      const float top = source.At(tx.first, ty.first) * (1 - tx.weight) + source.At(tx.second, ty.first) * tx.weight;
-      const float bottom =
-        source.At(tx.first, ty.second) * (1 - tx.weight) + source.At(tx.second, ty.second) * tx.weight;
+      const float top = source.At(tx.first, ty.first) * (1 - tx.weight) +
+        source.At(tx.second, ty.first) * tx.weight;
+      const float bottom = source.At(tx.first, ty.second) * (1 - tx.weight) +
+        source.At(tx.second, ty.second) * tx.weight;
       target.At(x, y) = top * (1 - ty.weight) + bottom * ty.weight;
     }
   }
@@ -138,7 +144,8 @@ std::array<int, 2> CellSize(vtkImageData* image, int sliceAxis)
   const double width = dims[view.across] * std::abs(spacing[view.across]) / pixel;
   const double height = dims[view.up] * std::abs(spacing[view.up]) / pixel;
   const double zoom = std::max(1.0, std::ceil(MinimumCellSide / std::max(width, height)));
-  return { static_cast<int>(std::lround(width * zoom)), static_cast<int>(std::lround(height * zoom)) };
+  return { static_cast<int>(std::lround(width * zoom)),
+    static_cast<int>(std::lround(height * zoom)) };
 }
 
 /// Grey levels in [0, 1] for the input: a CT window for Hounsfield data (air at -1000),
@@ -184,8 +191,8 @@ Raster RenderLabel(const std::string& text)
   freeType->ScaleToPowerTwoOff(); // an image of exactly the text's size
   vtkNew<vtkImageData> image;
   int size[2] = { 0, 0 };
-  if (freeType->RenderString(property, vtkStdString(text), 72, image, size) && size[0] > 0 && size[1] > 0 &&
-    image->GetNumberOfScalarComponents() == 4)
+  if (freeType->RenderString(property, vtkStdString(text), 72, image, size) && size[0] > 0 &&
+    size[1] > 0 && image->GetNumberOfScalarComponents() == 4)
   {
     const int* extent = image->GetExtent();
     Raster label(size[0], size[1], 0.0f);
@@ -249,9 +256,8 @@ Labels RenderLabels(const FigureContent& content)
   {
     labels.columns.push_back(RenderLabel(text));
   }
-  auto rendered = [](const std::vector<Raster>& r) {
-    return std::all_of(r.begin(), r.end(), [](const Raster& label) { return label.width > 0; });
-  };
+  auto rendered = [](const std::vector<Raster>& r)
+  { return std::all_of(r.begin(), r.end(), [](const Raster& label) { return label.width > 0; }); };
   return rendered(labels.rows) && rendered(labels.columns) ? labels : Labels{};
 }
 
@@ -273,42 +279,49 @@ Raster ComposeFigure(const FigureContent& content, const Labels& labels)
   }
   const int columns = static_cast<int>(content.columnLabels.size());
   const int methodRows = static_cast<int>(content.rows.size()) - 1;
-  const int gridLeft = Margin + labelWidth, pitchX = cellSize[0] + Separator, pitchY = cellSize[1] + Separator;
+  const int gridLeft = Margin + labelWidth, pitchX = cellSize[0] + Separator,
+            pitchY = cellSize[1] + Separator;
   const int methodsTop = Margin + cellSize[1] + headerHeight;
-  Raster canvas(gridLeft + columns * pitchX - Separator + Margin, methodsTop + methodRows * pitchY - Separator + Margin,
-    Background);
+  Raster canvas(gridLeft + columns * pitchX - Separator + Margin,
+    methodsTop + methodRows * pitchY - Separator + Margin, Background);
 
   // The method grid on a separator-grey ground: the gaps between cells stay grey.
-  Paste(canvas, Raster(columns * pitchX - Separator, methodRows * pitchY - Separator, SeparatorGrey), gridLeft,
+  Paste(canvas,
+    Raster(columns * pitchX - Separator, methodRows * pitchY - Separator, SeparatorGrey), gridLeft,
     methodsTop, false);
   for (std::size_t row = 0; row < content.rows.size(); ++row)
   {
     const int top = row == 0 ? Margin : methodsTop + static_cast<int>(row - 1) * pitchY;
     for (std::size_t column = 0; column < content.rows[row].size(); ++column)
     {
-      Paste(canvas, content.rows[row][column], gridLeft + static_cast<int>(column) * pitchX, top, false);
+      Paste(canvas, content.rows[row][column], gridLeft + static_cast<int>(column) * pitchX, top,
+        false);
     }
     if (!labels.Empty())
     {
-      Paste(canvas, labels.rows[row], Margin, top + (cellSize[1] - labels.rows[row].height) / 2, true);
+      Paste(
+        canvas, labels.rows[row], Margin, top + (cellSize[1] - labels.rows[row].height) / 2, true);
     }
   }
   for (std::size_t column = 0; column < labels.columns.size(); ++column)
   {
     const Raster& label = labels.columns[column];
-    Paste(canvas, label, gridLeft + static_cast<int>(column) * pitchX + (cellSize[0] - label.width) / 2,
+    Paste(canvas, label,
+      gridLeft + static_cast<int>(column) * pitchX + (cellSize[0] - label.width) / 2,
       Margin + cellSize[1] + (headerHeight - label.height) / 2, true);
   }
   return canvas;
 }
 
-FigureContent BuildFigureContent(vtkImageData* image, vtkDataArray* scalars, const std::vector<Computation>& results,
-  const std::vector<int>& radii, int sliceAxis)
+FigureContent BuildFigureContent(vtkImageData* image, vtkDataArray* scalars,
+  const std::vector<Computation>& results, const std::vector<int>& radii, int sliceAxis)
 {
   FigureContent content;
   content.cellSize = CellSize(image, sliceAxis);
-  auto cell = [&](vtkDataArray* values) {
-    return Resample(ExtractSlice(image, values, sliceAxis), content.cellSize[0], content.cellSize[1]);
+  auto cell = [&](vtkDataArray* values)
+  {
+    return Resample(
+      ExtractSlice(image, values, sliceAxis), content.cellSize[0], content.cellSize[1]);
   };
   const Window window = InputWindow(scalars);
   content.rowLabels.push_back("Input (" + window.description + ")");
@@ -323,7 +336,8 @@ FigureContent BuildFigureContent(vtkImageData* image, vtkDataArray* scalars, con
     content.rows.emplace_back();
     for (int radius : radii)
     {
-      content.rows.back().push_back(cell(Find(results, &method, radius).values)); // AO is in [0, 1] already
+      content.rows.back().push_back(
+        cell(Find(results, &method, radius).values)); // AO is in [0, 1] already
     }
   }
   return content;
@@ -332,8 +346,9 @@ FigureContent BuildFigureContent(vtkImageData* image, vtkDataArray* scalars, con
 /// Without text rendering the layout goes to stdout and to a .txt beside the PNG.
 void WriteLegend(const FigureContent& content, const std::string& pngPath)
 {
-  std::string legend = "Layout of " + pngPath + " (no text rendering available):\n  row 1, column 1: " +
-    content.rowLabels[0] + "\n  columns, left to right:";
+  std::string legend = "Layout of " + pngPath +
+    " (no text rendering available):\n  row 1, column 1: " + content.rowLabels[0] +
+    "\n  columns, left to right:";
   for (const auto& label : content.columnLabels)
   {
     legend += " " + label + ";";
@@ -392,8 +407,9 @@ void CheckPngReadBack(const Raster& canvas, const std::string& path)
 
 } // namespace
 
-void WriteFigure(vtkImageData* image, vtkDataArray* scalars, const std::vector<Computation>& results,
-  const std::vector<int>& radii, int sliceAxis, const std::string& path)
+void WriteFigure(vtkImageData* image, vtkDataArray* scalars,
+  const std::vector<Computation>& results, const std::vector<int>& radii, int sliceAxis,
+  const std::string& path)
 {
   const FigureContent content = BuildFigureContent(image, scalars, results, radii, sliceAxis);
   const Labels labels = RenderLabels(content);

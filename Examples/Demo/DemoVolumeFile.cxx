@@ -27,7 +27,8 @@ std::string DifferingArrays(vtkImageData* expected, vtkImageData* actual)
     vtkDataArray* got = actual->GetPointData()->GetArray(want->GetName());
     const int components = want->GetNumberOfComponents();
     bool same = got && got->GetDataType() == want->GetDataType() &&
-      got->GetNumberOfTuples() == want->GetNumberOfTuples() && got->GetNumberOfComponents() == components;
+      got->GetNumberOfTuples() == want->GetNumberOfTuples() &&
+      got->GetNumberOfComponents() == components;
     for (vtkIdType t = 0; same && t < want->GetNumberOfTuples(); ++t)
     {
       for (int c = 0; same && c < components; ++c)
@@ -91,11 +92,12 @@ void CheckVolumeReadBack(vtkImageData* written, const std::string& path)
   const std::string differing = DifferingArrays(written, read);
   if (!differing.empty())
   {
-    Fail(ExitFailure, "read back of '" + path + "' failed: these arrays differ: " + differing + ".");
+    Fail(
+      ExitFailure, "read back of '" + path + "' failed: these arrays differ: " + differing + ".");
   }
   std::printf("read back: OK (%d arrays of %lld voxels, identical, checked in %.2f s)\n",
-    written->GetPointData()->GetNumberOfArrays(), static_cast<long long>(written->GetNumberOfPoints()),
-    SecondsSince(start));
+    written->GetPointData()->GetNumberOfArrays(),
+    static_cast<long long>(written->GetNumberOfPoints()), SecondsSince(start));
 }
 
 } // namespace vaodemo

@@ -82,7 +82,8 @@ int ParseInt(const std::string& text, const char* option, int minimum)
   }
   if (used != text.size() || value < minimum)
   {
-    Fail(ExitBadInput, std::string(option) + " takes integers of at least " + std::to_string(minimum) + " (got '" +
+    Fail(ExitBadInput,
+      std::string(option) + " takes integers of at least " + std::to_string(minimum) + " (got '" +
         text + "').\n" + Usage);
   }
   return value;
@@ -100,7 +101,9 @@ std::vector<std::string> OptionValues(int argc, char** argv, int& i, int count)
   }
   if (values.empty() || (count >= 0 && static_cast<int>(values.size()) != count))
   {
-    Fail(ExitBadInput, option + " needs " + (count < 0 ? std::string("at least one value") : std::to_string(count) + " value(s)") +
+    Fail(ExitBadInput,
+      option + " needs " +
+        (count < 0 ? std::string("at least one value") : std::to_string(count) + " value(s)") +
         ".\n" + Usage);
   }
   return values;
@@ -210,7 +213,9 @@ vtkSmartPointer<vtkAlgorithm> OpenReader(const std::string& path)
   {
     return CheckedReader<vtkXMLImageDataReader>(path);
   }
-  Fail(ExitBadInput, "'" + path + "': unsupported file type '" + extension + "' (use .mha, .mhd, .nrrd, .nhdr or .vti).");
+  Fail(ExitBadInput,
+    "'" + path + "': unsupported file type '" + extension +
+      "' (use .mha, .mhd, .nrrd, .nhdr or .vti).");
 }
 
 vtkSmartPointer<vtkImageData> ReadVolume(const std::string& path)
@@ -223,9 +228,11 @@ vtkSmartPointer<vtkImageData> ReadVolume(const std::string& path)
   {
     // The usual cause here: the expat of this machine breaks VTK 9.2's appended-data parsing.
     const std::string hint = LowerCaseExtension(path) == ".vti"
-      ? " (this VTK reads .vti files with inline data only, not appended: save it inline or as .mha)"
+      ? " (this VTK reads .vti files with inline data only, not appended: save it inline or as "
+        ".mha)"
       : "";
-    Fail(ExitBadInput, "cannot read '" + path + "': " + errors.Text("the reader produced no voxels.") + hint);
+    Fail(ExitBadInput,
+      "cannot read '" + path + "': " + errors.Text("the reader produced no voxels.") + hint);
   }
   return image;
 }
@@ -248,17 +255,21 @@ vtkSmartPointer<vtkImageData> GeneratePhantom(const std::array<int, 3>& dimensio
 vtkDataArray* SelectScalars(vtkImageData* image, const std::string& name)
 {
   vtkPointData* pointData = image->GetPointData();
-  vtkAbstractArray* array = name.empty() ? pointData->GetScalars() : pointData->GetAbstractArray(name.c_str());
+  vtkAbstractArray* array =
+    name.empty() ? pointData->GetScalars() : pointData->GetAbstractArray(name.c_str());
   if (!array)
   {
     std::string available;
     for (int a = 0; a < pointData->GetNumberOfArrays(); ++a)
     {
-      available += std::string(available.empty() ? "" : ", ") + "'" + pointData->GetArrayName(a) + "'";
+      available +=
+        std::string(available.empty() ? "" : ", ") + "'" + pointData->GetArrayName(a) + "'";
     }
-    Fail(ExitBadInput, (name.empty() ? std::string("the input has no active scalars")
-                                     : "the input has no point array '" + name + "'") +
-        " (point arrays: " + (available.empty() ? "none" : available) + "; choose one with --scalars).");
+    Fail(ExitBadInput,
+      (name.empty() ? std::string("the input has no active scalars")
+                    : "the input has no point array '" + name + "'") +
+        " (point arrays: " + (available.empty() ? "none" : available) +
+        "; choose one with --scalars).");
   }
   auto* scalars = vtkDataArray::SafeDownCast(array);
   if (!scalars)
@@ -267,7 +278,8 @@ vtkDataArray* SelectScalars(vtkImageData* image, const std::string& name)
   }
   if (scalars->GetNumberOfComponents() != 1)
   {
-    Fail(ExitBadInput, std::string("point array '") + scalars->GetName() + "' has " +
+    Fail(ExitBadInput,
+      std::string("point array '") + scalars->GetName() + "' has " +
         std::to_string(scalars->GetNumberOfComponents()) +
         " components; ambient occlusion needs a scalar (one-component) array.");
   }
@@ -291,10 +303,12 @@ Computation RunFilter(vtkImageData* image, const std::string& scalars, const Met
   filter->Update();
   const double seconds = SecondsSince(start);
   const std::string resultName = variance ? "Variance" : ArrayName(method.key, radius);
-  vtkSmartPointer<vtkDataArray> values = filter->GetOutput()->GetPointData()->GetArray(resultName.c_str());
+  vtkSmartPointer<vtkDataArray> values =
+    filter->GetOutput()->GetPointData()->GetArray(resultName.c_str());
   if (!values)
   {
-    Fail(ExitFailure, std::string(method.label) + " at R = " + std::to_string(radius) +
+    Fail(ExitFailure,
+      std::string(method.label) + " at R = " + std::to_string(radius) +
         " failed: " + errors.Text("no output."));
   }
   if (variance)
@@ -304,12 +318,15 @@ Computation RunFilter(vtkImageData* image, const std::string& scalars, const Met
   return { variance ? nullptr : &method, radius, seconds, values };
 }
 
-std::vector<Computation> ComputeAll(vtkImageData* image, const std::string& scalars, const std::vector<int>& radii)
+std::vector<Computation> ComputeAll(
+  vtkImageData* image, const std::string& scalars, const std::vector<int>& radii)
 {
   std::vector<Computation> results;
   const std::size_t total = radii.size() * Methods.size() + 1;
-  auto report = [&](const Computation& c, const char* label) {
-    std::printf("[%2zu/%zu] %-24s R = %-3d %8.3f s\n", results.size(), total, label, c.radius, c.seconds);
+  auto report = [&](const Computation& c, const char* label)
+  {
+    std::printf(
+      "[%2zu/%zu] %-24s R = %-3d %8.3f s\n", results.size(), total, label, c.radius, c.seconds);
     std::fflush(stdout);
   };
   for (int radius : radii)
@@ -322,8 +339,8 @@ std::vector<Computation> ComputeAll(vtkImageData* image, const std::string& scal
   }
   // The variance comes with every estimator's box statistics; Gaussian CDF is the cheapest
   // run that yields it (its openness array is dropped).
-  results.push_back(
-    RunFilter(image, scalars, MethodWithId(vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF), radii.back(), true));
+  results.push_back(RunFilter(
+    image, scalars, MethodWithId(vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF), radii.back(), true));
   report(results.back(), "Variance");
   return results;
 }
@@ -359,17 +376,16 @@ Deviation Compare(vtkDataArray* estimate, vtkDataArray* reference)
   return { std::sqrt(sumSquares / std::max<vtkIdType>(1, n)), sum / std::max<vtkIdType>(1, n) };
 }
 
-
 void PrintTable(const std::vector<Computation>& results)
 {
-  std::printf("\n%-24s %6s %9s %9s %20s %8s\n", "method", "radius", "seconds", "AO mean", "RMSE vs Exact Box",
-    "bias");
+  std::printf("\n%-24s %6s %9s %9s %20s %8s\n", "method", "radius", "seconds", "AO mean",
+    "RMSE vs Exact Box", "bias");
   for (const Computation& c : results)
   {
     if (!c.method)
     {
-      std::printf("%-24s %6d %9.3f %9s %20s %8s   (mean variance %.4g)\n", "Variance", c.radius, c.seconds, "-",
-        "-", "-", Mean(c.values));
+      std::printf("%-24s %6d %9.3f %9s %20s %8s   (mean variance %.4g)\n", "Variance", c.radius,
+        c.seconds, "-", "-", "-", Mean(c.values));
       continue;
     }
     std::string rmse = "(reference)", bias;
@@ -380,8 +396,8 @@ void PrintTable(const std::vector<Computation>& results)
       rmse = Format("%.3f", d.rmse);
       bias = Format("%+.3f", d.bias);
     }
-    std::printf("%-24s %6d %9.3f %9.3f %20s %8s\n", c.method->label, c.radius, c.seconds, Mean(c.values),
-      rmse.c_str(), bias.c_str());
+    std::printf("%-24s %6d %9.3f %9.3f %20s %8s\n", c.method->label, c.radius, c.seconds,
+      Mean(c.values), rmse.c_str(), bias.c_str());
   }
   std::printf("\n");
 }
@@ -396,9 +412,10 @@ void Run(const Options& options)
   int dims[3];
   image->GetDimensions(dims);
   const double* spacing = image->GetSpacing();
-  std::printf("input: %s, %d x %d x %d voxels, spacing %g x %g x %g, array '%s' (%s), %s in %.2f s\n",
-    options.input.empty() ? "generated phantom" : options.input.c_str(), dims[0], dims[1], dims[2], spacing[0],
-    spacing[1], spacing[2], scalars->GetName(), scalars->GetDataTypeAsString(),
+  std::printf(
+    "input: %s, %d x %d x %d voxels, spacing %g x %g x %g, array '%s' (%s), %s in %.2f s\n",
+    options.input.empty() ? "generated phantom" : options.input.c_str(), dims[0], dims[1], dims[2],
+    spacing[0], spacing[1], spacing[2], scalars->GetName(), scalars->GetDataTypeAsString(),
     options.input.empty() ? "generated" : "read", SecondsSince(start));
   std::fflush(stdout);
 
@@ -412,7 +429,8 @@ void Run(const Options& options)
 
   const std::vector<Computation> results = ComputeAll(image, scalars->GetName(), options.radii);
   PrintTable(results);
-  const std::string volumePath = (std::filesystem::path(options.outputDir) / "ambient_occlusion.vti").string();
+  const std::string volumePath =
+    (std::filesystem::path(options.outputDir) / "ambient_occlusion.vti").string();
   const vtkSmartPointer<vtkImageData> result = AssembleResult(image, scalars, results);
   start = std::chrono::steady_clock::now();
   WriteVolume(result, volumePath);

@@ -10,7 +10,8 @@
 namespace vaodata
 {
 
-inline std::string ScanPath(const std::string& shipped, const std::string& extra, const std::string& relative)
+inline std::string ScanPath(
+  const std::string& shipped, const std::string& extra, const std::string& relative)
 {
   const std::string inShipped = shipped + "/" + relative;
   if (std::ifstream(inShipped).good() || extra.empty())

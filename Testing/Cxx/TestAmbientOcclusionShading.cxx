@@ -41,8 +41,10 @@ vtkSmartPointer<vtkImageData> SmallVolume()
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetDimensions(2, 2, 2);
   image->GetPointData()->SetScalars(Array("Density", { 0, 100, 200, 300, 400, 500, 600, 700 }));
-  image->GetPointData()->AddArray(Array("AmbientOcclusion", { 1, 0.5f, 0.25f, 1, 0.5f, 0.25f, 1, 0 }));
-  image->GetPointData()->AddArray(Array("Variance", { 0, 1000, 2000, 3000, 4000, 5000, 6000, 7000 }));
+  image->GetPointData()->AddArray(
+    Array("AmbientOcclusion", { 1, 0.5f, 0.25f, 1, 0.5f, 0.25f, 1, 0 }));
+  image->GetPointData()->AddArray(
+    Array("Variance", { 0, 1000, 2000, 3000, 4000, 5000, 6000, 7000 }));
   return image;
 }
 
@@ -59,7 +61,8 @@ TEST(AmbientOcclusionShadingFilter, VolumesGetRuizEquation5AndTheVarianceModulat
   opacity->AddPoint(700, 1.0);
   shading->SetOpacityTransferFunction(opacity);
   shading->Update();
-  auto* rgba = vtkUnsignedCharArray::SafeDownCast(vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGBA"));
+  auto* rgba = vtkUnsignedCharArray::SafeDownCast(
+    vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGBA"));
   ASSERT_NE(rgba, nullptr);
   ASSERT_EQ(rgba->GetNumberOfComponents(), 4);
   for (vtkIdType i = 0; i < 8; ++i)
@@ -72,7 +75,10 @@ TEST(AmbientOcclusionShadingFilter, VolumesGetRuizEquation5AndTheVarianceModulat
     const double m = std::min(1.0, i * 1000.0 / 4000.0);
     EXPECT_NEAR(rgba->GetComponent(i, 3), m * 255.0, 1.0) << i;
   }
-  EXPECT_EQ(std::string(vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetScalars()->GetName()), "ShadedRGBA");
+  EXPECT_EQ(
+    std::string(
+      vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetScalars()->GetName()),
+    "ShadedRGBA");
 }
 
 TEST(AmbientOcclusionShadingFilter, TheVarianceModulationIsClampedBelowFullOpacity)
@@ -88,10 +94,12 @@ TEST(AmbientOcclusionShadingFilter, TheVarianceModulationIsClampedBelowFullOpaci
   opacity->AddPoint(700, 0.4);
   shading->SetOpacityTransferFunction(opacity);
   shading->Update();
-  vtkDataArray* rgba = vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGBA");
+  vtkDataArray* rgba =
+    vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGBA");
   ASSERT_NE(rgba, nullptr);
   for (vtkIdType i = 0; i < 8; ++i)
-    EXPECT_NEAR(rgba->GetComponent(i, 3), 0.4 * std::min(1.0, i * 1000.0 / 4000.0) * 255.0, 1.0) << i;
+    EXPECT_NEAR(rgba->GetComponent(i, 3), 0.4 * std::min(1.0, i * 1000.0 / 4000.0) * 255.0, 1.0)
+      << i;
 }
 
 TEST(AmbientOcclusionShadingFilter, SurfacesGetColourTimesAmbientOcclusionTimesShadow)
@@ -106,7 +114,8 @@ TEST(AmbientOcclusionShadingFilter, SurfacesGetColourTimesAmbientOcclusionTimesS
   vtkNew<vtkAmbientOcclusionShading> shading;
   shading->SetInputData(surface);
   shading->Update();
-  vtkDataArray* rgb = vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGB");
+  vtkDataArray* rgb =
+    vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGB");
   ASSERT_NE(rgb, nullptr);
   const double expected[] = { 255, 127.5, 25.5, 0 }; // white x AO x shadow
   for (vtkIdType i = 0; i < 4; ++i)
@@ -115,8 +124,10 @@ TEST(AmbientOcclusionShadingFilter, SurfacesGetColourTimesAmbientOcclusionTimesS
 
 TEST(AmbientOcclusionShadingFilter, RejectsBadInputWithAClearError)
 {
-  auto check = [](vtkDataSet* input, const std::function<void(vtkAmbientOcclusionShading*)>& configure,
-                 const std::string& words) {
+  auto check = [](vtkDataSet* input,
+                 const std::function<void(vtkAmbientOcclusionShading*)>& configure,
+                 const std::string& words)
+  {
     vtkNew<vtkAmbientOcclusionShading> shading;
     vtkNew<MessageCatcher> catcher;
     catcher->Watch(shading);
@@ -129,34 +140,55 @@ TEST(AmbientOcclusionShadingFilter, RejectsBadInputWithAClearError)
   };
   auto noAO = SmallVolume();
   noAO->GetPointData()->RemoveArray("AmbientOcclusion");
-  check(noAO, [](vtkAmbientOcclusionShading*) {}, "AmbientOcclusion");
+  check(
+    noAO, [](vtkAmbientOcclusionShading*) {}, "AmbientOcclusion");
   auto noVariance = SmallVolume();
   noVariance->GetPointData()->RemoveArray("Variance");
-  check(noVariance, [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); }, "Variance");
-  check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetGamma(0); }, "Gamma");
-  check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetAmbientIntensity(-1); }, "AmbientIntensity");
-  check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetColorPreset(7); }, "ColorPreset");
-  check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetScalarsArrayName("Nope"); }, "Nope");
-  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
-  check(SmallVolume(), [&](vtkAmbientOcclusionShading* s) { s->SetScalarRange(nan, 700); }, "ScalarRange must be finite");
-  check(SmallVolume(), [&](vtkAmbientOcclusionShading* s) { s->SetOpacityRamp(0, nan); }, "OpacityRamp must be finite");
+  check(
+    noVariance, [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); }, "Variance");
+  check(
+    SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetGamma(0); }, "Gamma");
+  check(
+    SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetAmbientIntensity(-1); },
+    "AmbientIntensity");
+  check(
+    SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetColorPreset(7); }, "ColorPreset");
+  check(
+    SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetScalarsArrayName("Nope"); }, "Nope");
+  const double nan = std::numeric_limits<double>::quiet_NaN(),
+               inf = std::numeric_limits<double>::infinity();
+  check(
+    SmallVolume(), [&](vtkAmbientOcclusionShading* s) { s->SetScalarRange(nan, 700); },
+    "ScalarRange must be finite");
+  check(
+    SmallVolume(), [&](vtkAmbientOcclusionShading* s) { s->SetOpacityRamp(0, nan); },
+    "OpacityRamp must be finite");
   auto infScalar = SmallVolume();
   infScalar->GetPointData()->GetScalars()->SetComponent(5, 0, inf);
-  check(infScalar, [](vtkAmbientOcclusionShading*) {}, "Array 'Density' has 1 NaN or infinite values (the first at point 5)");
+  check(
+    infScalar, [](vtkAmbientOcclusionShading*) {},
+    "Array 'Density' has 1 NaN or infinite values (the first at point 5)");
   auto nanAO = SmallVolume();
   nanAO->GetPointData()->GetArray("AmbientOcclusion")->SetComponent(3, 0, nan);
-  check(nanAO, [](vtkAmbientOcclusionShading*) {}, "Array 'AmbientOcclusion' has 1 NaN");
+  check(
+    nanAO, [](vtkAmbientOcclusionShading*) {}, "Array 'AmbientOcclusion' has 1 NaN");
   auto nanVariance = SmallVolume();
   nanVariance->GetPointData()->GetArray("Variance")->SetComponent(2, 0, nan);
-  check(nanVariance, [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); }, "Array 'Variance' has 1 NaN");
-  check(SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetNumberOfThreads(-2); }, "NumberOfThreads");
+  check(
+    nanVariance, [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); },
+    "Array 'Variance' has 1 NaN");
+  check(
+    SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetNumberOfThreads(-2); },
+    "NumberOfThreads");
   // Arrays with fewer or more values than the points (read past their end before).
   const vtkIdType points = SmallVolume()->GetNumberOfPoints();
   for (const char* name : { "Density", "AmbientOcclusion", "Variance" })
     for (vtkIdType tuples : { vtkIdType(3), points - 1, points + 1 })
-      check(WithPointArrayResized(SmallVolume(), name, tuples), [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); },
-        std::string("Array '") + name + "' has " + std::to_string(tuples) + " tuples for the input's " +
-          std::to_string(points) + " points");
+      check(
+        WithPointArrayResized(SmallVolume(), name, tuples),
+        [](vtkAmbientOcclusionShading* s) { s->ModulateOpacityOn(); },
+        std::string("Array '") + name + "' has " + std::to_string(tuples) +
+          " tuples for the input's " + std::to_string(points) + " points");
 }
 
 TEST(AmbientOcclusionShadingFilter, AnyNumberOfThreadsGivesTheSameColours)
@@ -184,7 +216,8 @@ TEST(AmbientOcclusionShadingFilter, AnyNumberOfThreadsGivesTheSameColours)
     shading->ModulateOpacityOn();
     shading->SetNumberOfThreads(threads);
     shading->Update();
-    vtkDataArray* rgba = vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGBA");
+    vtkDataArray* rgba =
+      vtkDataSet::SafeDownCast(shading->GetOutput())->GetPointData()->GetArray("ShadedRGBA");
     ASSERT_NE(rgba, nullptr);
     ASSERT_EQ(rgba->GetNumberOfTuples(), n);
     const auto* bytes = static_cast<const unsigned char*>(rgba->GetVoidPointer(0));

@@ -8,9 +8,9 @@
 #include "vtkOcclusionSweeping.h"
 #include "vtkVolumetricAmbientOcclusion.h"
 
-#include "vtkFlyingEdges3D.h"
-#include "vtkFloatArray.h"
 #include "vtkDataSet.h"
+#include "vtkFloatArray.h"
+#include "vtkFlyingEdges3D.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationInformationVectorKey.h"
@@ -32,7 +32,8 @@ vtkSmartPointer<vtkFloatArray> Uncached(vtkFloatArray* array)
   auto copy = vtkSmartPointer<vtkFloatArray>::New();
   copy->SetNumberOfComponents(array->GetNumberOfComponents());
   copy->SetNumberOfTuples(array->GetNumberOfTuples());
-  std::copy(array->GetPointer(0), array->GetPointer(0) + array->GetNumberOfValues(), copy->GetPointer(0));
+  std::copy(
+    array->GetPointer(0), array->GetPointer(0) + array->GetNumberOfValues(), copy->GetPointer(0));
   return copy;
 }
 
@@ -48,8 +49,10 @@ void ExpectCachedRangesOfVtk(vtkDataSet* output, int expectedArrays)
       continue;
     SCOPED_TRACE(array->GetName());
     ASSERT_GT(array->GetNumberOfTuples(), 0);
-    EXPECT_TRUE(array->GetInformation()->Has(vtkAbstractArray::PER_COMPONENT())) << "no cached range";
-    EXPECT_TRUE(array->GetInformation()->Has(vtkAbstractArray::PER_FINITE_COMPONENT())) << "no cached range";
+    EXPECT_TRUE(array->GetInformation()->Has(vtkAbstractArray::PER_COMPONENT()))
+      << "no cached range";
+    EXPECT_TRUE(array->GetInformation()->Has(vtkAbstractArray::PER_FINITE_COMPONENT()))
+      << "no cached range";
     auto fresh = Uncached(array);
     ASSERT_FALSE(fresh->GetInformation()->Has(vtkAbstractArray::PER_COMPONENT()));
     const int components = array->GetNumberOfComponents();
@@ -118,8 +121,9 @@ TEST(CachedRanges, VolumetricOutputsEqualVtksRangesAndModifiedDropsThem)
 TEST(CachedRanges, RangesTheMomentMethodsKeepEqualVtksRanges)
 {
   auto input = Phantom();
-  for (const int method : { vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, vtkVolumetricAmbientOcclusion::CHEBYSHEV,
-         vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION })
+  for (const int method :
+    { vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, vtkVolumetricAmbientOcclusion::CHEBYSHEV,
+      vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION })
   {
     for (const bool variance : { false, true })
     {

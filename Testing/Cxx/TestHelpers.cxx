@@ -26,8 +26,9 @@ bool HaveDataFile(const std::string& relative)
 
 std::string MissingDataMessage(const std::string& relative)
 {
-  return relative + " is not shipped in Data/: configure with -DVAO_EXTRA_DATA_DIR=DIR, DIR holding " +
-    relative + " (VAO_EXTRA_DATA_DIR is now '" + VAO_EXTRA_DATA_DIR + "')";
+  return relative +
+    " is not shipped in Data/: configure with -DVAO_EXTRA_DATA_DIR=DIR, DIR holding " + relative +
+    " (VAO_EXTRA_DATA_DIR is now '" + VAO_EXTRA_DATA_DIR + "')";
 }
 
 vtkSmartPointer<vtkImageData> ReadMetaImage(const std::string& path)
@@ -48,7 +49,8 @@ std::vector<double> Values(vtkDataArray* array)
   return values;
 }
 
-void SetDensity(vtkImageData* image, vtkDataArray* values, const std::function<double(int, int, int)>& f)
+void SetDensity(
+  vtkImageData* image, vtkDataArray* values, const std::function<double(int, int, int)>& f)
 {
   const int* d = image->GetDimensions();
   values->SetName("Density");
@@ -63,18 +65,22 @@ void SetDensity(vtkImageData* image, vtkDataArray* values, const std::function<d
 }
 
 vtkSmartPointer<vtkImageData> Ball(vtkDataArray* values, const std::array<int, 3>& dims,
-  const std::array<double, 3>& centre, double radius, const std::function<double(bool, int, int, int)>& value)
+  const std::array<double, 3>& centre, double radius,
+  const std::function<double(bool, int, int, int)>& value)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetDimensions(dims[0], dims[1], dims[2]);
-  SetDensity(image, values, [&](int i, int j, int k) {
-    const double dx = i - centre[0], dy = j - centre[1], dz = k - centre[2];
-    return value(std::sqrt(dx * dx + dy * dy + dz * dz) < radius, i, j, k);
-  });
+  SetDensity(image, values,
+    [&](int i, int j, int k)
+    {
+      const double dx = i - centre[0], dy = j - centre[1], dz = k - centre[2];
+      return value(std::sqrt(dx * dx + dy * dy + dz * dz) < radius, i, j, k);
+    });
   return image;
 }
 
-vtkSmartPointer<vtkDataSet> WithPointArrayResized(vtkDataSet* data, const char* name, vtkIdType tuples)
+vtkSmartPointer<vtkDataSet> WithPointArrayResized(
+  vtkDataSet* data, const char* name, vtkIdType tuples)
 {
   vtkSmartPointer<vtkDataSet> copy = vtk::TakeSmartPointer(data->NewInstance());
   copy->DeepCopy(data);

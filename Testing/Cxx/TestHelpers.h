@@ -60,16 +60,19 @@ std::vector<double> Values(vtkDataArray* array);
 
 /// Fills `values` (any numeric array) with f(i, j, k) over the image's dimensions, x
 /// fastest, names it "Density" and makes it the image's point scalars.
-void SetDensity(vtkImageData* image, vtkDataArray* values, const std::function<double(int, int, int)>& f);
+void SetDensity(
+  vtkImageData* image, vtkDataArray* values, const std::function<double(int, int, int)>& f);
 
 /// A ball in an image of `dims` points (origin 0, spacing 1): the points closer than
 /// `radius` to `centre` (both in index units) are inside it. Its "Density" scalars, of
 /// `values`' type, are value(inside, i, j, k) at point (i, j, k).
 vtkSmartPointer<vtkImageData> Ball(vtkDataArray* values, const std::array<int, 3>& dims,
-  const std::array<double, 3>& centre, double radius, const std::function<double(bool, int, int, int)>& value);
+  const std::array<double, 3>& centre, double radius,
+  const std::function<double(bool, int, int, int)>& value);
 
 /// A copy of `data` whose point array `name` holds `tuples` tuples (its first ones, then
 /// zeros): a point array that does not fit the points, which VTK lets a script attach.
-vtkSmartPointer<vtkDataSet> WithPointArrayResized(vtkDataSet* data, const char* name, vtkIdType tuples);
+vtkSmartPointer<vtkDataSet> WithPointArrayResized(
+  vtkDataSet* data, const char* name, vtkIdType tuples);
 
 } // namespace vaotest

@@ -40,7 +40,8 @@ std::vector<double> Openness(vtkImageData* image, double radius, const Configure
 
 Configure MethodOnly(int method, int query = vtkVolumetricAmbientOcclusion::VOXEL_VALUE)
 {
-  return [=](vtkVolumetricAmbientOcclusion* f) {
+  return [=](vtkVolumetricAmbientOcclusion* f)
+  {
     f->SetMethod(method);
     f->SetQueryMode(query);
   };
@@ -51,7 +52,8 @@ struct Rmse
   double all, visible;
 };
 
-Rmse Compare(const std::vector<double>& estimate, const std::vector<double>& exact, const std::vector<double>& values)
+Rmse Compare(const std::vector<double>& estimate, const std::vector<double>& exact,
+  const std::vector<double>& values)
 {
   const auto range = std::minmax_element(values.begin(), values.end());
   const double threshold = *range.first + 0.1 * (*range.second - *range.first);
@@ -91,8 +93,8 @@ void AccuracyOf(const char* scan, const std::string& file, double radius)
   for (const Row& row : rows)
   {
     const Rmse e = Compare(Openness(image, radius, MethodOnly(row.method)), exact, values);
-    std::cout << "| " << scan << " | " << radius << " | " << row.name << " | " << e.all << " | " << e.visible << " |"
-              << std::endl;
+    std::cout << "| " << scan << " | " << radius << " | " << row.name << " | " << e.all << " | "
+              << e.visible << " |" << std::endl;
     if (row.method == vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF)
     {
       EXPECT_LE(e.all, 0.05) << scan << " R " << radius;
@@ -105,12 +107,14 @@ void AccuracyOf(const char* scan, const std::string& file, double radius)
   }
   // The smoothed query: each method against Exact Box with the same query.
   const int smoothed = vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE;
-  const auto exactSmoothed = Openness(image, radius, MethodOnly(vtkVolumetricAmbientOcclusion::EXACT_BOX, smoothed));
+  const auto exactSmoothed =
+    Openness(image, radius, MethodOnly(vtkVolumetricAmbientOcclusion::EXACT_BOX, smoothed));
   for (const Row& row : { rows[0], rows[1] })
   {
-    const Rmse e = Compare(Openness(image, radius, MethodOnly(row.method, smoothed)), exactSmoothed, values);
-    std::cout << "| " << scan << " | " << radius << " | " << row.name << ", smoothed query | " << e.all << " | "
-              << e.visible << " |" << std::endl;
+    const Rmse e =
+      Compare(Openness(image, radius, MethodOnly(row.method, smoothed)), exactSmoothed, values);
+    std::cout << "| " << scan << " | " << radius << " | " << row.name << ", smoothed query | "
+              << e.all << " | " << e.visible << " |" << std::endl;
     if (row.method == vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF)
     {
       EXPECT_LE(e.all, 0.05);
@@ -157,19 +161,24 @@ TEST(HistogramCdfAccuracy, ToothWith256BinsIsExactBox)
   ASSERT_EQ(tooth->GetNumberOfPoints(), 103 * 94 * 161);
   for (double radius : { 2.0, 5.0 })
   {
-    const auto exact = Openness(tooth, radius, MethodOnly(vtkVolumetricAmbientOcclusion::EXACT_BOX));
-    const auto histogram = Openness(tooth, radius, [](vtkVolumetricAmbientOcclusion* f) {
-      f->SetMethod(vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF);
-      f->SetNumberOfBins(256);
-    });
+    const auto exact =
+      Openness(tooth, radius, MethodOnly(vtkVolumetricAmbientOcclusion::EXACT_BOX));
+    const auto histogram = Openness(tooth, radius,
+      [](vtkVolumetricAmbientOcclusion* f)
+      {
+        f->SetMethod(vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF);
+        f->SetNumberOfBins(256);
+      });
     ASSERT_EQ(histogram.size(), exact.size());
     double largest = 0.0;
     for (size_t i = 0; i < exact.size(); ++i)
       largest = std::max(largest, std::abs(histogram[i] - exact[i]));
-    std::cout << "tooth R = " << radius << ": largest difference from Exact Box " << largest << std::endl;
+    std::cout << "tooth R = " << radius << ": largest difference from Exact Box " << largest
+              << std::endl;
     EXPECT_LE(largest, 1e-6);
     // At the default 64 bins it is not exact, but close.
-    const auto coarse = Openness(tooth, radius, MethodOnly(vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF));
+    const auto coarse =
+      Openness(tooth, radius, MethodOnly(vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF));
     double sq = 0.0;
     for (size_t i = 0; i < exact.size(); ++i)
       sq += (coarse[i] - exact[i]) * (coarse[i] - exact[i]);

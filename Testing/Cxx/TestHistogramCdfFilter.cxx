@@ -17,7 +17,8 @@ using namespace vaotest;
 namespace
 {
 
-vtkSmartPointer<vtkImageData> WholeRun(int dims[3], const std::function<void(vtkVolumetricAmbientOcclusion*)>& configure)
+vtkSmartPointer<vtkImageData> WholeRun(
+  int dims[3], const std::function<void(vtkVolumetricAmbientOcclusion*)>& configure)
 {
   vtkNew<vtkAmbientOcclusionPhantom> phantom;
   phantom->SetDimensions(dims[0], dims[1], dims[2]);
@@ -31,13 +32,15 @@ vtkSmartPointer<vtkImageData> WholeRun(int dims[3], const std::function<void(vtk
 }
 
 /// Every piece or sub-extent of a fresh pipeline equals the whole run, voxel for voxel.
-void ExpectStreamingEqualsWhole(const std::function<void(vtkVolumetricAmbientOcclusion*)>& configure)
+void ExpectStreamingEqualsWhole(
+  const std::function<void(vtkVolumetricAmbientOcclusion*)>& configure)
 {
   int dims[3] = { 34, 30, 37 };
   auto whole = WholeRun(dims, configure);
   const auto wholeAO = Values(whole->GetPointData()->GetArray("AmbientOcclusion"));
   ASSERT_EQ(static_cast<int>(wholeAO.size()), dims[0] * dims[1] * dims[2]);
-  auto expectMatches = [&](vtkImageData* out, const std::string& what) {
+  auto expectMatches = [&](vtkImageData* out, const std::string& what)
+  {
     const int* e = out->GetExtent();
     const auto ao = Values(out->GetPointData()->GetArray("AmbientOcclusion"));
     ASSERT_EQ(static_cast<vtkIdType>(ao.size()), out->GetNumberOfPoints()) << what;
@@ -45,7 +48,8 @@ void ExpectStreamingEqualsWhole(const std::function<void(vtkVolumetricAmbientOcc
     for (int k = e[4]; k <= e[5]; ++k)
       for (int j = e[2]; j <= e[3]; ++j)
         for (int i = e[0]; i <= e[1]; ++i, ++id)
-          ASSERT_EQ(ao[id], wholeAO[(vtkIdType(k) * dims[1] + j) * dims[0] + i]) << what << " " << i << "," << j << "," << k;
+          ASSERT_EQ(ao[id], wholeAO[(vtkIdType(k) * dims[1] + j) * dims[0] + i])
+            << what << " " << i << "," << j << "," << k;
   };
   for (int pieces : { 2, 3, 5 })
   {
@@ -57,10 +61,12 @@ void ExpectStreamingEqualsWhole(const std::function<void(vtkVolumetricAmbientOcc
     for (int piece = 0; piece < pieces; ++piece)
     {
       filter->UpdatePiece(piece, pieces, 0);
-      expectMatches(filter->GetOutput(), "piece " + std::to_string(piece) + "/" + std::to_string(pieces));
+      expectMatches(
+        filter->GetOutput(), "piece " + std::to_string(piece) + "/" + std::to_string(pieces));
     }
   }
-  const int extents[][6] = { { 0, 33, 0, 29, 10, 12 }, { 5, 9, 0, 29, 0, 36 }, { 12, 20, 3, 9, 15, 30 } };
+  const int extents[][6] = { { 0, 33, 0, 29, 10, 12 }, { 5, 9, 0, 29, 0, 36 },
+    { 12, 20, 3, 9, 15, 30 } };
   for (const auto& wanted : extents)
   {
     vtkNew<vtkAmbientOcclusionPhantom> source;
@@ -70,7 +76,8 @@ void ExpectStreamingEqualsWhole(const std::function<void(vtkVolumetricAmbientOcc
     configure(streamed);
     streamed->UpdateExtent(wanted);
     for (int a = 0; a < 6; ++a)
-      ASSERT_EQ(streamed->GetOutput()->GetExtent()[a], wanted[a]) << "the output is not the requested extent";
+      ASSERT_EQ(streamed->GetOutput()->GetExtent()[a], wanted[a])
+        << "the output is not the requested extent";
     expectMatches(streamed->GetOutput(), "extent");
   }
 }
@@ -88,24 +95,29 @@ TEST(HistogramCdfFilter, IsTheDefaultMethod)
 TEST(HistogramCdfFilter, StreamedPiecesAndExtentsEqualTheWholeRun)
 {
   ExpectStreamingEqualsWhole([](vtkVolumetricAmbientOcclusion* f) { f->SetRadius(4); });
-  ExpectStreamingEqualsWhole([](vtkVolumetricAmbientOcclusion* f) {
-    f->SetRadius(3);
-    f->SetNumberOfBins(7);
-    f->SetQueryMode(vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE);
-    f->SetQuerySmoothing(1.8);
-  });
+  ExpectStreamingEqualsWhole(
+    [](vtkVolumetricAmbientOcclusion* f)
+    {
+      f->SetRadius(3);
+      f->SetNumberOfBins(7);
+      f->SetQueryMode(vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE);
+      f->SetQuerySmoothing(1.8);
+    });
 }
 
 TEST(HistogramCdfFilter, TheSmoothedQueryStreamsWithEveryMethod)
 {
   // A window (ceil(3 x 2) = 6 voxels) wider than the radius: the input must grow by it.
-  for (int method : { vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, vtkVolumetricAmbientOcclusion::EXACT_BOX })
-    ExpectStreamingEqualsWhole([method](vtkVolumetricAmbientOcclusion* f) {
-      f->SetMethod(method);
-      f->SetRadius(2);
-      f->SetQueryMode(vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE);
-      f->SetQuerySmoothing(2.0);
-    });
+  for (int method :
+    { vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, vtkVolumetricAmbientOcclusion::EXACT_BOX })
+    ExpectStreamingEqualsWhole(
+      [method](vtkVolumetricAmbientOcclusion* f)
+      {
+        f->SetMethod(method);
+        f->SetRadius(2);
+        f->SetQueryMode(vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE);
+        f->SetQuerySmoothing(2.0);
+      });
 }
 
 TEST(HistogramCdfFilter, TheSmoothedQueryIsInVoxelsWhateverTheSpacing)
@@ -115,12 +127,14 @@ TEST(HistogramCdfFilter, TheSmoothedQueryIsInVoxelsWhateverTheSpacing)
   for (double sigma : { 0.7, 1.0, 2.5 })
   {
     auto image = RandomImage(11, 9, 8, 7);
-    const FilterRun run = RunFilter(image, [sigma](vtkVolumetricAmbientOcclusion* f) {
-      f->SetMethod(vtkVolumetricAmbientOcclusion::EXACT_BOX);
-      f->SetRadius(2);
-      f->SetQueryMode(vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE);
-      f->SetQuerySmoothing(sigma);
-    });
+    const FilterRun run = RunFilter(image,
+      [sigma](vtkVolumetricAmbientOcclusion* f)
+      {
+        f->SetMethod(vtkVolumetricAmbientOcclusion::EXACT_BOX);
+        f->SetRadius(2);
+        f->SetQueryMode(vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE);
+        f->SetQuerySmoothing(sigma);
+      });
     ASSERT_TRUE(run.errors.empty());
     const auto ao = Values(run.output->GetPointData()->GetArray("AmbientOcclusion"));
     const auto v = Values(image->GetPointData()->GetScalars());
@@ -137,7 +151,9 @@ TEST(HistogramCdfFilter, TheSmoothedQueryIsInVoxelsWhateverTheSpacing)
             for (int j = std::max(0, y - w); j <= std::min(n[1] - 1, y + w); ++j)
               for (int i = std::max(0, x - w); i <= std::min(n[0] - 1, x + w); ++i)
               {
-                const long double g = std::exp(-((i - x) * (i - x) + (j - y) * (j - y) + (k - z) * (k - z)) / (2.0L * sigma * sigma));
+                const long double g =
+                  std::exp(-((i - x) * (i - x) + (j - y) * (j - y) + (k - z) * (k - z)) /
+                    (2.0L * sigma * sigma));
                 num += g * at(i, j, k);
                 den += g;
               }
@@ -152,7 +168,8 @@ TEST(HistogramCdfFilter, TheSmoothedQueryIsInVoxelsWhateverTheSpacing)
                 total += 1;
                 below += at(i, j, k) <= q ? 1 : 0;
               }
-          ASSERT_NEAR(ao[id], below / total, 1e-6) << "sigma " << sigma << " voxel " << x << "," << y << "," << z;
+          ASSERT_NEAR(ao[id], below / total, 1e-6)
+            << "sigma " << sigma << " voxel " << x << "," << y << "," << z;
         }
   }
 }
@@ -160,21 +177,30 @@ TEST(HistogramCdfFilter, TheSmoothedQueryIsInVoxelsWhateverTheSpacing)
 TEST(HistogramCdfFilter, RejectsBadBinsAndSmoothing)
 {
   for (int bins : { -3, 0, 1, 1025, 100000 })
-    ExpectRejected(RandomImage(6, 6, 6, 1), [bins](vtkVolumetricAmbientOcclusion* f) { f->SetNumberOfBins(bins); },
+    ExpectRejected(
+      RandomImage(6, 6, 6, 1),
+      [bins](vtkVolumetricAmbientOcclusion* f) { f->SetNumberOfBins(bins); },
       "NumberOfBins must lie in [2, 1024]");
   for (double sigma : { 0.0, -1.0, std::nan(""), double(INFINITY), 150.0 })
-    ExpectRejected(RandomImage(6, 6, 6, 1), [sigma](vtkVolumetricAmbientOcclusion* f) {
-      f->SetQueryMode(vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE);
-      f->SetQuerySmoothing(sigma);
-    }, "QuerySmoothing");
-  ExpectRejected(RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) { f->SetQueryMode(3); },
+    ExpectRejected(
+      RandomImage(6, 6, 6, 1),
+      [sigma](vtkVolumetricAmbientOcclusion* f)
+      {
+        f->SetQueryMode(vtkVolumetricAmbientOcclusion::SMOOTHED_VALUE);
+        f->SetQuerySmoothing(sigma);
+      },
+      "QuerySmoothing");
+  ExpectRejected(
+    RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) { f->SetQueryMode(3); },
     "Unknown QueryMode");
   // Bins that another method ignores are no error for it.
-  const FilterRun run = RunFilter(RandomImage(6, 6, 6, 1), [](vtkVolumetricAmbientOcclusion* f) {
-    f->SetMethod(vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF);
-    f->SetRadius(1);
-    f->SetNumberOfBins(0);
-  });
+  const FilterRun run = RunFilter(RandomImage(6, 6, 6, 1),
+    [](vtkVolumetricAmbientOcclusion* f)
+    {
+      f->SetMethod(vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF);
+      f->SetRadius(1);
+      f->SetNumberOfBins(0);
+    });
   EXPECT_TRUE(run.errors.empty());
   EXPECT_EQ(run.output->GetNumberOfPoints(), 216);
 }
@@ -187,7 +213,8 @@ TEST(HistogramCdfFilter, NonFiniteValuesAreNamed)
   values->SetName("Density");
   values->SetValue(100, std::nanf(""));
   image->GetPointData()->SetScalars(values);
-  ExpectRejected(image, [](vtkVolumetricAmbientOcclusion* f) { f->SetRadius(2); },
+  ExpectRejected(
+    image, [](vtkVolumetricAmbientOcclusion* f) { f->SetRadius(2); },
     "NaN or infinite values (the first at voxel 7, 2, 7)");
 }
 
@@ -210,7 +237,8 @@ TEST(HistogramCdfFilter, GivenThresholdsStreamOnlyTheGrownPiece)
   ASSERT_EQ(computed->GetNumberOfTuples(), used->GetNumberOfTuples());
   for (vtkIdType i = 0; i < computed->GetNumberOfTuples(); ++i)
     ASSERT_EQ(computed->GetValue(i), used->GetComponent(i, 0)) << i;
-  EXPECT_LT(source->GetOutput()->GetNumberOfPoints(), dims[0] * dims[1] * dims[2]) << "a slab, not the volume";
+  EXPECT_LT(source->GetOutput()->GetNumberOfPoints(), dims[0] * dims[1] * dims[2])
+    << "a slab, not the volume";
 
   // With them given, a sub-extent needs only itself grown by the radius.
   streamed->SetHistogramThresholds(computed);
@@ -225,17 +253,21 @@ TEST(HistogramCdfFilter, GivenThresholdsStreamOnlyTheGrownPiece)
   for (int k = wanted[4]; k <= wanted[5]; ++k)
     for (int j = wanted[2]; j <= wanted[3]; ++j)
       for (int i = wanted[0]; i <= wanted[1]; ++i, ++id)
-        ASSERT_EQ(ao[id], wholeAO[(vtkIdType(k) * dims[1] + j) * dims[0] + i]) << i << "," << j << "," << k;
+        ASSERT_EQ(ao[id], wholeAO[(vtkIdType(k) * dims[1] + j) * dims[0] + i])
+          << i << "," << j << "," << k;
 }
 
 TEST(HistogramCdfFilter, RejectsBadGivenThresholds)
 {
-  for (const std::vector<double>& bad : { std::vector<double>{ 5.0, 1.0 }, std::vector<double>{}, { 0.0, std::nan("") } })
+  for (const std::vector<double>& bad :
+    { std::vector<double>{ 5.0, 1.0 }, std::vector<double>{}, { 0.0, std::nan("") } })
   {
     vtkNew<vtkDoubleArray> thresholds;
     for (const double t : bad)
       thresholds->InsertNextValue(t);
-    ExpectRejected(RandomImage(6, 6, 6, 1), [&](vtkVolumetricAmbientOcclusion* f) { f->SetHistogramThresholds(thresholds); },
+    ExpectRejected(
+      RandomImage(6, 6, 6, 1),
+      [&](vtkVolumetricAmbientOcclusion* f) { f->SetHistogramThresholds(thresholds); },
       "HistogramThresholds");
   }
 }

@@ -7,8 +7,8 @@
 #include "vtkIsosurfaceAmbientOcclusion.h"
 #include "vtkVarianceOcclusionMap.h"
 
-#include "vtkFlyingEdges3D.h"
 #include "vtkFloatArray.h"
+#include "vtkFlyingEdges3D.h"
 #include "vtkImageData.h"
 #include "vtkMultiBlockDataSet.h"
 #include "vtkNew.h"
@@ -39,7 +39,8 @@ vtkSmartPointer<vtkImageData> Slab(int n, int zLo, int zHi)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetDimensions(n, n, n);
-  SetDensity(image, vtkNew<vtkShortArray>(), [&](int, int, int k) { return k >= zLo && k <= zHi ? 1000 : 0; });
+  SetDensity(image, vtkNew<vtkShortArray>(),
+    [&](int, int, int k) { return k >= zLo && k <= zHi ? 1000 : 0; });
   return image;
 }
 
@@ -69,7 +70,8 @@ vtkSmartPointer<vtkImageData> WithNaN(vtkImageData* volume, int i, int j, int k)
 
 TEST(VarianceOcclusionMapFilter, RejectsBadInputWithAClearError)
 {
-  const auto run = [](vtkImageData* volume, int threads) {
+  const auto run = [](vtkImageData* volume, int threads)
+  {
     vtkNew<vtkVarianceOcclusionMap> map;
     vtkNew<MessageCatcher> catcher;
     catcher->Watch(map);
@@ -83,15 +85,20 @@ TEST(VarianceOcclusionMapFilter, RejectsBadInputWithAClearError)
   EXPECT_NE(run(volume, -1).find("NumberOfThreads"), std::string::npos);
   for (vtkIdType tuples : { 11, 1727, 1729 })
   {
-    const std::string error = run(vtkImageData::SafeDownCast(WithPointArrayResized(volume, "Density", tuples)), 0);
-    EXPECT_NE(error.find("Array 'Density' has " + std::to_string(tuples) + " tuples for the input's 1728 points"),
-      std::string::npos) << error;
+    const std::string error =
+      run(vtkImageData::SafeDownCast(WithPointArrayResized(volume, "Density", tuples)), 0);
+    EXPECT_NE(error.find("Array 'Density' has " + std::to_string(tuples) +
+                " tuples for the input's 1728 points"),
+      std::string::npos)
+      << error;
   }
   vtkNew<vtkImageData> shifted;
   shifted->DeepCopy(WithNaN(volume, 2, 9, 4));
   shifted->SetExtent(10, 21, -3, 8, 0, 11);
   const std::string error = run(shifted, 0);
-  EXPECT_NE(error.find("has 1 NaN or infinite values (the first at voxel 12, 6, 4)"), std::string::npos) << error;
+  EXPECT_NE(
+    error.find("has 1 NaN or infinite values (the first at voxel 12, 6, 4)"), std::string::npos)
+    << error;
 }
 
 TEST(VarianceOcclusionMapFilter, OutputsOneImagePerLevelWithItsGeometry)
@@ -137,7 +144,8 @@ TEST(VarianceOcclusionMapFilter, PiecesReadLessAndEqualTheWholePyramid)
   for (bool half : { false, true })
     for (int pieces : { 2, 3, 5 })
     {
-      SCOPED_TRACE(std::string(half ? "half resolution, " : "") + std::to_string(pieces) + " pieces");
+      SCOPED_TRACE(
+        std::string(half ? "half resolution, " : "") + std::to_string(pieces) + " pieces");
       vtkNew<vtkAmbientOcclusionPhantom> phantom;
       phantom->SetDimensions(45, 39, 161);
       vtkNew<vtkVarianceOcclusionMap> whole;
@@ -155,7 +163,8 @@ TEST(VarianceOcclusionMapFilter, PiecesReadLessAndEqualTheWholePyramid)
       {
         map->UpdatePiece(p, pieces, 0);
         const int* read = vtkImageData::SafeDownCast(map->GetInputDataObject(0, 0))->GetExtent();
-        EXPECT_LT((read[5] - read[4] + 1) * (read[3] - read[2] + 1), 39 * 161) << "piece " << p << " read it all";
+        EXPECT_LT((read[5] - read[4] + 1) * (read[3] - read[2] + 1), 39 * 161)
+          << "piece " << p << " read it all";
         for (unsigned l = 0; l < 4; ++l)
         {
           auto* level = vtkImageData::SafeDownCast(map->GetOutput()->GetBlock(l));
@@ -174,8 +183,10 @@ TEST(VarianceOcclusionMapFilter, PiecesReadLessAndEqualTheWholePyramid)
                 for (const char* name : { "Mean", "Variance" })
                 {
                   const double want = LevelValue(full, name, i, j, k);
-                  ASSERT_NEAR(LevelValue(level, name, i, j, k), want, 1e-6 * std::max(1.0, std::abs(want)))
-                    << name << " of level " << l << " at " << i << "," << j << "," << k << ", piece " << p;
+                  ASSERT_NEAR(
+                    LevelValue(level, name, i, j, k), want, 1e-6 * std::max(1.0, std::abs(want)))
+                    << name << " of level " << l << " at " << i << "," << j << "," << k
+                    << ", piece " << p;
                 }
                 int ijk[3] = { i, j, k };
                 covered[l][full->ComputePointId(ijk)] = 1;
@@ -183,7 +194,8 @@ TEST(VarianceOcclusionMapFilter, PiecesReadLessAndEqualTheWholePyramid)
         }
       }
       for (unsigned l = 0; l < 4; ++l)
-        EXPECT_EQ(std::count(covered[l].begin(), covered[l].end(), 1), static_cast<long>(covered[l].size()))
+        EXPECT_EQ(
+          std::count(covered[l].begin(), covered[l].end(), 1), static_cast<long>(covered[l].size()))
           << "level " << l << ": every voxel in some piece";
     }
 }
@@ -227,7 +239,8 @@ TEST(IsosurfaceAmbientOcclusionFilter, ThePyramidIsBuiltOnceWhileOnlyTheQueryCha
   filter->Update();
   filter->SetInputData(0, Contour(volume, 300)); // a new surface
   filter->Update();
-  EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 1) << "the query alone must not rebuild the pyramid";
+  EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 1)
+    << "the query alone must not rebuild the pyramid";
   ASSERT_NE(filter->GetOutput()->GetPointData()->GetArray("Shadow"), nullptr);
   filter->SetNumberOfLevels(3);
   filter->Update();
@@ -239,7 +252,8 @@ TEST(IsosurfaceAmbientOcclusionFilter, ThePyramidIsBuiltOnceWhileOnlyTheQueryCha
   filter->SetVolumeData(copy);
   filter->SetLightDirection(0, 1, 1);
   filter->Update();
-  EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 2) << "a shallow copy of the volume rebuilt the pyramid";
+  EXPECT_EQ(filter->GetNumberOfPyramidBuilds(), 2)
+    << "a shallow copy of the volume rebuilt the pyramid";
   // New values in the array (announced as VTK asks, array->Modified()) or a new grid do.
   copy->GetPointData()->GetScalars()->Modified();
   filter->Update();
@@ -262,7 +276,8 @@ TEST(IsosurfaceAmbientOcclusionFilter, ALightMoveReusesTheAmbientOcclusionAndNot
   filter->ComputeShadowsOn();
   filter->SetLightDirection(0, 0, 1);
   filter->Update();
-  auto array = [&](const char* name) { return filter->GetOutput()->GetPointData()->GetArray(name); };
+  auto array = [&](const char* name)
+  { return filter->GetOutput()->GetPointData()->GetArray(name); };
   auto values = [&](const char* name) { return Values(array(name)); };
   vtkDataArray* first = array("AmbientOcclusion");
   const auto firstAo = values("AmbientOcclusion");
@@ -272,8 +287,10 @@ TEST(IsosurfaceAmbientOcclusionFilter, ALightMoveReusesTheAmbientOcclusionAndNot
   EXPECT_EQ(array("AmbientOcclusion"), first) << "the light does not change the AO: it is reused";
   EXPECT_NE(values("Shadow"), firstShadow);
   // Whatever the AO reads makes it new, equal to a fresh filter's.
-  auto fresh = [&](vtkPolyData* s, double offset) {
-    const ShadeRun run = Shade(s, volume, [&](vtkIsosurfaceAmbientOcclusion* f) { f->SetOffsetFactor(offset); });
+  auto fresh = [&](vtkPolyData* s, double offset)
+  {
+    const ShadeRun run =
+      Shade(s, volume, [&](vtkIsosurfaceAmbientOcclusion* f) { f->SetOffsetFactor(offset); });
     return Values(run.output->GetPointData()->GetArray("AmbientOcclusion"));
   };
   filter->SetOffsetFactor(2.5);
@@ -297,11 +314,14 @@ TEST(IsosurfaceAmbientOcclusionFilter, ShadowsFallBehindASlabAndFollowTheLight)
 {
   auto volume = Slab(40, 18, 22);
   auto surface = Contour(volume, 500);
-  auto meanShadow = [&](double lightZ, bool top) {
-    const ShadeRun run = Shade(surface, volume, [lightZ](vtkIsosurfaceAmbientOcclusion* f) {
-      f->ComputeShadowsOn();
-      f->SetLightDirection(0, 0, lightZ);
-    });
+  auto meanShadow = [&](double lightZ, bool top)
+  {
+    const ShadeRun run = Shade(surface, volume,
+      [lightZ](vtkIsosurfaceAmbientOcclusion* f)
+      {
+        f->ComputeShadowsOn();
+        f->SetLightDirection(0, 0, lightZ);
+      });
     EXPECT_TRUE(run.errors.empty());
     vtkDataArray* shadow = run.output->GetPointData()->GetArray("Shadow");
     double sum = 0;
@@ -355,16 +375,28 @@ TEST(IsosurfaceAmbientOcclusionFilter, RejectsBadInputWithAClearError)
   bare->GetPointData()->Initialize();
   auto flat = Slab(24, 100, 100); // all air
   ExpectRejected(bare, flat, none, "no point normals");
-  ExpectRejected(surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) {
-    f->ComputeShadowsOn();
-    f->SetLightDirection(0, 0, 0);
-  }, "LightDirection");
-  ExpectRejected(surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetNumberOfLevels(0); }, "NumberOfLevels");
-  ExpectRejected(surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetOffsetFactor(-1); }, "OffsetFactor");
-  ExpectRejected(surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetNumberOfThreads(-1); }, "NumberOfThreads");
-  ExpectRejected(surface, WithNaN(volume, 7, 5, 3), none, "NaN or infinite values (the first at voxel 7, 5, 3)");
+  ExpectRejected(
+    surface, volume,
+    [](vtkIsosurfaceAmbientOcclusion* f)
+    {
+      f->ComputeShadowsOn();
+      f->SetLightDirection(0, 0, 0);
+    },
+    "LightDirection");
+  ExpectRejected(
+    surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetNumberOfLevels(0); },
+    "NumberOfLevels");
+  ExpectRejected(
+    surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetOffsetFactor(-1); },
+    "OffsetFactor");
+  ExpectRejected(
+    surface, volume, [](vtkIsosurfaceAmbientOcclusion* f) { f->SetNumberOfThreads(-1); },
+    "NumberOfThreads");
+  ExpectRejected(
+    surface, WithNaN(volume, 7, 5, 3), none, "NaN or infinite values (the first at voxel 7, 5, 3)");
   for (vtkIdType tuples : { 13, 13823, 13825 })
-    ExpectRejected(surface, vtkImageData::SafeDownCast(WithPointArrayResized(volume, "Density", tuples)), none,
+    ExpectRejected(surface,
+      vtkImageData::SafeDownCast(WithPointArrayResized(volume, "Density", tuples)), none,
       "Array 'Density' has " + std::to_string(tuples) + " tuples for the input's 13824 points");
   vtkNew<vtkImageData> twoD;
   twoD->DeepCopy(Slab(24, 8, 12));
@@ -407,8 +439,8 @@ bool Blocked(vtkImageData* volume, double iso, const double p[3], const double d
   for (double s = h; s <= reach; s += 0.5 * h)
   {
     const double q[3] = { p[0] + s * d[0], p[1] + s * d[1], p[2] + s * d[2] };
-    if (q[0] < bounds[0] || q[0] > bounds[1] || q[1] < bounds[2] || q[1] > bounds[3] || q[2] < bounds[4] ||
-      q[2] > bounds[5])
+    if (q[0] < bounds[0] || q[0] > bounds[1] || q[1] < bounds[2] || q[1] > bounds[3] ||
+      q[2] < bounds[4] || q[2] > bounds[5])
       return false;
     if (Trilinear(volume, q) > iso)
       return true;
@@ -440,9 +472,10 @@ TEST(IsosurfaceAmbientOcclusionFilter, FollowsMonteCarloAmbientOcclusionOnTheCtB
       MonteCarloAO(n, 128, rng, [&](const double d[3]) { return Blocked(ct, iso, p, d, reach); }));
   }
   const Agreement agreement = AgreementOf(penner, traced);
-  const double correlation = agreement.correlation, mp = agreement.meanEstimate, mt = agreement.meanReference;
-  std::cout << penner.size() << " bone surface points: correlation " << correlation << ", mean AO " << mp
-            << ", Monte Carlo (reach " << reach << " mm) " << mt << std::endl;
+  const double correlation = agreement.correlation, mp = agreement.meanEstimate,
+               mt = agreement.meanReference;
+  std::cout << penner.size() << " bone surface points: correlation " << correlation << ", mean AO "
+            << mp << ", Monte Carlo (reach " << reach << " mm) " << mt << std::endl;
   EXPECT_GT(correlation, kMinimumBoneCorrelation);
 }
 

@@ -7,8 +7,8 @@
 #include "vtkIsosurfaceAmbientOcclusion.h"
 
 #include "vtkDoubleArray.h"
-#include "vtkFlyingEdges3D.h"
 #include "vtkFloatArray.h"
+#include "vtkFlyingEdges3D.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
@@ -43,7 +43,8 @@ Bone BoneOf(int nx, int ny, int nz)
 }
 
 /// AO and shadows of `surface` on `volume` (one filter each, so nothing is cached).
-std::pair<std::vector<double>, std::vector<double>> Shaded(vtkPolyData* surface, vtkImageData* volume)
+std::pair<std::vector<double>, std::vector<double>> Shaded(
+  vtkPolyData* surface, vtkImageData* volume)
 {
   vtkNew<vtkIsosurfaceAmbientOcclusion> filter;
   filter->SetInputData(0, surface);
@@ -129,7 +130,8 @@ TEST(IsosurfacePoints, NormalsShorterThanThePointsAreRefused)
     filter->Update();
     ASSERT_FALSE(catcher->Errors.empty());
     EXPECT_NE(catcher->Errors[0].find("normals"), std::string::npos) << catcher->Errors[0];
-    EXPECT_NE(catcher->Errors[0].find(std::to_string(n - 7) + " tuples for " + std::to_string(n) + " points"),
+    EXPECT_NE(catcher->Errors[0].find(
+                std::to_string(n - 7) + " tuples for " + std::to_string(n) + " points"),
       std::string::npos)
       << catcher->Errors[0];
     EXPECT_EQ(filter->GetOutput()->GetNumberOfPoints(), 0);

@@ -58,9 +58,11 @@ TEST(OcclusionSweepingFilter, OutputsDistanceOcclusionAndOctants)
   auto ball = CentredBall(25, 7.3);
   const SweepRun run = Sweep(ball, [](vtkOcclusionSweeping* f) { f->OutputOctantVisibilityOn(); });
   ASSERT_TRUE(run.errors.empty()) << run.errors[0];
-  auto* distance = vtkFloatArray::SafeDownCast(run.output->GetPointData()->GetArray("SignedDistance"));
+  auto* distance =
+    vtkFloatArray::SafeDownCast(run.output->GetPointData()->GetArray("SignedDistance"));
   auto* ao = vtkFloatArray::SafeDownCast(run.output->GetPointData()->GetArray("AmbientOcclusion"));
-  auto* octants = vtkFloatArray::SafeDownCast(run.output->GetPointData()->GetArray("OctantVisibility"));
+  auto* octants =
+    vtkFloatArray::SafeDownCast(run.output->GetPointData()->GetArray("OctantVisibility"));
   ASSERT_TRUE(distance && ao && octants);
   EXPECT_EQ(octants->GetNumberOfComponents(), 8);
   ASSERT_NE(run.output->GetPointData()->GetArray("Density"), nullptr);
@@ -72,7 +74,8 @@ TEST(OcclusionSweepingFilter, OutputsDistanceOcclusionAndOctants)
       {
         const bool inside = ball->GetPointData()->GetScalars()->GetComponent(id, 0) > 50;
         ASSERT_EQ(distance->GetValue(id) < 0, inside) << i << "," << j << "," << k;
-        const double exact = 0.5 * (std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c)) - 7.3);
+        const double exact =
+          0.5 * (std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c)) - 7.3);
         ASSERT_NEAR(distance->GetValue(id), exact, 0.5 * 1.5) << "world units, spacing 0.5";
         ASSERT_GE(ao->GetValue(id), 0.0f);
         ASSERT_LE(ao->GetValue(id), 1.0f);
@@ -110,7 +113,8 @@ TEST(OcclusionSweepingFilter, PiecesEqualTheWholeResult)
 
 TEST(OcclusionSweepingFilter, AnIsoValueOffTheDataWarnsAndGivesAnOpenField)
 {
-  const SweepRun run = Sweep(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(1000); });
+  const SweepRun run =
+    Sweep(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(1000); });
   EXPECT_TRUE(run.errors.empty());
   ASSERT_EQ(run.warnings.size(), 1u);
   EXPECT_NE(run.warnings[0].find("does not cross"), std::string::npos);
@@ -118,15 +122,17 @@ TEST(OcclusionSweepingFilter, AnIsoValueOffTheDataWarnsAndGivesAnOpenField)
   EXPECT_EQ(*std::min_element(ao.begin(), ao.end()), 1.0);
 }
 
-void ExpectRejected(vtkImageData* input, const std::function<void(vtkOcclusionSweeping*)>& configure,
-  const std::string& words)
+void ExpectRejected(vtkImageData* input,
+  const std::function<void(vtkOcclusionSweeping*)>& configure, const std::string& words)
 {
   const SweepRun run = Sweep(input, configure);
   ASSERT_FALSE(run.errors.empty()) << "no error for: " << words;
   std::string lower = run.errors[0];
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(
+    lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
   std::string wanted = words;
-  std::transform(wanted.begin(), wanted.end(), wanted.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(
+    wanted.begin(), wanted.end(), wanted.begin(), [](unsigned char c) { return std::tolower(c); });
   EXPECT_NE(lower.find(wanted), std::string::npos) << run.errors[0];
   EXPECT_EQ(run.output->GetNumberOfPoints(), 0);
 }
@@ -142,7 +148,8 @@ TEST(OcclusionSweepingFilter, RejectsBadInputWithAClearError)
   flat->SetDimensions(9, 81, 1);
   ExpectRejected(flat, none, "needs a 3-D volume");
   for (vtkIdType tuples : { 7, 728, 730 })
-    ExpectRejected(vtkImageData::SafeDownCast(WithPointArrayResized(CentredBall(9, 3), "Density", tuples)), none,
+    ExpectRejected(
+      vtkImageData::SafeDownCast(WithPointArrayResized(CentredBall(9, 3), "Density", tuples)), none,
       "Array 'Density' has " + std::to_string(tuples) + " tuples for the input's 729 points");
   auto nan = CentredBall(9, 3);
   vtkNew<vtkFloatArray> values;
@@ -152,16 +159,28 @@ TEST(OcclusionSweepingFilter, RejectsBadInputWithAClearError)
   nan->GetPointData()->SetScalars(values);
   ExpectRejected(nan, none, "NaN");
   ExpectRejected(nan, none, "NaN or infinite values (the first at voxel 4, 4, 0)");
-  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(std::nan("")); }, "iso");
-  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfIterations(0); }, "iteration");
-  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetGamma(0); }, "gamma");
-  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetOpacity(1.5); }, "opacity");
-  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetConvergenceTolerance(-1); }, "tolerance");
-  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) {
-    int none8[8] = { 0, 0, 0, 0, 0, 0, 0, 0 };
-    f->SetOctantMask(none8);
-  }, "octant");
-  ExpectRejected(CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfThreads(-1); }, "NumberOfThreads");
+  ExpectRejected(
+    CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetIsoValue(std::nan("")); }, "iso");
+  ExpectRejected(
+    CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfIterations(0); }, "iteration");
+  ExpectRejected(
+    CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetGamma(0); }, "gamma");
+  ExpectRejected(
+    CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetOpacity(1.5); }, "opacity");
+  ExpectRejected(
+    CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetConvergenceTolerance(-1); },
+    "tolerance");
+  ExpectRejected(
+    CentredBall(9, 3),
+    [](vtkOcclusionSweeping* f)
+    {
+      int none8[8] = { 0, 0, 0, 0, 0, 0, 0, 0 };
+      f->SetOctantMask(none8);
+    },
+    "octant");
+  ExpectRejected(
+    CentredBall(9, 3), [](vtkOcclusionSweeping* f) { f->SetNumberOfThreads(-1); },
+    "NumberOfThreads");
 }
 
 } // namespace
@@ -176,6 +195,7 @@ TEST(OcclusionSweeping, AKernelShortageIsSaidAsTheFiltersOwn)
   EXPECT_EQ(named.find("Not enough memory for the sweeping buffers; "), 0u) << named;
   vao::Status bare = vao::Status::noMemory("x");
   bare.message = "out of memory";
-  const std::string unnamed = vtkAmbientOcclusionArrayInput::KernelError(bare, scalars, "Occlusion sweeping failed");
+  const std::string unnamed =
+    vtkAmbientOcclusionArrayInput::KernelError(bare, scalars, "Occlusion sweeping failed");
   EXPECT_EQ(unnamed.find("Not enough memory for its working buffers; "), 0u) << unnamed;
 }

@@ -10,8 +10,8 @@
 #include "vtkVarianceOcclusionMap.h"
 #include "vtkVolumetricAmbientOcclusion.h"
 
-#include "vtkFlyingEdges3D.h"
 #include "vtkFloatArray.h"
+#include "vtkFlyingEdges3D.h"
 #include "vtkImageData.h"
 #include "vtkMultiBlockDataSet.h"
 #include "vtkNew.h"
@@ -41,8 +41,8 @@ Matrix Rotation(std::array<double, 3> axis, double angle)
     a /= norm;
   const double c = std::cos(angle), s = std::sin(angle), t = 1.0 - c;
   const double x = axis[0], y = axis[1], z = axis[2];
-  return { t * x * x + c, t * x * y - s * z, t * x * z + s * y, t * x * y + s * z, t * y * y + c, t * y * z - s * x,
-    t * x * z - s * y, t * y * z + s * x, t * z * z + c };
+  return { t * x * x + c, t * x * y - s * z, t * x * z + s * y, t * x * y + s * z, t * y * y + c,
+    t * y * z - s * x, t * x * z - s * y, t * y * z + s * x, t * z * z + c };
 }
 
 std::array<double, 3> Times(const Matrix& m, const double v[3])
@@ -53,7 +53,8 @@ std::array<double, 3> Times(const Matrix& m, const double v[3])
 
 /// A ball beside a wall in air, n^3 float voxels of anisotropic spacing; `flat`: the ball
 /// alone, in air of exactly 0.
-vtkSmartPointer<vtkImageData> Scene(int n, const Matrix* direction, const double origin[3], bool flat = false)
+vtkSmartPointer<vtkImageData> Scene(
+  int n, const Matrix* direction, const double origin[3], bool flat = false)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetDimensions(n, n, n);
@@ -61,13 +62,17 @@ vtkSmartPointer<vtkImageData> Scene(int n, const Matrix* direction, const double
   image->SetOrigin(origin[0], origin[1], origin[2]);
   if (direction)
     image->SetDirectionMatrix(direction->data());
-  SetDensity(image, vtkNew<vtkFloatArray>(), [n, flat](int i, int j, int k) {
-    const double ball = std::hypot(i - 0.4 * n, j - 0.5 * n, k - 0.5 * n) < 0.2 * n ? 1000.0 : 0.0;
-    if (flat)
-      return static_cast<float>(std::hypot(i - 0.7 * n, j - 0.7 * n, k - 0.5 * n) < 0.2 * n ? 1000.0 : 0.0);
-    const double wall = i >= 3 * n / 4 && i < 3 * n / 4 + 3 ? 1000.0 : 0.0;
-    return static_cast<float>(std::max(ball, wall) + (i * 7 + j * 3 + k) % 5);
-  });
+  SetDensity(image, vtkNew<vtkFloatArray>(),
+    [n, flat](int i, int j, int k)
+    {
+      const double ball =
+        std::hypot(i - 0.4 * n, j - 0.5 * n, k - 0.5 * n) < 0.2 * n ? 1000.0 : 0.0;
+      if (flat)
+        return static_cast<float>(
+          std::hypot(i - 0.7 * n, j - 0.7 * n, k - 0.5 * n) < 0.2 * n ? 1000.0 : 0.0);
+      const double wall = i >= 3 * n / 4 && i < 3 * n / 4 + 3 ? 1000.0 : 0.0;
+      return static_cast<float>(std::max(ball, wall) + (i * 7 + j * 3 + k) % 5);
+    });
   return image;
 }
 
@@ -112,12 +117,14 @@ TEST(OrientedImages, IsosurfaceAmbientOcclusionOfARotatedSceneIsTheScenesOwn)
   {
     Matrix direction;
     const double* origin;
-    double tolerance; // a quarter turn about z at the origin 0 moves every float exactly
+    double tolerance;  // a quarter turn about z at the origin 0 moves every float exactly
     bool flat = false; // a ball in exact air, where the points read along the axes agree too
   };
   for (const Case& c : { Case{ Rotation({ 0, 0, 1 }, 0.5 * M_PI), zero, 0.0 },
-         Case{ Rotation({ 1, 2, 3 }, 0.7), origin, 2e-5 }, Case{ Rotation({ -2, 1, 0.5 }, 2.5), origin, 2e-5 },
-         Case{ Rotation({ 0.3, -1, 0.2 }, 0.02), origin, 2e-5 }, Case{ Rotation({ 0, 0, 1 }, 0.7), origin, 2e-5, true } })
+         Case{ Rotation({ 1, 2, 3 }, 0.7), origin, 2e-5 },
+         Case{ Rotation({ -2, 1, 0.5 }, 2.5), origin, 2e-5 },
+         Case{ Rotation({ 0.3, -1, 0.2 }, 0.02), origin, 2e-5 },
+         Case{ Rotation({ 0, 0, 1 }, 0.7), origin, 2e-5, true } })
   {
     Matrix exact = c.direction;
     if (c.tolerance == 0.0)
@@ -154,7 +161,8 @@ TEST(OrientedImages, IsosurfaceAmbientOcclusionOfARotatedSceneIsTheScenesOwn)
       for (vtkIdType i = 0; i < n; ++i)
         off += !(std::abs(got[i] - expected[i]) <= c.tolerance);
       // Float points and normals rotated round differently: 2e-6 apart at most (measured).
-      EXPECT_EQ(off, 0) << name << ": " << off << " of " << n << " points differ by more than " << c.tolerance;
+      EXPECT_EQ(off, 0) << name << ": " << off << " of " << n << " points differ by more than "
+                        << c.tolerance;
     }
   }
 }
@@ -176,7 +184,8 @@ TEST(OrientedImages, ASurfaceLeftAlongTheImagesAxesIsRecognised)
     ASSERT_EQ(warnings.size(), 1u) << angle;
     EXPECT_NE(warnings[0].find("direction matrix ignored"), std::string::npos) << warnings[0];
     for (const char* name : { "AmbientOcclusion", "Shadow" })
-      EXPECT_EQ(Values(b.output->GetPointData()->GetArray(name)), Values(a.output->GetPointData()->GetArray(name)))
+      EXPECT_EQ(Values(b.output->GetPointData()->GetArray(name)),
+        Values(a.output->GetPointData()->GetArray(name)))
         << name << " at angle " << angle;
   }
 }
@@ -207,15 +216,18 @@ TEST(OrientedImages, PyramidLevelsLieWhereTheirVoxelsAre)
         {
           // Level voxel (i, j, k) is input voxel first + step * (i, j, k) of the level's extent.
           const double index[3] = { double(i), double(j), double(k) };
-          const double input[3] = { 2.0 + step * (i - e[0]), -3.0 + step * (j - e[2]), 5.0 + step * (k - e[4]) };
+          const double input[3] = { 2.0 + step * (i - e[0]), -3.0 + step * (j - e[2]),
+            5.0 + step * (k - e[4]) };
           double p[3], q[3];
           level->TransformContinuousIndexToPhysicalPoint(index, p);
           turned->TransformContinuousIndexToPhysicalPoint(input, q);
           for (int a3 = 0; a3 < 3; ++a3)
-            ASSERT_NEAR(p[a3], q[a3], 1e-9) << "level " << l << " voxel " << i << " " << j << " " << k;
+            ASSERT_NEAR(p[a3], q[a3], 1e-9)
+              << "level " << l << " voxel " << i << " " << j << " " << k;
         }
     // The levels' values are the axis-aligned scene's, bit for bit.
-    EXPECT_EQ(Values(level->GetPointData()->GetArray("Mean")), Values(same->GetPointData()->GetArray("Mean")));
+    EXPECT_EQ(Values(level->GetPointData()->GetArray("Mean")),
+      Values(same->GetPointData()->GetArray("Mean")));
   }
 }
 
@@ -227,11 +239,13 @@ TEST(OrientedImages, ADirectionThatIsNotARotationIsRefused)
   for (const Matrix& m : { shear, stretch })
   {
     auto image = Scene(12, &m, origin);
-    auto refused = [&](vtkAlgorithm* filter) {
+    auto refused = [&](vtkAlgorithm* filter)
+    {
       vtkNew<MessageCatcher> catcher;
       catcher->Watch(filter);
       filter->Update();
-      EXPECT_NE(catcher->AllErrors().find("is not a rotation"), std::string::npos) << catcher->AllErrors();
+      EXPECT_NE(catcher->AllErrors().find("is not a rotation"), std::string::npos)
+        << catcher->AllErrors();
     };
     vtkNew<vtkVolumetricAmbientOcclusion> volumetric;
     volumetric->SetInputData(image);

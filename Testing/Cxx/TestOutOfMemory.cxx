@@ -74,7 +74,8 @@ void ExpectShortageThenSuccess(vtkAlgorithm* filter, const std::function<void(bo
   set(true);
   filter->Update();
   ASSERT_FALSE(catcher->Errors.empty()) << "no error under the memory limit";
-  EXPECT_NE(catcher->AllErrors().find("Not enough memory"), std::string::npos) << catcher->AllErrors();
+  EXPECT_NE(catcher->AllErrors().find("Not enough memory"), std::string::npos)
+    << catcher->AllErrors();
   EXPECT_EQ(outputPoints(), 0);
   catcher->Errors.clear();
   set(false);
@@ -88,14 +89,17 @@ TEST(OutOfMemory, PhantomSource)
   vtkNew<vtkAmbientOcclusionPhantom> phantom;
   LimitAddressSpace(300);
   ExpectShortageThenSuccess(
-    phantom, [&](bool large) { large ? phantom->SetDimensions(2000, 2000, 2000) : phantom->SetDimensions(24, 24, 24); },
+    phantom,
+    [&](bool large)
+    { large ? phantom->SetDimensions(2000, 2000, 2000) : phantom->SetDimensions(24, 24, 24); },
     [&] { return phantom->GetOutput()->GetNumberOfPoints(); });
   EXPECT_NE(phantom->GetOutput()->GetPointData()->GetArray("Density"), nullptr);
 }
 
 TEST(OutOfMemory, VolumetricAmbientOcclusion)
 {
-  const auto large = TwoValuedBall(400), small = TwoValuedBall(24); // 64 MB of input; 256 MB of output
+  const auto large = TwoValuedBall(400),
+             small = TwoValuedBall(24); // 64 MB of input; 256 MB of output
   vtkNew<vtkVolumetricAmbientOcclusion> filter;
   filter->SetRadius(2);
   LimitAddressSpace(160);
@@ -120,7 +124,8 @@ TEST(OutOfMemory, VolumetricAmbientOcclusionSmoothedQuery)
 
 TEST(OutOfMemory, OcclusionSweeping)
 {
-  const auto large = TwoValuedBall(300), small = TwoValuedBall(24); // 27 MB of input; 4 B + 32 B a voxel more
+  const auto large = TwoValuedBall(300),
+             small = TwoValuedBall(24); // 27 MB of input; 4 B + 32 B a voxel more
   vtkNew<vtkOcclusionSweeping> filter;
   filter->SetIsoValue(100);
   filter->SetOutputOctantVisibility(true);
@@ -137,9 +142,11 @@ TEST(OutOfMemory, VarianceOcclusionMap)
   LimitAddressSpace(300);
   ExpectShortageThenSuccess(
     filter, [&](bool big) { filter->SetInputData(big ? large : small); },
-    [&] {
+    [&]
+    {
       auto* blocks = filter->GetOutput();
-      return blocks && blocks->GetNumberOfBlocks() > 0 ? vtkIdType(blocks->GetNumberOfBlocks()) : vtkIdType(0);
+      return blocks && blocks->GetNumberOfBlocks() > 0 ? vtkIdType(blocks->GetNumberOfBlocks())
+                                                       : vtkIdType(0);
     });
 }
 
@@ -158,7 +165,8 @@ TEST(OutOfMemory, IsosurfaceAmbientOcclusion)
   LimitAddressSpace(300);
   ExpectShortageThenSuccess(
     filter,
-    [&](bool big) {
+    [&](bool big)
+    {
       filter->SetInputData(0, big ? bigContour->GetOutput() : smallContour->GetOutput());
       filter->SetInputData(1, big ? large : small);
     },
@@ -168,7 +176,8 @@ TEST(OutOfMemory, IsosurfaceAmbientOcclusion)
 TEST(OutOfMemory, AmbientOcclusionShading)
 {
   // The input carries an AmbientOcclusion array; the RGBA output needs 4 B a voxel more.
-  auto withAo = [](int n) {
+  auto withAo = [](int n)
+  {
     auto image = TwoValuedBall(n);
     vtkNew<vtkFloatArray> ao;
     ao->SetName("AmbientOcclusion");
@@ -189,7 +198,8 @@ TEST(OutOfMemory, ProbeOutsideSurface)
 {
   // 10 M surface points with normals (240 MB, made before the limit): the points sampled
   // on both sides of each for the vote (480 MB) and the samples do not fit; 500 points do.
-  const auto surfaceOf = [](vtkIdType n) {
+  const auto surfaceOf = [](vtkIdType n)
+  {
     auto surface = vtkSmartPointer<vtkPolyData>::New();
     vtkNew<vtkPoints> points;
     points->SetNumberOfPoints(n);

@@ -5,8 +5,8 @@
 #include "vtkOcclusionSweeping.h"
 #include "vtkProbeOutsideSurface.h"
 
-#include "vtkFlyingEdges3D.h"
 #include "vtkFloatArray.h"
+#include "vtkFlyingEdges3D.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
@@ -33,12 +33,15 @@ vtkSmartPointer<vtkImageData> BallOverFloor()
   image->SetSpacing(0.7, 0.5, 0.6);
   image->SetOrigin(1.5, -2.0, 0.25);
   vtkNew<vtkFloatArray> values;
-  SetDensity(image, values, [](int i, int j, int k) {
-    const double x = 0.7 * i, y = 0.5 * j, z = 0.6 * k;
-    const double ball = 4.0 - std::sqrt((x - 8.0) * (x - 8.0) + (y - 9.5) * (y - 9.5) + (z - 8.5) * (z - 8.5));
-    const double floor = 2.5 - z;
-    return 500.0 + 400.0 * std::clamp(std::max(ball, floor), -1.0, 1.0);
-  });
+  SetDensity(image, values,
+    [](int i, int j, int k)
+    {
+      const double x = 0.7 * i, y = 0.5 * j, z = 0.6 * k;
+      const double ball =
+        4.0 - std::sqrt((x - 8.0) * (x - 8.0) + (y - 9.5) * (y - 9.5) + (z - 8.5) * (z - 8.5));
+      const double floor = 2.5 - z;
+      return 500.0 + 400.0 * std::clamp(std::max(ball, floor), -1.0, 1.0);
+    });
   return image;
 }
 
@@ -83,7 +86,8 @@ double Trilinear(vtkImageData* image, vtkDataArray* field, const double x[3])
   {
     const int di = c & 1, dj = (c >> 1) & 1, dk = (c >> 2) & 1;
     const double w = (di ? t[0] : 1 - t[0]) * (dj ? t[1] : 1 - t[1]) * (dk ? t[2] : 1 - t[2]);
-    const vtkIdType id = (static_cast<vtkIdType>(base[2] + dk) * ny + base[1] + dj) * nx + base[0] + di;
+    const vtkIdType id =
+      (static_cast<vtkIdType>(base[2] + dk) * ny + base[1] + dj) * nx + base[0] + di;
     sum += w * field->GetComponent(id, 0);
   }
   return sum;
@@ -94,7 +98,8 @@ bool Inside(vtkImageData* image, const double x[3])
 {
   double b[6];
   image->GetBounds(b);
-  return x[0] >= b[0] && x[0] <= b[1] && x[1] >= b[2] && x[1] <= b[3] && x[2] >= b[4] && x[2] <= b[5];
+  return x[0] >= b[0] && x[0] <= b[1] && x[1] >= b[2] && x[1] <= b[3] && x[2] >= b[4] &&
+    x[2] <= b[5];
 }
 
 struct ProbeRun
@@ -104,7 +109,8 @@ struct ProbeRun
   std::vector<std::string> errors;
 };
 
-ProbeRun Probe(vtkPolyData* surface, vtkImageData* volume, const std::function<void(vtkProbeOutsideSurface*)>& set)
+ProbeRun Probe(vtkPolyData* surface, vtkImageData* volume,
+  const std::function<void(vtkProbeOutsideSurface*)>& set)
 {
   vtkNew<vtkProbeOutsideSurface> probe;
   vtkNew<MessageCatcher> catcher;
@@ -144,9 +150,8 @@ TEST(ProbeOutsideSurface, SamplesEveryArrayOutsideTheSurface)
   const ProbeRun back = Probe(reversed, field, kDefaults);
   EXPECT_EQ(back.side, -1);
   // Orientation fixed against the (original) normals samples inside instead.
-  const ProbeRun inside = Probe(surface, field, [](vtkProbeOutsideSurface* f) {
-    f->SetOrientation(vtkProbeOutsideSurface::REVERSED_NORMALS);
-  });
+  const ProbeRun inside = Probe(surface, field,
+    [](vtkProbeOutsideSurface* f) { f->SetOrientation(vtkProbeOutsideSurface::REVERSED_NORMALS); });
 
   const double offset = 1.5 * 0.5;
   for (const char* name : { "AmbientOcclusion", "SignedDistance", "Density" })
@@ -203,7 +208,8 @@ TEST(ProbeOutsideSurface, IsBrighterThanTheFieldOnTheSurfaceItself)
   meanOut /= surface->GetNumberOfPoints();
   EXPECT_GT(meanOut, meanOn + 0.1) << meanOn << " " << meanOut;
   // Distance 0 is the field on the surface.
-  const ProbeRun zero = Probe(surface, field, [](vtkProbeOutsideSurface* f) { f->SetDistance(0.0); });
+  const ProbeRun zero =
+    Probe(surface, field, [](vtkProbeOutsideSurface* f) { f->SetDistance(0.0); });
   vtkDataArray* same = zero.output->GetPointData()->GetArray("AmbientOcclusion");
   for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); i += 97)
     EXPECT_NEAR(same->GetComponent(i, 0), onSurface->GetComponent(i, 0), 1e-5);
@@ -214,7 +220,9 @@ TEST(ProbeOutsideSurface, RejectsBadInputWithAClearError)
   const auto field = Swept(BallOverFloor());
   const auto surface = Contour(field);
   const auto expectRejected = [&](vtkPolyData* s, vtkImageData* v,
-                                const std::function<void(vtkProbeOutsideSurface*)>& set, const std::string& words) {
+                                const std::function<void(vtkProbeOutsideSurface*)>& set,
+                                const std::string& words)
+  {
     const ProbeRun run = Probe(s, v, set);
     ASSERT_FALSE(run.errors.empty()) << words;
     EXPECT_NE(run.errors.front().find(words), std::string::npos) << run.errors.front();
@@ -225,16 +233,21 @@ TEST(ProbeOutsideSurface, RejectsBadInputWithAClearError)
   bare->GetPointData()->SetNormals(nullptr);
   bare->GetPointData()->RemoveArray("Normals");
   expectRejected(bare, field, kDefaults, "no point normals");
-  expectRejected(surface, field, [](vtkProbeOutsideSurface* f) { f->SetDistance(-1.0); }, "Distance");
-  expectRejected(surface, field, [](vtkProbeOutsideSurface* f) { f->SetDistance(std::nan("")); }, "Distance");
-  expectRejected(surface, field, [](vtkProbeOutsideSurface* f) { f->SetDistance(INFINITY); }, "Distance");
-  expectRejected(surface, field, [](vtkProbeOutsideSurface* f) { f->SetOrientation(7); }, "Orientation");
+  expectRejected(
+    surface, field, [](vtkProbeOutsideSurface* f) { f->SetDistance(-1.0); }, "Distance");
+  expectRejected(
+    surface, field, [](vtkProbeOutsideSurface* f) { f->SetDistance(std::nan("")); }, "Distance");
+  expectRejected(
+    surface, field, [](vtkProbeOutsideSurface* f) { f->SetDistance(INFINITY); }, "Distance");
+  expectRejected(
+    surface, field, [](vtkProbeOutsideSurface* f) { f->SetOrientation(7); }, "Orientation");
   vtkNew<vtkImageData> empty;
   empty->CopyStructure(field);
   expectRejected(surface, empty, kDefaults, "no point arrays");
   // A volume array that does not fit its points would be read past its end by the probe.
   for (vtkIdType tuples : { vtkIdType(7), field->GetNumberOfPoints() + 1 })
-    expectRejected(surface, vtkImageData::SafeDownCast(WithPointArrayResized(field, "AmbientOcclusion", tuples)),
+    expectRejected(surface,
+      vtkImageData::SafeDownCast(WithPointArrayResized(field, "AmbientOcclusion", tuples)),
       kDefaults, "Array 'AmbientOcclusion' has " + std::to_string(tuples) + " tuples");
   vtkNew<vtkPolyData> shortNormals;
   shortNormals->DeepCopy(surface);

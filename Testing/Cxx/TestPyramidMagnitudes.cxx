@@ -28,7 +28,8 @@ namespace
 vtkSmartPointer<vtkImageData> RippledBall(double scale, double offset)
 {
   return Ball(vtkNew<vtkDoubleArray>(), { 24, 22, 20 }, { 11.5, 10.2, 9.7 }, 6.0,
-    [=](bool inside, int i, int j, int k) {
+    [=](bool inside, int i, int j, int k)
+    {
       const double v = (inside ? 1000.0 : 0.0) + 7.0 * ((i * 7 + j * 3 + k * 5) % 3 - 1);
       return v * scale + offset;
     });
@@ -93,14 +94,16 @@ TEST(PyramidMagnitudes, RefusedSpansWarnedOffsetsAndQuietOrdinaryValues)
       EXPECT_FALSE(Warned(m));
     }
   // An offset of 1e7 against a spread of 1000: AO and Shadow 7e-3 off; the user is told.
-  for (const Messages& m : { VarianceMap(RippledBall(1.0, 1e7)), SurfaceAO(RippledBall(1.0, 1e7), surface) })
+  for (const Messages& m :
+    { VarianceMap(RippledBall(1.0, 1e7)), SurfaceAO(RippledBall(1.0, 1e7), surface) })
   {
     EXPECT_TRUE(m.output) << m.errors;
     EXPECT_TRUE(Warned(m));
   }
   // Spans whose variances leave float32: refused with a reason, no output.
   for (const double scale : { 1e-25, 1e17 })
-    for (const Messages& m : { VarianceMap(RippledBall(scale, 0.0)), SurfaceAO(RippledBall(scale, 0.0), surface) })
+    for (const Messages& m :
+      { VarianceMap(RippledBall(scale, 0.0)), SurfaceAO(RippledBall(scale, 0.0), surface) })
     {
       EXPECT_FALSE(m.output);
       EXPECT_NE(m.errors.find("rescale the data"), std::string::npos) << m.errors;

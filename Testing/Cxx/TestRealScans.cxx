@@ -60,11 +60,14 @@ void ExpectPublishedRmse(double radius, double gaussian, double cdf, double cheb
   auto ct = ReadMetaImage(DataFile("ct_head_phantom/ct_head_phantom_128x128x136_int16.mha"));
   ASSERT_EQ(ct->GetNumberOfPoints(), 128 * 128 * 136);
   const auto exact = AmbientOcclusion(ct, vtkVolumetricAmbientOcclusion::EXACT_BOX, radius);
-  const ErrorStats g = Compare(AmbientOcclusion(ct, vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, radius), exact);
-  const ErrorStats c = Compare(AmbientOcclusion(ct, vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION, radius), exact);
-  const ErrorStats b = Compare(AmbientOcclusion(ct, vtkVolumetricAmbientOcclusion::CHEBYSHEV, radius), exact);
-  std::cout << "R = " << radius << ": RMSE Gaussian CDF " << g.rmse << ", CDF Reconstruction " << c.rmse
-            << ", Chebyshev " << b.rmse << " (bias " << b.bias << ")" << std::endl;
+  const ErrorStats g =
+    Compare(AmbientOcclusion(ct, vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF, radius), exact);
+  const ErrorStats c =
+    Compare(AmbientOcclusion(ct, vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION, radius), exact);
+  const ErrorStats b =
+    Compare(AmbientOcclusion(ct, vtkVolumetricAmbientOcclusion::CHEBYSHEV, radius), exact);
+  std::cout << "R = " << radius << ": RMSE Gaussian CDF " << g.rmse << ", CDF Reconstruction "
+            << c.rmse << ", Chebyshev " << b.rmse << " (bias " << b.bias << ")" << std::endl;
   EXPECT_NEAR(g.rmse, gaussian, 0.005);
   EXPECT_NEAR(c.rmse, cdf, 0.005);
   EXPECT_NEAR(b.rmse, chebyshev, 0.005);
@@ -154,7 +157,8 @@ TEST(RealScans, RegressionImageOfAnAmbientOcclusionSlice)
   reader->SetFileName(baselinePath.c_str());
   reader->Update();
   const double error = ImageError(image, reader->GetOutput());
-  std::cout << "regression image error " << error << " (written to " << outputPath << ")" << std::endl;
+  std::cout << "regression image error " << error << " (written to " << outputPath << ")"
+            << std::endl;
   EXPECT_LT(error, 10.0);
 
   // The comparison can fail: a constant AO field is far from the baseline.
@@ -163,7 +167,8 @@ TEST(RealScans, RegressionImageOfAnAmbientOcclusionSlice)
   constant->SetNumberOfTuples(volume->GetNumberOfPoints());
   constant->Fill(0.5f);
   volume->GetPointData()->AddArray(constant);
-  const double constantError = ImageError(ColourMappedSlice(volume, "Constant"), reader->GetOutput());
+  const double constantError =
+    ImageError(ColourMappedSlice(volume, "Constant"), reader->GetOutput());
   std::cout << "constant-AO image error " << constantError << std::endl;
   EXPECT_GT(constantError, 100.0);
 }

@@ -23,22 +23,22 @@
 #include "vtkNew.h"
 #include "vtkPNGReader.h"
 #include "vtkPNGWriter.h"
+#include "vtkPiecewiseFunction.h"
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
-#include "vtkPiecewiseFunction.h"
 #include "vtkPolyDataMapper.h"
 #include "vtkProp3D.h"
 #include "vtkSmartVolumeMapper.h"
 
-#include <algorithm>
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
+#include "vtkProbeFilter.h"
 #include "vtkProperty.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
-#include "vtkWindowToImageFilter.h"
-#include "vtkProbeFilter.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
 #include "vtkWarpVector.h"
+#include "vtkWindowToImageFilter.h"
+#include <algorithm>
 
 #include <cmath>
 #include <cstdio>
@@ -209,7 +209,8 @@ vtkSmartPointer<vtkPolyData> PennerBone(vtkAlgorithmOutput* ct)
   for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i)
   {
     // Ambient light dimmed by AO, plus direct light dimmed by the shadow.
-    product->SetValue(i, static_cast<float>(ao->GetComponent(i, 0) * (0.5 + 0.5 * shadow->GetComponent(i, 0))));
+    product->SetValue(
+      i, static_cast<float>(ao->GetComponent(i, 0) * (0.5 + 0.5 * shadow->GetComponent(i, 0))));
   }
   surface->GetPointData()->AddArray(product);
   return surface;
@@ -244,10 +245,13 @@ vtkSmartPointer<vtkImageData> AmbientLitVolume(vtkImageData* withAO, bool modula
 int main(int argc, char* argv[])
 {
   const std::string mode = argc > 1 ? argv[1] : "";
-  if (argc < 5 || (mode != "sweeping" && mode != "penner" && mode != "volume" && mode != "modulation"))
+  if (argc < 5 ||
+    (mode != "sweeping" && mode != "penner" && mode != "volume" && mode != "modulation"))
   {
-    std::fprintf(stderr, "usage: %s sweeping|penner|volume|modulation CT.mha BASELINE.png OUTPUT.png "
-                         "[--write-baseline]\n", argv[0]);
+    std::fprintf(stderr,
+      "usage: %s sweeping|penner|volume|modulation CT.mha BASELINE.png OUTPUT.png "
+      "[--write-baseline]\n",
+      argv[0]);
     return 2;
   }
   const char* baselinePath = argv[3];
@@ -261,13 +265,15 @@ int main(int argc, char* argv[])
   vtkNew<vtkImageData> volume;
   if (mode == "sweeping" || mode == "penner")
   {
-    surface = mode == "sweeping" ? SweepingSkin(reader->GetOutputPort()) : PennerBone(reader->GetOutputPort());
+    surface = mode == "sweeping" ? SweepingSkin(reader->GetOutputPort())
+                                 : PennerBone(reader->GetOutputPort());
     if (!surface->GetPointData()->GetArray("Shade") || surface->GetNumberOfPoints() < 1000)
     {
       std::fprintf(stderr, "FAILED: the surface carries no shading\n");
       return 1;
     }
-    render = [&surface](bool constantAO) {
+    render = [&surface](bool constantAO)
+    {
       if (!constantAO)
       {
         return Render(surface, "Shade");
@@ -291,7 +297,8 @@ int main(int argc, char* argv[])
     ao->Update();
     volume->DeepCopy(ao->GetOutput());
     const bool modulate = mode == "modulation";
-    render = [&volume, modulate](bool constantAO) { return AmbientLitVolume(volume, modulate, constantAO); };
+    render = [&volume, modulate](bool constantAO)
+    { return AmbientLitVolume(volume, modulate, constantAO); };
   }
   auto image = render(false);
   vtkNew<vtkPNGWriter> writer;
@@ -313,7 +320,8 @@ int main(int argc, char* argv[])
   baselineReader->Update();
   const double error = Difference(image, baselineReader->GetOutput());
   const double constantError = Difference(render(true), baselineReader->GetOutput());
-  std::printf("regression image RMS difference %g (threshold 2), constant-AO RMS difference %g (must exceed 5); "
+  std::printf("regression image RMS difference %g (threshold 2), constant-AO RMS difference %g "
+              "(must exceed 5); "
               "image %s\n",
     error, constantError, outputPath);
   if (error > 2.0 || constantError < 5.0)

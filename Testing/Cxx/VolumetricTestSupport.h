@@ -22,7 +22,8 @@ namespace vaotest
 {
 
 /// A random int16 image with a non-zero extent origin and anisotropic spacing.
-inline vtkSmartPointer<vtkImageData> RandomImage(int nx, int ny, int nz, unsigned seed, int components = 1)
+inline vtkSmartPointer<vtkImageData> RandomImage(
+  int nx, int ny, int nz, unsigned seed, int components = 1)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetExtent(3, 3 + nx - 1, -2, -2 + ny - 1, 5, 5 + nz - 1);
@@ -47,7 +48,8 @@ struct FilterRun
   std::vector<std::string> warnings;
 };
 
-inline FilterRun RunFilter(vtkDataObject* input, const std::function<void(vtkVolumetricAmbientOcclusion*)>& configure)
+inline FilterRun RunFilter(
+  vtkDataObject* input, const std::function<void(vtkVolumetricAmbientOcclusion*)>& configure)
 {
   vtkNew<vtkVolumetricAmbientOcclusion> filter;
   vtkNew<MessageCatcher> catcher;
@@ -59,14 +61,17 @@ inline FilterRun RunFilter(vtkDataObject* input, const std::function<void(vtkVol
   return run;
 }
 
-inline void ExpectRejected(vtkDataObject* input, const std::function<void(vtkVolumetricAmbientOcclusion*)>& configure,
+inline void ExpectRejected(vtkDataObject* input,
+  const std::function<void(vtkVolumetricAmbientOcclusion*)>& configure,
   const std::string& expectedWords)
 {
   // Radius 1 unless the case sets its own, so that only the named problem is present.
-  const FilterRun run = RunFilter(input, [&](vtkVolumetricAmbientOcclusion* f) {
-    f->SetRadius(1);
-    configure(f);
-  });
+  const FilterRun run = RunFilter(input,
+    [&](vtkVolumetricAmbientOcclusion* f)
+    {
+      f->SetRadius(1);
+      configure(f);
+    });
   ASSERT_FALSE(run.errors.empty()) << "no error for: " << expectedWords;
   bool found = false;
   for (const auto& e : run.errors)

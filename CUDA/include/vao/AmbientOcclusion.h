@@ -76,7 +76,8 @@ enum class QueryMode : int
 {
   VoxelValue = 0,
   IsoValue = 1,
-  SmoothedValue = 2, // docs/methods.md section 9: a normalised Gaussian average of v around the voxel
+  SmoothedValue =
+    2, // docs/methods.md section 9: a normalised Gaussian average of v around the voxel
 };
 
 /// The accepted QuerySmoothing (sigma in voxels): the window of ceil(3 sigma) voxels each
@@ -107,7 +108,7 @@ int querySmoothingHalfWidth(double sigma);
 struct Execution
 {
   int threads = 0; // 0: every hardware thread
-  int device = -1;  // CUDA device (vao/Cuda.h, deviceStatus); -1: chosen by the node-local rank
+  int device = -1; // CUDA device (vao/Cuda.h, deviceStatus); -1: chosen by the node-local rank
   std::function<void(double)> progress;
   std::function<bool()> abortRequested;
 };
@@ -151,7 +152,7 @@ struct Status
   // fastest), so that a caller can name its voxel in its own coordinates.
   std::int64_t nonFiniteCount = 0;
   std::int64_t firstNonFinite = -1;
-  bool outOfMemory = false; // an allocation failed: smaller pieces may succeed
+  bool outOfMemory = false;   // an allocation failed: smaller pieces may succeed
   bool deviceFailure = false; // the GPU could not do it (no device, a CUDA error): the CPU may
 
   static Status success() { return {}; }

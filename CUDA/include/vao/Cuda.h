@@ -84,8 +84,8 @@ Status computeBoxStatistics(const VolumeView& volume, const Region& region, cons
 /// (equal to 1e-5, the CPU's fused multiply-adds aside), downloaded into `pyramid`. On a
 /// failure (Status::deviceFailure for the device's) the pyramid is left empty.
 Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const PyramidParameters& parameters, std::vector<MomentLevel>& pyramid,
-  const Execution& execution = {}, Timing* timing = nullptr);
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
+  std::vector<MomentLevel>& pyramid, const Execution& execution = {}, Timing* timing = nullptr);
 
 /// For tests of the fallback to the CPU: the next `calls` computations on the device fail
 /// once their input is on the device, as a device error would (Status::deviceFailure, a

@@ -1,8 +1,8 @@
 // The openness estimators of docs/methods.md, written once for host and device.
 //
 // Every function here is a pure formula on the statistics of one neighbourhood, so the
-// CPU path and the CUDA kernels (src/cuda/box_statistics/Pipeline.h) include this header and call the same code.
-// Openness O = P(v <= q) over the neighbourhood: 1 = fully open, 0 = fully occluded.
+// CPU path and the CUDA kernels (src/cuda/box_statistics/Pipeline.h) include this header and call
+// the same code. Openness O = P(v <= q) over the neighbourhood: 1 = fully open, 0 = fully occluded.
 #pragma once
 
 #include <cmath>
@@ -184,14 +184,17 @@ VAO_HD double opennessGaussianCdf(double query, const NeighbourhoodStats& s, Erf
 /// opennessChebyshev given the flat rule's rounding spread (flatRoundingSpread of the
 /// rounding variance): callers that query one set of sums many times take the square root
 /// once. Both answers are formed and one is kept, as the AVX2 form of the surface queries
-/// (src/cpu/surface_queries/SurfaceLanes.h) does with masks; the bound's 0/0 on a flat box is not kept.
-VAO_HD double opennessChebyshevWithin(double query, double mean, double variance, double roundingVariance,
-  double roundingSpread)
+/// (src/cpu/surface_queries/SurfaceLanes.h) does with masks; the bound's 0/0 on a flat box is not
+/// kept.
+VAO_HD double opennessChebyshevWithin(
+  double query, double mean, double variance, double roundingVariance, double roundingSpread)
 {
   const double d = query - mean;
   const double occluderShare = variance / (variance + d * d);
   const double bound = d > 0.0 ? clamp01(1.0 - occluderShare) : 0.0;
-  return isFlatVariance(variance, roundingVariance) ? flatOpennessWithin(query, mean, roundingSpread) : bound;
+  return isFlatVariance(variance, roundingVariance)
+    ? flatOpennessWithin(query, mean, roundingSpread)
+    : bound;
 }
 
 /// Cantelli's one-tailed bound on the occluder fraction P(v >= q), as docs/methods.md section 5
@@ -218,14 +221,14 @@ VAO_HD int thresholdIndex(double q, const double* thresholds, int n)
   return lo;
 }
 
-/// Histogram CDF (docs/methods.md section 8): O = F at q, where F_k = P(v <= t_k) over the box is known
-/// at the n ascending thresholds; linear between the two that enclose q, F_k itself at
-/// q = t_k, 0 below t_0 and 1 at or above t_(n-1). The thresholds start at the data set's
-/// lowest value and end at its highest, so both ends are exact. The box holds `count`
-/// voxels, `below` of them at or under t_(upper-1) (0 for upper = 0) and `at` in
-/// (t_(upper-1), t_upper], where upper = thresholdIndex(q).
-VAO_HD double opennessHistogramCdfAt(double q, const double* thresholds, int n, int upper,
-  double count, double below, double at)
+/// Histogram CDF (docs/methods.md section 8): O = F at q, where F_k = P(v <= t_k) over the box is
+/// known at the n ascending thresholds; linear between the two that enclose q, F_k itself at q =
+/// t_k, 0 below t_0 and 1 at or above t_(n-1). The thresholds start at the data set's lowest value
+/// and end at its highest, so both ends are exact. The box holds `count` voxels, `below` of them at
+/// or under t_(upper-1) (0 for upper = 0) and `at` in (t_(upper-1), t_upper], where upper =
+/// thresholdIndex(q).
+VAO_HD double opennessHistogramCdfAt(
+  double q, const double* thresholds, int n, int upper, double count, double below, double at)
 {
   if (n <= 0 || q < thresholds[0])
   {
@@ -272,7 +275,8 @@ VAO_HD double exactSumsNumerator(long long sum, long long sumSquares, long long 
 #if defined(__CUDA_ARCH__)
   const bool fits = false;
 #else
-  const bool fits = !__builtin_mul_overflow(count, sumSquares, &a) && !__builtin_mul_overflow(sum, sum, &b);
+  const bool fits =
+    !__builtin_mul_overflow(count, sumSquares, &a) && !__builtin_mul_overflow(sum, sum, &b);
 #endif
   if (fits)
   {
@@ -280,7 +284,8 @@ VAO_HD double exactSumsNumerator(long long sum, long long sumSquares, long long 
     const long long numerator = a - b;
     return numerator > 0 ? static_cast<double>(numerator) : 0.0;
   }
-  const __int128 numerator = static_cast<__int128>(count) * sumSquares - static_cast<__int128>(sum) * sum;
+  const __int128 numerator =
+    static_cast<__int128>(count) * sumSquares - static_cast<__int128>(sum) * sum;
   return numerator > 0 ? static_cast<double>(numerator) : 0.0;
 }
 

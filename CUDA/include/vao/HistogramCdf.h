@@ -40,8 +40,8 @@ struct ValueHistogram
 {
   static constexpr std::int64_t kMaximumCells = 65536;
 
-  double lowest = 0.0;  // the data set's range: fixes the cells
-  double highest = 0.0; //
+  double lowest = 0.0;       // the data set's range: fixes the cells
+  double highest = 0.0;      //
   bool integerCells = false; // one cell per integer value from `lowest`
   std::vector<std::int64_t> counts;
   std::vector<double> minimum; // smallest value seen in each cell (+inf: none)
@@ -60,15 +60,15 @@ struct ValueHistogram
 
 /// Adds the values of `region` of the volume to the summary (finite values only; the
 /// caller refuses non-finite data first). Runs on every core.
-Status addToValueHistogram(const VolumeView& volume, const Region& region, ValueHistogram& histogram,
-  const Execution& execution = {});
+Status addToValueHistogram(const VolumeView& volume, const Region& region,
+  ValueHistogram& histogram, const Execution& execution = {});
 
 /// At most `bins` ascending thresholds, placed as the header says (deterministic).
 std::vector<double> histogramThresholds(const ValueHistogram& histogram, int bins);
 
 /// The thresholds of a volume that is the whole data set: range, summary, placement.
-Status volumeThresholds(
-  const VolumeView& volume, int bins, std::vector<double>& thresholds, const Execution& execution = {});
+Status volumeThresholds(const VolumeView& volume, int bins, std::vector<double>& thresholds,
+  const Execution& execution = {});
 
 /// "" or why `bins` is not an accepted NumberOfBins.
 std::string checkHistogramBins(int bins);

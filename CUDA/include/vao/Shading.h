@@ -25,7 +25,8 @@ VAO_HD double varianceModulation(double variance, double varianceMax)
 /// undefined behaviour).
 VAO_HD unsigned char toByte(double unit)
 {
-  return unit > 0.0 ? static_cast<unsigned char>(clamp01(unit) * 255.0 + 0.5) : static_cast<unsigned char>(0);
+  return unit > 0.0 ? static_cast<unsigned char>(clamp01(unit) * 255.0 + 0.5)
+                    : static_cast<unsigned char>(0);
 }
 
 } // namespace vao

@@ -14,7 +14,8 @@ namespace vao
 
 /// Data present, every axis at least `minimumPerAxis` voxels, stride >= 1.
 /// `method` names what needs them in the message when minimumPerAxis > 1.
-Status checkVolume(const VolumeView& volume, std::int64_t minimumPerAxis = 1, const char* method = nullptr);
+Status checkVolume(
+  const VolumeView& volume, std::int64_t minimumPerAxis = 1, const char* method = nullptr);
 
 /// The region lies in the volume and is not empty.
 Status checkRegion(const VolumeView& volume, const Region& region);
@@ -106,6 +107,7 @@ Status catchOutOfMemory(const char* what, F&& f)
 /// The checks of a call on box moments (Volumetric AO on the CPU or the GPU): validate(),
 /// then, where the type needs it, one scan for non-finite values and for magnitudes whose
 /// squares overflow. `scan` receives the scan (empty for the types of up to 16 bits).
-Status validateMomentRequest(const VolumeView& volume, const Region& region, const Radius& radius, ValueScan& scan);
+Status validateMomentRequest(
+  const VolumeView& volume, const Region& region, const Radius& radius, ValueScan& scan);
 
 } // namespace vao

@@ -36,7 +36,8 @@ struct MomentLevel
   // World bounds (x0, x1, y0, y1, z0, z1) of the whole volume's level when this level holds
   // only a window of it (a distributed piece); NaN: the level is whole. The soft-shadow
   // march of pyramid[0] stops at these bounds, not at the window's.
-  std::array<double, 6> wholeBounds = { kUnsetBound, kUnsetBound, kUnsetBound, kUnsetBound, kUnsetBound, kUnsetBound };
+  std::array<double, 6> wholeBounds = { kUnsetBound, kUnsetBound, kUnsetBound, kUnsetBound,
+    kUnsetBound, kUnsetBound };
   LevelArray mean;
   LevelArray variance; // E[v^2] - E[v]^2 of the blurred moments, clamped at 0
   // The variance rounding alone can leave in a flat region (sumRoundingVariance of the
@@ -89,9 +90,9 @@ struct SurfaceOcclusionParameters
 {
   SurfaceQuery query = SurfaceQuery::HalfVoxelInside;
   double isoValue = 0.0;
-  double offsetFactor = 1.0; // k: samples at p + k r_l n
+  double offsetFactor = 1.0;            // k: samples at p + k r_l n
   Method estimator = Method::Chebyshev; // Chebyshev or GaussianCdf (the only ones a level's
-                                       // blurred mean and variance can feed)
+                                        // blurred mean and variance can feed)
   LevelCombination combination = LevelCombination::MaximumOcclusion;
   int levels = -1; // levels used, -1: all of the pyramid
 };
@@ -106,14 +107,14 @@ struct SurfaceOcclusionParameters
 /// Points: 3 doubles each; normals: 3 doubles each; out: one float per point.
 Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
   const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const double* points,
-  const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution = {});
+  const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution = {});
 
 /// The same with float points and normals (vtkPoints' usual type), read in place.
 Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
   const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const float* points,
-  const float* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution = {});
+  const float* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution = {});
 
 /// Soft shadow (1 = lit) of surface points towards the light direction L (need not be
 /// unit; must be finite and not zero): a march along L starting at p + r_0 n (off the
@@ -123,14 +124,14 @@ Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const Vo
 /// at occlusion >= 0.999. There is no raw volume here, so the half-voxel-inside query reads
 /// level 0's (blurred) mean at p - h/2 n (h: level 0's smallest spacing); IsoValue gives
 /// q = c exactly. offsetFactor and combination are not used.
-Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* points, const double* normals,
-  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
-  float* out, const Execution& execution = {});
+Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* points,
+  const double* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution = {});
 
 /// The same with float points and normals, read in place.
-Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const float* points, const float* normals,
-  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
-  float* out, const Execution& execution = {});
+Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const float* points,
+  const float* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution = {});
 
 namespace detail
 {
@@ -182,28 +183,31 @@ private:
 /// The pyramid of buildMomentPyramid (same checks, levels 2 and up the same), levels 0
 /// and 1 left to be built in tiles by the queries. On failure the pyramid is left empty.
 Status buildSurfacePyramid(const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const PyramidParameters& parameters, SurfacePyramid& pyramid,
-  const Execution& execution = {});
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
+  SurfacePyramid& pyramid, const Execution& execution = {});
 
 /// surfaceAmbientOcclusion and surfaceShadow on a SurfacePyramid: the tiles the points
 /// reach are built as the query sweeps them (kept for later queries up to the pyramid's
 /// keptTileBytes()).
-Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const double* points, const double* normals, std::int64_t count,
+Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const double* points,
+  const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution = {});
+Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const float* points,
+  const float* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution = {});
+Status surfaceShadow(SurfacePyramid& pyramid, const double* points, const double* normals,
+  std::int64_t count, const std::array<double, 3>& lightDirection,
   const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution = {});
-Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const float* points, const float* normals, std::int64_t count,
+Status surfaceShadow(SurfacePyramid& pyramid, const float* points, const float* normals,
+  std::int64_t count, const std::array<double, 3>& lightDirection,
   const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution = {});
-Status surfaceShadow(SurfacePyramid& pyramid, const double* points, const double* normals, std::int64_t count,
-  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution = {});
-Status surfaceShadow(SurfacePyramid& pyramid, const float* points, const float* normals, std::int64_t count,
-  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution = {});
 
 /// Trilinear sample of a level's mean and variance at a world position (clamped to the
 /// level's bounds).
-void sampleLevel(const MomentLevel& level, const std::array<double, 3>& position, double& mean, double& variance);
+void sampleLevel(
+  const MomentLevel& level, const std::array<double, 3>& position, double& mean, double& variance);
 
 /// Trilinear sample of the volume (any scalar type) at a world position, clamped to the
 /// volume: voxel (0, 0, 0) at `origin`, `spacing` per axis. The interpolation of the

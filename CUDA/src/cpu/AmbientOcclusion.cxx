@@ -2,11 +2,11 @@
 // (and the box extrema for CDF Reconstruction), the box histograms of Histogram CDF, or the
 // exact references; with the voxel's value, the iso value or the smoothed query as q.
 #include "cpu/box_statistics/BoxEngine.h"
-#include "cpu/common/ConcurrentRange.h"
-#include "cpu/simd/CpuDispatch.h"
 #include "cpu/box_statistics/EstimatorRows.h"
+#include "cpu/common/ConcurrentRange.h"
 #include "cpu/exact_reference/ExactReference.h"
 #include "cpu/histogram_cdf/HistogramChannels.h"
+#include "cpu/simd/CpuDispatch.h"
 #include "cpu/smoothed_query/SmoothedQuery.h"
 #include "cpu/transfer_function/TransferFunctionOpenness.h"
 #include "vao/Storage.h"
@@ -15,7 +15,6 @@
 
 #include <cmath>
 #include <vector>
-
 
 namespace vao
 {
@@ -46,21 +45,24 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   // Chebyshev and the Gaussian CDF take exact sums as they are (opennessRow).
   const bool fromSums = p.method == Method::Chebyshev || p.method == Method::GaussianCdf;
   // CDF Reconstruction takes the mean alone from the moments.
-  const bool variance = output.variance || (output.openness && p.method != Method::CdfReconstruction);
+  const bool variance =
+    output.variance || (output.openness && p.method != Method::CdfReconstruction);
   // The openness alone reads raw rows where they come (16-bit voxels).
   const bool moments = output.variance != nullptr || !output.openness || !fromSums;
-  const detail::RowContents contents{ withExtrema, moments, output.openness && voxelQuery && !query, variance,
-    output.openness && !output.variance };
+  const detail::RowContents contents{ withExtrema, moments, output.openness && voxelQuery && !query,
+    variance, output.openness && !output.variance };
   // Kept where the rows' extremes take vector instructions; the plain loop would cost
   // several times the separate, threaded pass the caller then makes (vao/ValueRanges.h).
   const bool keepRange = output.openness && output.opennessRange && detail::cpuHasAvx2();
   detail::ConcurrentRange range;
   const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, contents, execution,
-    [&](const detail::NeighbourhoodRow& row) {
+    [&](const detail::NeighbourhoodRow& row)
+    {
       if (output.variance)
       {
         for (std::int64_t i = 0; i < row.size; ++i)
-          output.variance[row.index + i] = static_cast<float>(reportedVariance(row.variance[i], row.roundingVariance));
+          output.variance[row.index + i] =
+            static_cast<float>(reportedVariance(row.variance[i], row.roundingVariance));
       }
       if (output.openness)
       {
@@ -122,8 +124,9 @@ Status validateRequest(const VolumeView& volume, const Region& region,
     std::max(std::abs(scan.minimum), std::abs(scan.maximum)) > kLargestSmoothedMagnitude)
   {
     // The smoothed query sums differences of values: beyond this they overflow double.
-    status = Status::failure("the smoothed query needs values within +-1e300 (their differences would overflow "
-                             "double precision): rescale the data (e.g. with the Calculator) first");
+    status = Status::failure(
+      "the smoothed query needs values within +-1e300 (their differences would overflow "
+      "double precision): rescale the data (e.g. with the Calculator) first");
   }
   return status;
 }
@@ -132,7 +135,8 @@ Status validateRequest(const VolumeView& volume, const Region& region,
 /// (box histograms), Transfer Function (the box mean of the opacity) and the exact
 /// references. `q` is the smoothed query, or null.
 Status separateOpenness(const VolumeView& volume, const Region& region,
-  const AmbientOcclusionParameters& parameters, const double* q, float* openness, const Execution& stage)
+  const AmbientOcclusionParameters& parameters, const double* q, float* openness,
+  const Execution& stage)
 {
   if (parameters.method == Method::HistogramCdf)
   {
@@ -198,25 +202,29 @@ Status ambientOcclusion(const VolumeView& volume, const Region& region,
   {
     separable.openness = nullptr; // done: only the variance comes from the moments
   }
-  return detail::dispatchScalarType(volume.type, [&](auto tag) {
-    return separableOpenness<decltype(tag)>(volume, region, parameters, separable, q, scan,
-      detail::stageExecution(execution, opennessEnd, 1.0));
-  });
+  return detail::dispatchScalarType(volume.type,
+    [&](auto tag)
+    {
+      return separableOpenness<decltype(tag)>(volume, region, parameters, separable, q, scan,
+        detail::stageExecution(execution, opennessEnd, 1.0));
+    });
 }
 
 } // namespace
 
 int querySmoothingHalfWidth(double sigma)
 {
-  return std::isfinite(sigma) && sigma > 0.0 ? static_cast<int>(std::ceil(3.0 * std::min(sigma, kMaximumQuerySmoothing))) : 0;
+  return std::isfinite(sigma) && sigma > 0.0
+    ? static_cast<int>(std::ceil(3.0 * std::min(sigma, kMaximumQuerySmoothing)))
+    : 0;
 }
 
 Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, const AmbientOcclusionOutput& output,
   const Execution& execution)
 {
-  return catchOutOfMemory(
-    "the working buffers of Volumetric AO (box statistics, histograms, the smoothed query, the exact references' rows)",
+  return catchOutOfMemory("the working buffers of Volumetric AO (box statistics, histograms, the "
+                          "smoothed query, the exact references' rows)",
     [&] { return ambientOcclusion(volume, region, parameters, output, execution); });
 }
 

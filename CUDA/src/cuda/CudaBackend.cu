@@ -6,15 +6,15 @@
 #include "vao/Validation.h"
 
 #include "VolumeAccess.h"
+#include "cpu/common/Parallel.h"
+#include "cpu/exact_reference/ExactReference.h"
+#include "cpu/moment_pyramid/PyramidPlan.h"
 #include "cuda/CudaExecutor.h"
+#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/SlabTransfers.h"
 #include "cuda/exact_reference/ExactPipeline.h"
 #include "cuda/histogram_cdf/HistogramPipeline.h"
 #include "cuda/moment_pyramid/PyramidPipeline.h"
-#include "cuda/common/SlabTransfers.h"
-#include "cpu/exact_reference/ExactReference.h"
-#include "cpu/moment_pyramid/PyramidPlan.h"
-#include "cpu/common/Parallel.h"
-#include "cuda/box_statistics/Pipeline.h"
 
 #include <cuda_runtime.h>
 
@@ -77,14 +77,14 @@ void runCounting(const VolumeView& view, const Region& region, const AmbientOccl
   const bool iso = p.queryMode == QueryMode::IsoValue;
   if (p.method == Method::HistogramCdf)
   {
-    gpu::runHistogramPasses<T>(ex, input.get(), g, p.thresholds.data(), static_cast<int>(p.thresholds.size()),
-      iso, p.isoValue, openness.get());
+    gpu::runHistogramPasses<T>(ex, input.get(), g, p.thresholds.data(),
+      static_cast<int>(p.thresholds.size()), iso, p.isoValue, openness.get());
   }
   else
   {
     gpu::runExactPasses<T>(ex, input.get(), g,
-      detail::neighbourhoodRowHalfWidths(p.radius, p.method == Method::ExactSphere), iso, p.isoValue, openness.get(),
-      0.1, 0.95);
+      detail::neighbourhoodRowHalfWidths(p.radius, p.method == Method::ExactSphere), iso,
+      p.isoValue, openness.get(), 0.1, 0.95);
   }
   if (timing)
   {
@@ -96,8 +96,8 @@ void runCounting(const VolumeView& view, const Region& region, const AmbientOccl
 
 template <class T>
 void run(const VolumeView& view, const Region& region, const Radius& radius, bool withExtrema,
-  gpu::EstimatorSetting estimator, const ValueScan& scan, const HostOutputs& host, const Execution& execution,
-  Timing* timing)
+  gpu::EstimatorSetting estimator, const ValueScan& scan, const HostOutputs& host,
+  const Execution& execution, Timing* timing)
 {
   using Acc = typename detail::MomentTraits<T>::Accumulator;
   const detail::TypedVolume<T> volume(view);
@@ -110,10 +110,11 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
   {
     // One kernel, z slabs streamed: SlabTransfers.h.
     const auto bytes = [](auto* p) { return reinterpret_cast<unsigned char*>(p); };
-    const OutputArray outputs[kFusedOutputs] = { { bytes(host.openness), 4 }, { bytes(host.variance), 4 },
-      { bytes(st.count), 8 }, { bytes(st.mean), 8 }, { bytes(st.variance), 8 }, { bytes(st.minimum), 8 },
-      { bytes(st.maximum), 8 } };
-    runFusedSlabs<T, Acc>(volume, region, g, shift, estimator, withExtrema, outputs, execution, timing, failIfInjected);
+    const OutputArray outputs[kFusedOutputs] = { { bytes(host.openness), 4 },
+      { bytes(host.variance), 4 }, { bytes(st.count), 8 }, { bytes(st.mean), 8 },
+      { bytes(st.variance), 8 }, { bytes(st.minimum), 8 }, { bytes(st.maximum), 8 } };
+    runFusedSlabs<T, Acc>(
+      volume, region, g, shift, estimator, withExtrema, outputs, execution, timing, failIfInjected);
     return;
   }
   CudaExecutor ex(timing, execution);
@@ -124,17 +125,18 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
 
   const Index n = g.region();
   DeviceBuffer<float> openness(host.openness ? n : 0), variance(host.variance ? n : 0);
-  DeviceBuffer<double> count(st.count ? n : 0), mean(st.mean ? n : 0), varianceD(st.variance ? n : 0),
-    minimum(st.minimum ? n : 0), maximum(st.maximum ? n : 0);
-  const gpu::FinalOutputs out{ openness.get(), variance.get(), count.get(), mean.get(), varianceD.get(),
-    minimum.get(), maximum.get() };
+  DeviceBuffer<double> count(st.count ? n : 0), mean(st.mean ? n : 0),
+    varianceD(st.variance ? n : 0), minimum(st.minimum ? n : 0), maximum(st.maximum ? n : 0);
+  const gpu::FinalOutputs out{ openness.get(), variance.get(), count.get(), mean.get(),
+    varianceD.get(), minimum.get(), maximum.get() };
   gpu::runPasses<T, Acc>(ex, input.get(), g, withExtrema, shift, estimator, out);
   if (timing)
   {
     ex.finish();
   }
 
-  auto download = [&](auto* to, const auto& from) {
+  auto download = [&](auto* to, const auto& from)
+  {
     if (to)
       ex.download(to, from.get(), n);
   };
@@ -191,8 +193,9 @@ Status onDevice(const Execution& execution, Timing* timing, const Work& work)
   return Status::success();
 }
 
-Status runChecked(const VolumeView& view, const Region& region, const Radius& radius, bool withExtrema,
-  const gpu::EstimatorSetting& estimator, const HostOutputs& host, const Execution& execution, Timing* timing)
+Status runChecked(const VolumeView& view, const Region& region, const Radius& radius,
+  bool withExtrema, const gpu::EstimatorSetting& estimator, const HostOutputs& host,
+  const Execution& execution, Timing* timing)
 {
   ValueScan scan;
   Status status;
@@ -211,14 +214,20 @@ Status runChecked(const VolumeView& view, const Region& region, const Radius& ra
   {
     return status;
   }
-  return onDevice(execution, timing, [&] {
-    detail::dispatchScalarType(view.type, [&](auto tag) {
-      if (host.counting)
-        runCounting<decltype(tag)>(view, region, *host.counting, host.openness, execution, timing);
-      else
-        run<decltype(tag)>(view, region, radius, withExtrema, estimator, scan, host, execution, timing);
+  return onDevice(execution, timing,
+    [&]
+    {
+      detail::dispatchScalarType(view.type,
+        [&](auto tag)
+        {
+          if (host.counting)
+            runCounting<decltype(tag)>(
+              view, region, *host.counting, host.openness, execution, timing);
+          else
+            run<decltype(tag)>(
+              view, region, radius, withExtrema, estimator, scan, host, execution, timing);
+        });
     });
-  });
 }
 
 } // namespace
@@ -234,27 +243,30 @@ DeviceStatus deviceStatus(int requested)
   static std::once_flag once;
   static std::vector<std::string> devices;
   static std::string none;
-  std::call_once(once, [] {
-    int count = 0;
-    const cudaError_t error = cudaGetDeviceCount(&count);
-    if (error != cudaSuccess || count == 0)
+  std::call_once(once,
+    []
     {
-      none = std::string("no usable CUDA device (") + (error != cudaSuccess ? cudaGetErrorString(error) : "none found") + ")";
-      cudaGetLastError();
-      return;
-    }
-    for (int i = 0; i < count; ++i)
-    {
-      cudaDeviceProp properties;
-      std::ostringstream text;
-      if (cudaGetDeviceProperties(&properties, i) == cudaSuccess)
-        text << properties.name << " (" << properties.totalGlobalMem / (1024 * 1024) << " MiB, sm_" << properties.major
-             << properties.minor << ")";
-      else
-        text << "(cannot be queried)";
-      devices.push_back(text.str());
-    }
-  });
+      int count = 0;
+      const cudaError_t error = cudaGetDeviceCount(&count);
+      if (error != cudaSuccess || count == 0)
+      {
+        none = std::string("no usable CUDA device (") +
+          (error != cudaSuccess ? cudaGetErrorString(error) : "none found") + ")";
+        cudaGetLastError();
+        return;
+      }
+      for (int i = 0; i < count; ++i)
+      {
+        cudaDeviceProp properties;
+        std::ostringstream text;
+        if (cudaGetDeviceProperties(&properties, i) == cudaSuccess)
+          text << properties.name << " (" << properties.totalGlobalMem / (1024 * 1024)
+               << " MiB, sm_" << properties.major << properties.minor << ")";
+        else
+          text << "(cannot be queried)";
+        devices.push_back(text.str());
+      }
+    });
   DeviceStatus status;
   const int count = static_cast<int>(devices.size());
   status.index = chooseDevice(requested, count, detail::nodeLocalRank());
@@ -264,12 +276,14 @@ DeviceStatus deviceStatus(int requested)
     if (count == 0)
       why << none;
     else
-      why << "CUDA device " << requested << " requested, but " << count << " visible (CUDA_VISIBLE_DEVICES counts)";
+      why << "CUDA device " << requested << " requested, but " << count
+          << " visible (CUDA_VISIBLE_DEVICES counts)";
     status.description = why.str();
     return status;
   }
   std::ostringstream text;
-  text << "device " << status.index << " of " << count << ": " << devices[static_cast<std::size_t>(status.index)];
+  text << "device " << status.index << " of " << count << ": "
+       << devices[static_cast<std::size_t>(status.index)];
   status.available = true;
   status.description = text.str();
   return status;
@@ -289,7 +303,8 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   }
   if (!isSeparableMethod(p.method))
   {
-    Status status = p.method == Method::HistogramCdf ? checkHistogramThresholds(p.thresholds) : Status::success();
+    Status status =
+      p.method == Method::HistogramCdf ? checkHistogramThresholds(p.thresholds) : Status::success();
     if (status.ok && p.method != Method::HistogramCdf && p.method != Method::ExactBox &&
       p.method != Method::ExactSphere)
       status = Status::failure("unknown method");
@@ -298,7 +313,8 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
     HostOutputs host;
     host.openness = output.openness;
     host.counting = &p;
-    const gpu::EstimatorSetting none{ Method::GaussianCdf, QueryMode::VoxelValue, 0.0, ErfMode::Exact };
+    const gpu::EstimatorSetting none{ Method::GaussianCdf, QueryMode::VoxelValue, 0.0,
+      ErfMode::Exact };
     if (status.ok && output.openness)
       status = runChecked(volume, region, p.radius, false, none, host, execution, timing);
     if (status.ok && output.variance)
@@ -319,8 +335,8 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   host.openness = output.openness;
   host.variance = output.variance;
   const bool withExtrema = output.openness && p.method == Method::CdfReconstruction;
-  return runChecked(volume, region, p.radius, withExtrema, { p.method, p.queryMode, p.isoValue, p.erfMode },
-    host, execution, timing);
+  return runChecked(volume, region, p.radius, withExtrema,
+    { p.method, p.queryMode, p.isoValue, p.erfMode }, host, execution, timing);
 }
 
 Status computeBoxStatistics(const VolumeView& volume, const Region& region, const Radius& radius,
@@ -333,31 +349,35 @@ Status computeBoxStatistics(const VolumeView& volume, const Region& region, cons
 }
 
 Status buildMomentPyramid(const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const PyramidParameters& parameters, std::vector<MomentLevel>& pyramid,
-  const Execution& execution, Timing* timing)
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
+  std::vector<MomentLevel>& pyramid, const Execution& execution, Timing* timing)
 {
   detail::PyramidSetup setup;
   Status status = detail::preparePyramid(volume, origin, spacing, parameters, setup);
   std::vector<MomentLevel> levels;
   if (status.ok)
   {
-    status = onDevice(execution, timing, [&] {
-      detail::dispatchScalarType(volume.type, [&](auto tag) {
-        using T = decltype(tag);
-        const Region whole = Region::whole(volume);
-        const gpu::RegionGeometry g = gpu::geometryFor(volume.dims, whole, { 0, 0, 0 });
-        CudaExecutor ex(timing, execution);
-        DeviceBuffer<T> input(g.block());
-        uploadBlock(detail::TypedVolume<T>(volume), whole, g, input.get(), execution.threads);
-        failIfInjected();
-        ex.progress(0.1);
-        gpu::runPyramid<T>(ex, input.get(), volume.dims, setup, parameters.levels, levels);
-        if (timing)
-        {
-          ex.finish();
-        }
+    status = onDevice(execution, timing,
+      [&]
+      {
+        detail::dispatchScalarType(volume.type,
+          [&](auto tag)
+          {
+            using T = decltype(tag);
+            const Region whole = Region::whole(volume);
+            const gpu::RegionGeometry g = gpu::geometryFor(volume.dims, whole, { 0, 0, 0 });
+            CudaExecutor ex(timing, execution);
+            DeviceBuffer<T> input(g.block());
+            uploadBlock(detail::TypedVolume<T>(volume), whole, g, input.get(), execution.threads);
+            failIfInjected();
+            ex.progress(0.1);
+            gpu::runPyramid<T>(ex, input.get(), volume.dims, setup, parameters.levels, levels);
+            if (timing)
+            {
+              ex.finish();
+            }
+          });
       });
-    });
   }
   pyramid.clear();
   if (!status.ok)

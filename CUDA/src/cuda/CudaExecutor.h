@@ -4,8 +4,8 @@
 #pragma once
 
 #include "cuda/box_statistics/FusedStatistics.h"
-#include "cuda/common/PinnedStaging.h"
 #include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/PinnedStaging.h"
 
 #include "vao/Cuda.h"
 
@@ -84,7 +84,8 @@ template <class Kernel>
 __global__ void fusedBlocks(Kernel kernel)
 {
   extern __shared__ __align__(16) unsigned char fusedShared[];
-  kernel.run(DeviceBlock{}, static_cast<Index>(blockIdx.x), reinterpret_cast<typename Kernel::Acc*>(fusedShared));
+  kernel.run(DeviceBlock{}, static_cast<Index>(blockIdx.x),
+    reinterpret_cast<typename Kernel::Acc*>(fusedShared));
 }
 
 /// Bytes of shared memory a block may have on the current device (the opt-in maximum).
@@ -92,7 +93,8 @@ Index sharedMemoryLimit()
 {
   int device = 0, bytes = 0;
   check(cudaGetDevice(&device), "device");
-  check(cudaDeviceGetAttribute(&bytes, cudaDevAttrMaxSharedMemoryPerBlockOptin, device), "device attribute");
+  check(cudaDeviceGetAttribute(&bytes, cudaDevAttrMaxSharedMemoryPerBlockOptin, device),
+    "device attribute");
   return bytes;
 }
 
@@ -107,8 +109,8 @@ void launchFusedBlocks(const Kernel& kernel, cudaStream_t stream)
             static_cast<int>(shared)),
       "shared memory size");
   if (kernel.blocks() > 0)
-    fusedBlocks<Kernel><<<static_cast<unsigned>(kernel.blocks()), static_cast<unsigned>(gpu::kTileColumns),
-      static_cast<std::size_t>(shared), stream>>>(kernel);
+    fusedBlocks<Kernel><<<static_cast<unsigned>(kernel.blocks()),
+      static_cast<unsigned>(gpu::kTileColumns), static_cast<std::size_t>(shared), stream>>>(kernel);
 }
 
 /// Runs the pipeline's kernels on the device. When asked for timings, each pass gets a
@@ -153,8 +155,9 @@ public:
   template <class U>
   void download(U* host, const U* device, Index count)
   {
-    stagedDownload(reinterpret_cast<unsigned char*>(host), reinterpret_cast<const unsigned char*>(device),
-      count * static_cast<Index>(sizeof(U)), this->Exec.threads);
+    stagedDownload(reinterpret_cast<unsigned char*>(host),
+      reinterpret_cast<const unsigned char*>(device), count * static_cast<Index>(sizeof(U)),
+      this->Exec.threads);
   }
 
   template <class Kernel>
@@ -164,7 +167,8 @@ public:
     this->begin();
     if (threads > 0)
     {
-      runKernel<<<static_cast<unsigned>((threads + kThreads - 1) / kThreads), kThreads>>>(kernel, threads);
+      runKernel<<<static_cast<unsigned>((threads + kThreads - 1) / kThreads), kThreads>>>(
+        kernel, threads);
     }
     this->end(name, bytes);
   }

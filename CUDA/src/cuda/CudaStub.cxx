@@ -22,14 +22,15 @@ Status computeAmbientOcclusion(const VolumeView&, const Region&, const AmbientOc
   return Status::device("no CUDA device: " + deviceStatus().description);
 }
 
-Status computeBoxStatistics(const VolumeView&, const Region&, const Radius&, const BoxStatisticsOutput&,
-  const Execution&, Timing*)
+Status computeBoxStatistics(const VolumeView&, const Region&, const Radius&,
+  const BoxStatisticsOutput&, const Execution&, Timing*)
 {
   return Status::device("no CUDA device: " + deviceStatus().description);
 }
 
-Status buildMomentPyramid(const VolumeView&, const std::array<double, 3>&, const std::array<double, 3>&,
-  const PyramidParameters&, std::vector<MomentLevel>& pyramid, const Execution&, Timing*)
+Status buildMomentPyramid(const VolumeView&, const std::array<double, 3>&,
+  const std::array<double, 3>&, const PyramidParameters&, std::vector<MomentLevel>& pyramid,
+  const Execution&, Timing*)
 {
   pyramid.clear();
   return Status::device("no CUDA device: " + deviceStatus().description);

@@ -22,8 +22,8 @@ namespace detail
 template <class T>
 struct WidenRow
 {
-  static VAO_ALWAYS_INLINE void run(const T* __restrict in, std::int64_t stride, std::int64_t n,
-    double* __restrict out)
+  static VAO_ALWAYS_INLINE void run(
+    const T* __restrict in, std::int64_t stride, std::int64_t n, double* __restrict out)
   {
     if (stride == 1)
       for (std::int64_t i = 0; i < n; ++i)
@@ -38,7 +38,8 @@ struct WidenRow
 /// bits of exact int32 sums): out[i] = int32(in[i]). Compiled for AVX2 too.
 struct WidenSums
 {
-  static VAO_ALWAYS_INLINE void run(const std::uint32_t* __restrict in, std::int64_t n, std::int64_t* __restrict out)
+  static VAO_ALWAYS_INLINE void run(
+    const std::uint32_t* __restrict in, std::int64_t n, std::int64_t* __restrict out)
   {
     for (std::int64_t i = 0; i < n; ++i)
       out[i] = static_cast<std::int32_t>(in[i]);
@@ -52,7 +53,7 @@ struct WidenSums
 struct RawRow
 {
   ScalarType type = ScalarType::Int16;
-  const void* value = nullptr; // the voxels' own, contiguous; null unless RowContents::values
+  const void* value = nullptr;   // the voxels' own, contiguous; null unless RowContents::values
   const void* minimum = nullptr; // null unless RowContents::extrema
   const void* maximum = nullptr;
   const std::int32_t* sum = nullptr; // null: the row is not raw
@@ -62,15 +63,15 @@ struct RawRow
 /// (x fastest), handed to a consumer: a row at a time lets the estimators run on vectors.
 struct NeighbourhoodRow
 {
-  std::int64_t index = 0; // of the row's first voxel in the region, x fastest
-  std::int64_t size = 0;  // voxels in the row
-  const double* value = nullptr;    // the voxels' own values
-  const double* count = nullptr;    // voxels in each clipped box
+  std::int64_t index = 0;        // of the row's first voxel in the region, x fastest
+  std::int64_t size = 0;         // voxels in the row
+  const double* value = nullptr; // the voxels' own values
+  const double* count = nullptr; // voxels in each clipped box
   const double* mean = nullptr;
   const double* variance = nullptr; // population variance, clamped at 0; null if not asked for
   const double* minimum = nullptr;  // null unless the extrema were asked for
   const double* maximum = nullptr;
-  double roundingVariance = 0.0;    // as NeighbourhoodStats::roundingVariance
+  double roundingVariance = 0.0; // as NeighbourhoodStats::roundingVariance
   // The boxes' exact integer sums (null for double sums), which Chebyshev and the Gaussian
   // CDF take directly (opennessFromExactSums): box i holds countX[i] * countYZ voxels.
   const std::int64_t* sum = nullptr;
@@ -83,8 +84,9 @@ struct NeighbourhoodRow
 
   NeighbourhoodStats stats(std::int64_t i) const
   {
-    return { this->mean[i], this->variance ? this->variance[i] : 0.0, this->minimum ? this->minimum[i] : 0.0,
-      this->maximum ? this->maximum[i] : 0.0, this->roundingVariance };
+    return { this->mean[i], this->variance ? this->variance[i] : 0.0,
+      this->minimum ? this->minimum[i] : 0.0, this->maximum ? this->maximum[i] : 0.0,
+      this->roundingVariance };
   }
 };
 
@@ -149,7 +151,8 @@ public:
     const BandRows<T>& rows = this->Rows;
     const Region& region = rows.band.region;
     const std::int64_t nx = region.size[0], ny = region.size[1];
-    const std::int64_t base = (slice.z - rows.whole.begin[2]) * rows.wholePlane + rows.firstRow * nx;
+    const std::int64_t base =
+      (slice.z - rows.whole.begin[2]) * rows.wholePlane + rows.firstRow * nx;
     constexpr bool narrow = std::is_same<Lin, std::uint32_t>::value;
     if (rows.contents.extrema)
       this->Extrema.compute(rows.extrema, rows.band, slice.z - region.begin[2]);
@@ -163,7 +166,8 @@ public:
     }
     for (std::int64_t j = 0; j < ny; ++j)
     {
-      const T* row = rows.volume.row(region.begin[1] + j, slice.z) + region.begin[0] * rows.volume.stride;
+      const T* row =
+        rows.volume.row(region.begin[1] + j, slice.z) + region.begin[0] * rows.volume.stride;
       const std::int64_t countYZ = rows.countY[j] * slice.countZ;
       out.index = base + j * nx;
       if constexpr (narrow && kSixteenBit)
@@ -227,8 +231,8 @@ private:
   /// (from exact integer sums, which are handed over too, or from double sums), and the
   /// extrema of the slice's x pass.
   template <class Lin>
-  VAO_ALWAYS_INLINE void statisticsRow(const MomentSlice<T, Lin>& slice, std::int64_t j, const T* row,
-    std::int64_t countYZ, SimdTier simd, NeighbourhoodRow& out)
+  VAO_ALWAYS_INLINE void statisticsRow(const MomentSlice<T, Lin>& slice, std::int64_t j,
+    const T* row, std::int64_t countYZ, SimdTier simd, NeighbourhoodRow& out)
   {
     const std::int64_t nx = out.size;
     const std::vector<std::int64_t>& countX = this->Rows.countX;
@@ -247,8 +251,8 @@ private:
       out.countX = countX.data();
       out.countYZ = countYZ;
       if (this->Rows.contents.moments) // double sums below always give them
-        meanVarianceRowExact(out.sum, out.sumSquares, countX.data(), countYZ, nx, this->Count.data(),
-          this->Mean.data(), out.sumSquares ? this->Variance.data() : nullptr);
+        meanVarianceRowExact(out.sum, out.sumSquares, countX.data(), countYZ, nx,
+          this->Count.data(), this->Mean.data(), out.sumSquares ? this->Variance.data() : nullptr);
     }
     else
     {
@@ -258,14 +262,16 @@ private:
         const std::int64_t c = countX[i] * countYZ;
         this->Count[i] = static_cast<double>(c);
         // Without the squares the mean comes out the same and the variance is dropped.
-        meanVarianceFromSums(slice.sum[p], slice.sumSquares ? slice.sumSquares[p] : 0.0, c, slice.shift,
-          this->Mean[i], this->Variance[i]);
+        meanVarianceFromSums(slice.sum[p], slice.sumSquares ? slice.sumSquares[p] : 0.0, c,
+          slice.shift, this->Mean[i], this->Variance[i]);
       }
     }
     if (this->Rows.contents.extrema)
     {
-      runRows<WidenRow<T>>(simd, this->Extrema.minima(j), std::int64_t(1), nx, this->Minimum.data());
-      runRows<WidenRow<T>>(simd, this->Extrema.maxima(j), std::int64_t(1), nx, this->Maximum.data());
+      runRows<WidenRow<T>>(
+        simd, this->Extrema.minima(j), std::int64_t(1), nx, this->Minimum.data());
+      runRows<WidenRow<T>>(
+        simd, this->Extrema.maxima(j), std::int64_t(1), nx, this->Maximum.data());
     }
     this->VisitRow(static_cast<const NeighbourhoodRow&>(out));
   }
@@ -285,24 +291,26 @@ private:
 /// from band to band, so that their pages are not cleared anew for each).
 template <class T, class Visit>
 bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Region& whole,
-  const MomentScale& scale, RowContents contents, const Execution& execution, BoxExtrema<T>& extrema,
-  Visit&& visit)
+  const MomentScale& scale, RowContents contents, const Execution& execution,
+  BoxExtrema<T>& extrema, Visit&& visit)
 {
   const bool withExtrema = contents.extrema;
   const Region& region = band.region;
   const double split = withExtrema ? 0.5 : 0.0;
-  if (withExtrema && !computeBoxExtrema(volume, band, stageExecution(execution, 0.0, split), extrema))
+  if (withExtrema &&
+    !computeBoxExtrema(volume, band, stageExecution(execution, 0.0, split), extrema))
   {
     return false;
   }
-  const BandRows<T> rows{ volume, band, whole, contents, extrema, band.windowCounts(0), band.windowCounts(1),
-    whole.size[0] * whole.size[1], region.begin[1] - whole.begin[1] };
+  const BandRows<T> rows{ volume, band, whole, contents, extrema, band.windowCounts(0),
+    band.windowCounts(1), whole.size[0] * whole.size[1], region.begin[1] - whole.begin[1] };
   using Consumer = BandRowConsumer<T, std::remove_reference_t<Visit>>;
   const auto makeConsumer = [&] { return Consumer(rows, visit); };
   const Execution stage = stageExecution(execution, split, 1.0);
   if constexpr (MomentTraits<T>::exactInteger)
     if (linearSumsFit32<T>(band))
-      return streamMoments<T, std::uint32_t>(volume, band, scale, contents.variance, stage, makeConsumer);
+      return streamMoments<T, std::uint32_t>(
+        volume, band, scale, contents.variance, stage, makeConsumer);
   return streamMoments<T, typename MomentTraits<T>::Accumulator>(
     volume, band, scale, contents.variance, stage, makeConsumer);
 }
@@ -316,7 +324,8 @@ bool visitBand(const TypedVolume<T>& volume, const BoxGeometry& band, const Regi
 /// 1/16 of the rows. Bands of at least 2R + 1 rows keep that price under 2x.
 inline std::int64_t extremaBandRows(const BoxGeometry& geometry)
 {
-  return std::max<std::int64_t>({ 8, geometry.dims[1] / 10, 2 * std::int64_t(geometry.radius.y) + 1 });
+  return std::max<std::int64_t>(
+    { 8, geometry.dims[1] / 10, 2 * std::int64_t(geometry.radius.y) + 1 });
 }
 
 /// The separable statistics of every region voxel, handed to visit(NeighbourhoodRow) row
@@ -343,8 +352,8 @@ bool forEachNeighbourhoodRow(const TypedVolume<T>& volume, const BoxGeometry& ge
     band.begin[1] = region.begin[1] + b * bandRows;
     band.size[1] = std::min(bandRows, ny - b * bandRows);
     const Execution stage = stageExecution(execution, double(b) / bands, double(b + 1) / bands);
-    if (!visitBand(
-          volume, BoxGeometry(geometry.dims, band, geometry.radius), region, scale, contents, stage, extrema, visit))
+    if (!visitBand(volume, BoxGeometry(geometry.dims, band, geometry.radius), region, scale,
+          contents, stage, extrema, visit))
     {
       return false;
     }

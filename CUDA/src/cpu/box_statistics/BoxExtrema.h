@@ -69,8 +69,10 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
   const int threads = resolveThreadCount(execution.threads);
   // Progress: the slices of the y pass, then the rows of the z pass.
   const std::int64_t work = slices + rows;
-  const bool planesDone = parallelFor(slices, threads, threads, stageExecution(execution, 0.0, double(slices) / work),
-    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+  const bool planesDone = parallelFor(slices, threads, threads,
+    stageExecution(execution, 0.0, double(slices) / work),
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
+    {
       const std::int64_t read = geometry.ys.size();
       // Interleaved voxels (one component of several) are gathered first: the pass takes
       // each row's span as contiguous lanes.
@@ -93,8 +95,8 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
           rowStride = span;
         }
         // y pass: the rows are the sequence, their x spans the lanes.
-        slidingMinMax(first, first, read, span, geometry.radius.y, region.begin[1] - geometry.ys.lo, rows,
-          &planeMin[s * plane], &planeMax[s * plane], scratch, rowStride);
+        slidingMinMax(first, first, read, span, geometry.radius.y, region.begin[1] - geometry.ys.lo,
+          rows, &planeMin[s * plane], &planeMax[s * plane], scratch, rowStride);
         progress.advance();
       }
     });
@@ -104,7 +106,8 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
   }
 
   return parallelFor(rows, threads, threads, stageExecution(execution, double(slices) / work, 1.0),
-    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
+    {
       ExtremumScratch<T> scratch;
       const std::int64_t z0 = region.begin[2] - geometry.zs.lo;
       for (std::int64_t y = begin; y < end && !progress.stopped(); ++y)
@@ -113,8 +116,8 @@ bool computeBoxExtrema(const TypedVolume<T>& volume, const BoxGeometry& geometry
         // results go back in place (the pass reads all of its input first).
         T* rowMin = &planeMin[y * span];
         T* rowMax = &planeMax[y * span];
-        slidingMinMax(rowMin, rowMax, slices, span, geometry.radius.z, z0, region.size[2], rowMin + result.offset,
-          rowMax + result.offset, scratch, plane, plane);
+        slidingMinMax(rowMin, rowMax, slices, span, geometry.radius.z, z0, region.size[2],
+          rowMin + result.offset, rowMax + result.offset, scratch, plane, plane);
         progress.advance();
       }
     });
@@ -163,12 +166,13 @@ public:
         inMin[r] = extrema.minimumRow(k, j);
         inMax[r] = extrema.maximumRow(k, j);
         minRows[r] = r < m ? &this->Minima[static_cast<std::size_t>(j * nx)] : this->Spare.data();
-        maxRows[r] = r < m ? &this->Maxima[static_cast<std::size_t>(j * nx)] : this->Spare.data() + nx;
+        maxRows[r] =
+          r < m ? &this->Maxima[static_cast<std::size_t>(j * nx)] : this->Spare.data() + nx;
       }
       rowsToLanes(inMin, lanes, 1, span, this->LanesMin.data());
       rowsToLanes(inMax, lanes, 1, span, this->LanesMax.data());
-      slidingMinMax(this->LanesMin.data(), this->LanesMax.data(), span, lanes, geometry.radius.x, x0, nx,
-        this->OutMin.data(), this->OutMax.data(), this->Scratch);
+      slidingMinMax(this->LanesMin.data(), this->LanesMax.data(), span, lanes, geometry.radius.x,
+        x0, nx, this->OutMin.data(), this->OutMax.data(), this->Scratch);
       lanesToRows(this->OutMin.data(), lanes, nx, minRows);
       lanesToRows(this->OutMax.data(), lanes, nx, maxRows);
     }

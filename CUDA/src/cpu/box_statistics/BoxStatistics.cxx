@@ -19,26 +19,33 @@ Status computeBoxStatistics(const VolumeView& view, const Region& region, const 
   }
   const detail::BoxGeometry geometry(view.dims, region, radius);
   const bool withExtrema = output.minimum || output.maximum;
-  return catchOutOfMemory("the working buffers of the box statistics", [&] {
-  return detail::dispatchScalarType(view.type, [&](auto tag) -> Status {
-    const detail::TypedVolume<decltype(tag)> volume(view);
-    // Only the shift matters here: the statistics are written as they are.
-    const detail::MomentScale scale{ detail::momentScale(volume, 0.0, 0.0).shift, 0.0 };
-    const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale, detail::RowContents{ withExtrema, true, false }, execution,
-      [&](const detail::NeighbourhoodRow& row) {
-        const auto put = [&](double* field, const double* values) {
-          if (field)
-            std::copy(values, values + row.size, field + row.index);
-        };
-        put(output.count, row.count);
-        put(output.mean, row.mean);
-        put(output.variance, row.variance);
-        put(output.minimum, row.minimum);
-        put(output.maximum, row.maximum);
-      });
-    return ok ? Status::success() : Status::cancelled();
-  });
-  });
+  return catchOutOfMemory("the working buffers of the box statistics",
+    [&]
+    {
+      return detail::dispatchScalarType(view.type,
+        [&](auto tag) -> Status
+        {
+          const detail::TypedVolume<decltype(tag)> volume(view);
+          // Only the shift matters here: the statistics are written as they are.
+          const detail::MomentScale scale{ detail::momentScale(volume, 0.0, 0.0).shift, 0.0 };
+          const bool ok = detail::forEachNeighbourhoodRow(volume, geometry, scale,
+            detail::RowContents{ withExtrema, true, false }, execution,
+            [&](const detail::NeighbourhoodRow& row)
+            {
+              const auto put = [&](double* field, const double* values)
+              {
+                if (field)
+                  std::copy(values, values + row.size, field + row.index);
+              };
+              put(output.count, row.count);
+              put(output.mean, row.mean);
+              put(output.variance, row.variance);
+              put(output.minimum, row.minimum);
+              put(output.maximum, row.maximum);
+            });
+          return ok ? Status::success() : Status::cancelled();
+        });
+    });
 }
 
 } // namespace vao

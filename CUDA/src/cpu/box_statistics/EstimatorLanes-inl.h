@@ -84,8 +84,8 @@ VAO_LANES D cdfReconstruction(D q, D mean, D minimum, D maximum)
 /// or a raw row's own 16-bit values) or isoValue where query is null; `plain(begin)` does
 /// the voxels from `begin` on (the row's tail). The row loops below take q alike.
 template <Method M, class Row, class Q, class Plain>
-VAO_LANES_ENTRY void opennessRowLanes(const Row& row, const Q* query, double isoValue, float* openness,
-  Plain&& plain)
+VAO_LANES_ENTRY void opennessRowLanes(
+  const Row& row, const Q* query, double isoValue, float* openness, Plain&& plain)
 {
   const D roundingVariance = set1(row.roundingVariance);
   const D roundingSpread = set1(flatRoundingSpread(row.roundingVariance));
@@ -114,8 +114,8 @@ VAO_LANES_ENTRY void opennessRowLanes(const Row& row, const Q* query, double iso
 /// passes and meanVarianceRowExact form them (exact conversions, then the same division),
 /// so the bits are opennessRowLanes'.
 template <class T, class Row, class Q, class Plain>
-VAO_LANES_ENTRY void cdfReconstructionRawLanes(const Row& row, const Q* query, double isoValue, float* openness,
-  Plain&& plain)
+VAO_LANES_ENTRY void cdfReconstructionRawLanes(
+  const Row& row, const Q* query, double isoValue, float* openness, Plain&& plain)
 {
   const T* minimum = static_cast<const T*>(row.raw.minimum);
   const T* maximum = static_cast<const T*>(row.raw.maximum);
@@ -126,7 +126,8 @@ VAO_LANES_ENTRY void cdfReconstructionRawLanes(const Row& row, const Q* query, d
     const D q = query ? loadAsDoubles(query + i) : set1(isoValue);
     const D count = mul(smallIntegersToDouble(loadIntegers(row.countX + i)), yz);
     const D mean = div(loadAsDoubles(row.raw.sum + i), count);
-    storeFloats(openness + i, cdfReconstruction(q, mean, loadAsDoubles(minimum + i), loadAsDoubles(maximum + i)));
+    storeFloats(openness + i,
+      cdfReconstruction(q, mean, loadAsDoubles(minimum + i), loadAsDoubles(maximum + i)));
   }
   plain(i);
 }
@@ -136,7 +137,8 @@ VAO_LANES_ENTRY void cdfReconstructionRawLanes(const Row& row, const Q* query, d
 /// are exact.
 VAO_LANES Mask smallSums(I s)
 {
-  return both(lessThan(s, set1(std::int64_t(1) << 50)), lessThan(set1(-(std::int64_t(1) << 50)), s));
+  return both(
+    lessThan(s, set1(std::int64_t(1) << 50)), lessThan(set1(-(std::int64_t(1) << 50)), s));
 }
 
 /// kWidth exact sums from p as doubles (total), and the lanes where that conversion and
@@ -158,8 +160,8 @@ VAO_LANES Mask loadSums(const std::int32_t* p, D& total)
 /// at 0), when all are exact (sums of magnitude below 2^50, both products below 2^52);
 /// false otherwise.
 template <class S>
-VAO_LANES bool exactBoxes(const S* sum, const std::int64_t* sumSquares, const std::int64_t* countX, D yz,
-  std::int64_t i, D& c, D& total, D& totalSquared, D& numerator)
+VAO_LANES bool exactBoxes(const S* sum, const std::int64_t* sumSquares, const std::int64_t* countX,
+  D yz, std::int64_t i, D& c, D& total, D& totalSquared, D& numerator)
 {
   const D exact = set1(4503599627370496.0); // 2^52
   const Mask small = loadSums(sum + i, total);
@@ -179,8 +181,8 @@ VAO_LANES bool exactBoxes(const S* sum, const std::int64_t* sumSquares, const st
 /// sumSquares, the counts and means alone.
 template <class Plain>
 VAO_LANES_ENTRY void meanVarianceRowLanes(const std::int64_t* sum, const std::int64_t* sumSquares,
-  const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, double* count, double* mean, double* variance,
-  Plain&& plain)
+  const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, double* count, double* mean,
+  double* variance, Plain&& plain)
 {
   const D yz = set1(static_cast<double>(countYZ));
   if (!sumSquares) // the means alone: sums below 2^50 in magnitude convert exactly
@@ -236,7 +238,8 @@ VAO_LANES_ENTRY void opennessFromExactSumsLanes(const S* sum, const std::int64_t
       const D q = query ? loadAsDoubles(query + i) : set1(isoValue);
       const D d = sub(mul(q, c), total);
       const Mask flat = lessEqual(positive, zero());
-      const D flatOpen = onlyWhere(greaterEqual(d, sub(zero(), mul(set1(kFlatSpread), abs(total)))), one);
+      const D flatOpen =
+        onlyWhere(greaterEqual(d, sub(zero(), mul(set1(kFlatSpread), abs(total)))), one);
       D open = zero();
       if constexpr (M == Method::Chebyshev)
       {
@@ -271,24 +274,26 @@ VAO_LANES_ENTRY void opennessFromExactSumsLanes(const S* sum, const std::int64_t
 struct RowLoops
 {
   template <Method M, class Row, class Q, class Plain>
-  static void onStatistics(const Row& row, const Q* query, double isoValue, float* openness, Plain&& plain)
+  static void onStatistics(
+    const Row& row, const Q* query, double isoValue, float* openness, Plain&& plain)
   {
     opennessRowLanes<M>(row, query, isoValue, openness, plain);
   }
   template <Method M, class Row, class Q, class Plain>
-  static void onExactSums(const Row& row, const Q* query, double isoValue, float* openness, Plain&& plain)
+  static void onExactSums(
+    const Row& row, const Q* query, double isoValue, float* openness, Plain&& plain)
   {
     if (row.raw.sum)
-      opennessFromExactSumsLanes<M>(
-        row.raw.sum, row.sumSquares, row.countX, row.countYZ, row.size, query, isoValue, openness, plain);
+      opennessFromExactSumsLanes<M>(row.raw.sum, row.sumSquares, row.countX, row.countYZ, row.size,
+        query, isoValue, openness, plain);
     else
-      opennessFromExactSumsLanes<M>(
-        row.sum, row.sumSquares, row.countX, row.countYZ, row.size, query, isoValue, openness, plain);
+      opennessFromExactSumsLanes<M>(row.sum, row.sumSquares, row.countX, row.countYZ, row.size,
+        query, isoValue, openness, plain);
   }
 #if VAO_VECTOR_MATH
   template <class T, class Row, class Q, class Plain>
-  static void cdfReconstructionOnRaw(const Row& row, const Q* query, double isoValue, float* openness,
-    Plain&& plain)
+  static void cdfReconstructionOnRaw(
+    const Row& row, const Q* query, double isoValue, float* openness, Plain&& plain)
   {
     cdfReconstructionRawLanes<T>(row, query, isoValue, openness, plain);
   }

@@ -40,8 +40,8 @@ double rawAt(const RawRow& raw, const void* p, std::int64_t i)
 /// give them (the mean alone of the moments, as CDF Reconstruction asks).
 NeighbourhoodStats rawStats(const NeighbourhoodRow& row, std::int64_t i)
 {
-  NeighbourhoodStats s{ 0.0, 0.0, rawAt(row.raw, row.raw.minimum, i), rawAt(row.raw, row.raw.maximum, i),
-    row.roundingVariance };
+  NeighbourhoodStats s{ 0.0, 0.0, rawAt(row.raw, row.raw.minimum, i),
+    rawAt(row.raw, row.raw.maximum, i), row.roundingVariance };
   double variance = 0.0;
   meanVarianceFromExactSums(row.raw.sum[i], 0, row.countX[i] * row.countYZ, s.mean, variance);
   return s;
@@ -63,8 +63,8 @@ void opennessRange(Method method, ErfMode erfMode, const NeighbourhoodRow& row, 
         static_cast<double>(sum), exactSumsNumerator(sum, row.sumSquares[i], c), erfMode));
     }
     else
-      openness[i] =
-        static_cast<float>(opennessFromStats(method, q, row.raw.sum ? rawStats(row, i) : row.stats(i), erfMode));
+      openness[i] = static_cast<float>(
+        opennessFromStats(method, q, row.raw.sum ? rawStats(row, i) : row.stats(i), erfMode));
   }
 }
 
@@ -73,37 +73,38 @@ void opennessRange(Method method, ErfMode erfMode, const NeighbourhoodRow& row, 
 /// where the row has them for it, else on its statistics, with the queries of lanesQuery
 /// (query, or a raw row's own values where query is null) or isoValue.
 template <class Loops, class Q>
-void opennessRowVectorFrom(Method method, const NeighbourhoodRow& row, const double* query, const Q* lanesQuery,
-  double isoValue, float* openness)
+void opennessRowVectorFrom(Method method, const NeighbourhoodRow& row, const double* query,
+  const Q* lanesQuery, double isoValue, float* openness)
 {
   if (takesExactSums(method, row))
   {
-    const auto plain = [&](std::int64_t end, std::int64_t begin) {
-      opennessRange(method, ErfMode::Exact, row, query, isoValue, openness, begin, end);
-    };
+    const auto plain = [&](std::int64_t end, std::int64_t begin)
+    { opennessRange(method, ErfMode::Exact, row, query, isoValue, openness, begin, end); };
     if (method == Method::Chebyshev)
       Loops::template onExactSums<Method::Chebyshev>(row, lanesQuery, isoValue, openness, plain);
     else
       Loops::template onExactSums<Method::GaussianCdf>(row, lanesQuery, isoValue, openness, plain);
     return;
   }
-  const auto plain = [&](std::int64_t begin) {
-    opennessRange(method, ErfMode::Exact, row, query, isoValue, openness, begin, row.size);
-  };
+  const auto plain = [&](std::int64_t begin)
+  { opennessRange(method, ErfMode::Exact, row, query, isoValue, openness, begin, row.size); };
 #if VAO_VECTOR_MATH
   if (row.raw.sum) // CDF Reconstruction's (RowContents::raw)
   {
     if (row.raw.type == ScalarType::Int16)
-      Loops::template cdfReconstructionOnRaw<std::int16_t>(row, lanesQuery, isoValue, openness, plain);
+      Loops::template cdfReconstructionOnRaw<std::int16_t>(
+        row, lanesQuery, isoValue, openness, plain);
     else
-      Loops::template cdfReconstructionOnRaw<std::uint16_t>(row, lanesQuery, isoValue, openness, plain);
+      Loops::template cdfReconstructionOnRaw<std::uint16_t>(
+        row, lanesQuery, isoValue, openness, plain);
     return;
   }
 #endif
   if (method == Method::Chebyshev)
     Loops::template onStatistics<Method::Chebyshev>(row, lanesQuery, isoValue, openness, plain);
   else if (method == Method::CdfReconstruction)
-    Loops::template onStatistics<Method::CdfReconstruction>(row, lanesQuery, isoValue, openness, plain);
+    Loops::template onStatistics<Method::CdfReconstruction>(
+      row, lanesQuery, isoValue, openness, plain);
   else
     Loops::template onStatistics<Method::GaussianCdf>(row, lanesQuery, isoValue, openness, plain);
 }
@@ -126,8 +127,8 @@ void opennessRowVector(
 
 } // namespace
 
-void opennessRowPlain(Method method, ErfMode erfMode, const NeighbourhoodRow& row, const double* query,
-  double isoValue, float* openness, std::int64_t begin)
+void opennessRowPlain(Method method, ErfMode erfMode, const NeighbourhoodRow& row,
+  const double* query, double isoValue, float* openness, std::int64_t begin)
 {
   opennessRange(method, erfMode, row, query, isoValue, openness, begin, row.size);
 }
@@ -135,7 +136,8 @@ void opennessRowPlain(Method method, ErfMode erfMode, const NeighbourhoodRow& ro
 bool opennessRowIsVector(Method method, ErfMode erfMode)
 {
   const bool chebyshev = method == Method::Chebyshev;
-  const bool gaussian = VAO_VECTOR_MATH && method == Method::GaussianCdf && erfMode == ErfMode::Exact;
+  const bool gaussian =
+    VAO_VECTOR_MATH && method == Method::GaussianCdf && erfMode == ErfMode::Exact;
   const bool reconstruction = VAO_VECTOR_MATH && method == Method::CdfReconstruction;
   return cpuHasAvx2() && (chebyshev || gaussian || reconstruction);
 }

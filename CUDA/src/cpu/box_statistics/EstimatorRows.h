@@ -20,8 +20,8 @@ void opennessRow(Method method, ErfMode erfMode, const NeighbourhoodRow& row, co
   double isoValue, float* openness);
 
 /// The plain loop of opennessRow from voxel `begin` on (the vector forms' tail; tests).
-void opennessRowPlain(Method method, ErfMode erfMode, const NeighbourhoodRow& row, const double* query,
-  double isoValue, float* openness, std::int64_t begin = 0);
+void opennessRowPlain(Method method, ErfMode erfMode, const NeighbourhoodRow& row,
+  const double* query, double isoValue, float* openness, std::int64_t begin = 0);
 
 /// True when opennessRow runs four voxels at a time here for this method.
 bool opennessRowIsVector(Method method, ErfMode erfMode);

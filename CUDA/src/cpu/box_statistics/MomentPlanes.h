@@ -10,10 +10,10 @@
 // written once per slice.
 #pragma once
 
-#include "cpu/simd/CpuDispatch.h"
-#include "cpu/common/Parallel.h"
-#include "cpu/box_statistics/RunningTotals.h"
 #include "VolumeAccess.h"
+#include "cpu/box_statistics/RunningTotals.h"
+#include "cpu/common/Parallel.h"
+#include "cpu/simd/CpuDispatch.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -66,8 +66,8 @@ struct BoxGeometry
 template <class Acc, class In = Acc, class Out = Acc>
 struct SlideColumns
 {
-  static VAO_ALWAYS_INLINE void run(Acc* __restrict plane, Acc* __restrict run, const In* __restrict entering,
-    const Out* __restrict leaving, std::int64_t n)
+  static VAO_ALWAYS_INLINE void run(Acc* __restrict plane, Acc* __restrict run,
+    const In* __restrict entering, const Out* __restrict leaving, std::int64_t n)
   {
     if (plane)
       for (std::int64_t i = 0; i < n; ++i)
@@ -97,12 +97,14 @@ constexpr bool kSquaresFitInt32 =
 template <class T, class Acc, bool Squares = true, class Lin = Acc, class Sq = Acc>
 struct RowDifferences
 {
-  static VAO_ALWAYS_INLINE void run(const T* __restrict in, const T* __restrict out, std::int64_t stride,
-    std::int64_t n, Acc shift, Lin* __restrict d1, Sq* __restrict d2, std::int32_t* largest = nullptr)
+  static VAO_ALWAYS_INLINE void run(const T* __restrict in, const T* __restrict out,
+    std::int64_t stride, std::int64_t n, Acc shift, Lin* __restrict d1, Sq* __restrict d2,
+    std::int32_t* largest = nullptr)
   {
     using Product = typename std::conditional<kSquaresFitInt32<T>, std::int32_t, Acc>::type;
     constexpr bool narrowSquares = Squares && !std::is_same<Sq, Acc>::value;
-    static_assert(!narrowSquares || std::is_same<Product, std::int32_t>::value, "32-bit squares of 8- and 16-bit values");
+    static_assert(!narrowSquares || std::is_same<Product, std::int32_t>::value,
+      "32-bit squares of 8- and 16-bit values");
     const auto s = static_cast<Product>(shift);
     std::int32_t most = 0;
     for (std::int64_t i = 0; i < n; ++i)
@@ -144,8 +146,9 @@ VAO_ALWAYS_INLINE Acc squaresWindow(Sq difference)
 template <class Acc, bool Squares = true, class Lin = Acc, class Sq = Acc>
 struct WindowDifferences
 {
-  static VAO_ALWAYS_INLINE void run(const Lin* __restrict p1, const Sq* __restrict p2, std::int64_t offset,
-    std::int64_t width, Lin* __restrict box1, Acc* __restrict box2, std::int64_t begin, std::int64_t end)
+  static VAO_ALWAYS_INLINE void run(const Lin* __restrict p1, const Sq* __restrict p2,
+    std::int64_t offset, std::int64_t width, Lin* __restrict box1, Acc* __restrict box2,
+    std::int64_t begin, std::int64_t end)
   {
     for (std::int64_t i = begin; i < end; ++i)
     {
@@ -165,7 +168,8 @@ template <class T>
 bool linearSumsFit32(const BoxGeometry& geometry)
 {
   static_assert(MomentTraits<T>::exactInteger, "exact integer sums only");
-  const double largest = std::max(-double(std::numeric_limits<T>::min()), double(std::numeric_limits<T>::max()));
+  const double largest =
+    std::max(-double(std::numeric_limits<T>::min()), double(std::numeric_limits<T>::max()));
   double voxels = 1.0;
   const int radii[3] = { geometry.radius.x, geometry.radius.y, geometry.radius.z };
   for (int a = 0; a < 3; ++a)
@@ -184,7 +188,8 @@ public:
   // 8-bit and int16 values with 32-bit sums of v: each row's differences of squares
   // a^2 - b^2 fit in int32 (RowDifferences), and their x sums run modulo 2^32 too
   // in the rows where no window can leave int32's range (boxRowDifference).
-  static constexpr bool kNarrowSquares = std::is_same<Lin, std::uint32_t>::value && kSquaresFitInt32<T>;
+  static constexpr bool kNarrowSquares =
+    std::is_same<Lin, std::uint32_t>::value && kSquaresFitInt32<T>;
 
   MomentPlanes(const TypedVolume<T>& volume, const BoxGeometry& geometry, Acc shift, bool squares)
     : Volume(volume)
@@ -254,11 +259,12 @@ private:
     std::fill(this->Run1.begin(), this->Run1.end(), Lin(0));
     const Lin* zerosLin = this->ZerosLin.data();
     std::fill(this->Run2.begin(), this->Run2.end(), Acc(0));
-    const auto slide = [&](std::int64_t row, std::int64_t in, std::int64_t out) {
+    const auto slide = [&](std::int64_t row, std::int64_t in, std::int64_t out)
+    {
       Lin* plane1 = row < 0 ? nullptr : this->Sum.data() + row * nx;
       Acc* plane2 = row < 0 ? nullptr : this->SumSquares.data() + row * nx;
-      runRows<SlideColumns<Lin>>(this->Simd, plane1, this->Run1.data(), in < 0 ? zerosLin : this->xbox1(in),
-        out < 0 ? zerosLin : this->xbox1(out), nx);
+      runRows<SlideColumns<Lin>>(this->Simd, plane1, this->Run1.data(),
+        in < 0 ? zerosLin : this->xbox1(in), out < 0 ? zerosLin : this->xbox1(out), nx);
       if (this->Squares)
         this->slideSquares(plane2, in, out);
     };
@@ -281,11 +287,20 @@ private:
   }
 
   std::int64_t slot(std::int64_t y) const { return (y - this->Geo.ys.lo) % this->RingRows; }
-  Lin* xbox1(std::int64_t y) { return this->XBox1.data() + this->slot(y) * this->Geo.region.size[0]; }
-  Acc* xbox2(std::int64_t y) { return this->XBox2.data() + this->slot(y) * this->Geo.region.size[0]; }
+  Lin* xbox1(std::int64_t y)
+  {
+    return this->XBox1.data() + this->slot(y) * this->Geo.region.size[0];
+  }
+  Acc* xbox2(std::int64_t y)
+  {
+    return this->XBox2.data() + this->slot(y) * this->Geo.region.size[0];
+  }
   /// Row y's x-box sums of squares where each fits in int32 (narrow: half the bytes in
   /// the ring, so that on CT-like data the ring stays in the first-level cache).
-  std::int32_t* xbox2Narrow(std::int64_t y) { return this->XBox2Narrow.data() + this->slot(y) * this->Geo.region.size[0]; }
+  std::int32_t* xbox2Narrow(std::int64_t y)
+  {
+    return this->XBox2Narrow.data() + this->slot(y) * this->Geo.region.size[0];
+  }
 
   /// The y pass of the squares: Run2 moves on by row `in` and `out` (-1: none), each read
   /// from whichever ring holds it, after plane2 (when not null) has taken it.
@@ -301,14 +316,18 @@ private:
       const std::int32_t* in32 = in < 0 ? this->ZerosNarrow.data() : this->xbox2Narrow(in);
       const std::int32_t* out32 = out < 0 ? this->ZerosNarrow.data() : this->xbox2Narrow(out);
       if (narrowIn && narrowOut)
-        return runRows<SlideColumns<Acc, std::int32_t, std::int32_t>>(this->Simd, plane2, run, in32, out32, nx);
+        return runRows<SlideColumns<Acc, std::int32_t, std::int32_t>>(
+          this->Simd, plane2, run, in32, out32, nx);
       if (narrowIn)
-        return runRows<SlideColumns<Acc, std::int32_t, Acc>>(this->Simd, plane2, run, in32, this->xbox2(out), nx);
+        return runRows<SlideColumns<Acc, std::int32_t, Acc>>(
+          this->Simd, plane2, run, in32, this->xbox2(out), nx);
       if (narrowOut)
-        return runRows<SlideColumns<Acc, Acc, std::int32_t>>(this->Simd, plane2, run, this->xbox2(in), out32, nx);
+        return runRows<SlideColumns<Acc, Acc, std::int32_t>>(
+          this->Simd, plane2, run, this->xbox2(in), out32, nx);
     }
     const Acc* zeros = this->Zeros.data();
-    runRows<SlideColumns<Acc>>(this->Simd, plane2, run, in < 0 ? zeros : this->xbox2(in), out < 0 ? zeros : this->xbox2(out), nx);
+    runRows<SlideColumns<Acc>>(this->Simd, plane2, run, in < 0 ? zeros : this->xbox2(in),
+      out < 0 ? zeros : this->xbox2(out), nx);
   }
 
   /// x box sums of one row of (entering - leaving), stored in the ring at xbox1(y), xbox2(y).
@@ -320,7 +339,8 @@ private:
     Lin* p1 = this->Row1.data();
     Acc* p2 = this->Row2.data();
     std::uint32_t* q2 = this->Row2Narrow.data();
-    const T* in = entering >= 0 ? this->Volume.row(y, entering) + this->Geo.xs.lo * stride : nullptr;
+    const T* in =
+      entering >= 0 ? this->Volume.row(y, entering) + this->Geo.xs.lo * stride : nullptr;
     const T* out = leaving >= 0 ? this->Volume.row(y, leaving) + this->Geo.xs.lo * stride : nullptr;
     // The differences of the two rows (a vector loop), then their prefix sums:
     // p[i] = sum of the first i values.
@@ -345,11 +365,13 @@ private:
     {
       if (this->Squares)
       {
-        runRows<RowDifferences<T, Acc, true, Lin>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
+        runRows<RowDifferences<T, Acc, true, Lin>>(
+          this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2 + 1);
         p2[0] = 0;
       }
       else
-        runRows<RowDifferences<T, Acc, false, Lin>>(this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2);
+        runRows<RowDifferences<T, Acc, false, Lin>>(
+          this->Simd, in, out, stride, span, this->Shift, p1 + 1, p2);
     }
     if constexpr (std::is_same<Lin, std::uint32_t>::value)
     {
@@ -359,7 +381,8 @@ private:
         runningTotals(p2, nullptr, span + 1, this->Simd);
     }
     else if constexpr (std::is_same<Acc, std::int64_t>::value)
-      runningTotals(p1, this->Squares ? p2 : nullptr, span + 1, this->Simd); // exact: any order of the additions
+      runningTotals(p1, this->Squares ? p2 : nullptr, span + 1,
+        this->Simd); // exact: any order of the additions
     else
       for (std::int64_t i = 0; i < span; ++i) // double sums: this order on every tier
       {
@@ -384,7 +407,8 @@ private:
     const std::int64_t x0 = this->Geo.region.begin[0] - this->Geo.xs.lo; // first output in span
     Lin* box1 = this->xbox1(y);
     // Sums of squares from 32-bit prefix sums (Sq = std::uint32_t) fit in int32: the narrow ring.
-    constexpr bool narrow = std::is_same<Sq, std::uint32_t>::value && !std::is_same<Acc, std::uint32_t>::value;
+    constexpr bool narrow =
+      std::is_same<Sq, std::uint32_t>::value && !std::is_same<Acc, std::uint32_t>::value;
     using Box = typename std::conditional<narrow, std::int32_t, Acc>::type;
     Box* box2 = nullptr;
     if (p2)
@@ -398,7 +422,8 @@ private:
     // Outputs whose window lies inside the span (a vector loop) and the clamped ends.
     const std::int64_t first = std::min(nx, std::max<std::int64_t>(0, r - x0));
     const std::int64_t end = std::max(first, std::min(nx, span - r - x0));
-    const auto clamped = [&](std::int64_t i) {
+    const auto clamped = [&](std::int64_t i)
+    {
       const std::int64_t lo = std::max<std::int64_t>(0, x0 + i - r);
       const std::int64_t hi = std::min<std::int64_t>(span, x0 + i + r + 1);
       box1[i] = p1[hi] - p1[lo];
@@ -408,9 +433,11 @@ private:
     for (std::int64_t i = 0; i < first; ++i)
       clamped(i);
     if (box2)
-      runRows<WindowDifferences<Box, true, Lin, Sq>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+      runRows<WindowDifferences<Box, true, Lin, Sq>>(
+        this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
     else
-      runRows<WindowDifferences<Box, false, Lin, Sq>>(this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
+      runRows<WindowDifferences<Box, false, Lin, Sq>>(
+        this->Simd, p1, p2, x0 - r, 2 * r + 1, box1, box2, first, end);
     for (std::int64_t i = end; i < nx; ++i)
       clamped(i);
   }
@@ -424,15 +451,15 @@ private:
   std::vector<Lin> Row1;
   std::vector<Acc> Row2;
   std::vector<std::uint32_t> Row2Narrow; // kNarrowSquares: the squares' differences, 32-bit
-  std::int64_t RingRows; // x-box rows kept: a window's and the next entering one
+  std::int64_t RingRows;                 // x-box rows kept: a window's and the next entering one
   std::vector<Lin> XBox1;
   std::vector<Acc> XBox2;
   std::vector<std::int32_t> XBox2Narrow; // kNarrowSquares: the rows whose sums fit in int32
-  std::vector<char> SlotNarrow; // per ring slot: its squares are in XBox2Narrow
+  std::vector<char> SlotNarrow;          // per ring slot: its squares are in XBox2Narrow
   std::vector<Lin> Run1;
   std::vector<Acc> Run2;
-  std::vector<Acc> Zeros; // a row outside the volume
-  std::vector<Lin> ZerosLin; // the same for the sums of v
+  std::vector<Acc> Zeros;                // a row outside the volume
+  std::vector<Lin> ZerosLin;             // the same for the sums of v
   std::vector<std::int32_t> ZerosNarrow; // and for the narrow squares
   SimdTier Simd = cpuSimdTier();
 };
@@ -443,11 +470,11 @@ template <class T, class Lin = typename MomentTraits<T>::Accumulator>
 struct MomentSlice
 {
   using Acc = typename MomentTraits<T>::Accumulator;
-  std::int64_t z;         // output slice, volume coordinates
-  const Lin* sum;         // region plane, x fastest (uint32: the int32 sums' bits)
-  const Acc* sumSquares;  // null when not asked for
-  double shift;           // add to sum / count to get the mean
-  std::int64_t countZ;    // clipped window size along z
+  std::int64_t z;          // output slice, volume coordinates
+  const Lin* sum;          // region plane, x fastest (uint32: the int32 sums' bits)
+  const Acc* sumSquares;   // null when not asked for
+  double shift;            // add to sum / count to get the mean
+  std::int64_t countZ;     // clipped window size along z
   double roundingVariance; // what rounding can fake on a flat box (MomentScale)
 };
 
@@ -457,14 +484,15 @@ struct MomentSlice
 /// sums of v are in Lin (std::uint32_t only where linearSumsFit32), the sums of squares
 /// formed only if `squares`. Returns false when cancelled.
 template <class T, class Lin, class MakeConsumer>
-bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry, const MomentScale& scale,
-  bool squares, const Execution& execution, MakeConsumer&& makeConsumer)
+bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
+  const MomentScale& scale, bool squares, const Execution& execution, MakeConsumer&& makeConsumer)
 {
   const auto shift = static_cast<typename MomentTraits<T>::Accumulator>(scale.shift);
   const int threads = resolveThreadCount(execution.threads);
   const std::int64_t nz = geometry.region.size[2];
   return parallelFor(nz, threads, threads, execution,
-    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
+    {
       MomentPlanes<T, Lin> planes(volume, geometry, shift, squares);
       auto consume = makeConsumer();
       for (std::int64_t k = begin; k < end; ++k)

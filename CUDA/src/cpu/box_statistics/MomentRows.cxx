@@ -12,8 +12,9 @@ namespace vao
 namespace detail
 {
 
-void meanVarianceRowExactPlain(const std::int64_t* sum, const std::int64_t* sumSquares, const std::int64_t* countX,
-  std::int64_t countYZ, std::int64_t n, double* count, double* mean, double* variance, std::int64_t begin)
+void meanVarianceRowExactPlain(const std::int64_t* sum, const std::int64_t* sumSquares,
+  const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, double* count, double* mean,
+  double* variance, std::int64_t begin)
 {
   for (std::int64_t i = begin; i < n; ++i)
   {
@@ -26,8 +27,9 @@ void meanVarianceRowExactPlain(const std::int64_t* sum, const std::int64_t* sumS
   }
 }
 
-void meanVarianceRowExact(const std::int64_t* sum, const std::int64_t* sumSquares, const std::int64_t* countX,
-  std::int64_t countYZ, std::int64_t n, double* count, double* mean, double* variance)
+void meanVarianceRowExact(const std::int64_t* sum, const std::int64_t* sumSquares,
+  const std::int64_t* countX, std::int64_t countYZ, std::int64_t n, double* count, double* mean,
+  double* variance)
 {
 #if VAO_HAVE_AVX2_TARGET
   const auto plain = [&](std::int64_t end, std::int64_t begin) {

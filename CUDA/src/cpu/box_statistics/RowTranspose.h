@@ -55,10 +55,12 @@ VAO_AVX2_INLINE void rowsToLanes16x16(const void* const* rows, std::int64_t bloc
   {
     __m256i a[16];
     for (int k = 0; k < 16; ++k)
-      a[k] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(static_cast<const std::int16_t*>(rows[k]) + 16 * b));
+      a[k] = _mm256_loadu_si256(
+        reinterpret_cast<const __m256i*>(static_cast<const std::int16_t*>(rows[k]) + 16 * b));
     transpose16x16Epi16(a);
     for (int i = 0; i < 16; ++i)
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(static_cast<std::int16_t*>(out) + 256 * b + 16 * i), a[i]);
+      _mm256_storeu_si256(
+        reinterpret_cast<__m256i*>(static_cast<std::int16_t*>(out) + 256 * b + 16 * i), a[i]);
   }
 }
 
@@ -69,10 +71,12 @@ VAO_AVX2_INLINE void lanesToRows16x16(const void* lanes, std::int64_t blocks, vo
   {
     __m256i a[16];
     for (int i = 0; i < 16; ++i)
-      a[i] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(static_cast<const std::int16_t*>(lanes) + 256 * b + 16 * i));
+      a[i] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(
+        static_cast<const std::int16_t*>(lanes) + 256 * b + 16 * i));
     transpose16x16Epi16(a);
     for (int k = 0; k < 16; ++k)
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(static_cast<std::int16_t*>(rows[k]) + 16 * b), a[k]);
+      _mm256_storeu_si256(
+        reinterpret_cast<__m256i*>(static_cast<std::int16_t*>(rows[k]) + 16 * b), a[k]);
   }
 }
 #endif
@@ -91,7 +95,8 @@ bool transposesInBlocks()
 
 /// lanes[i * m + k] = rows[k][i * stride] for k < m, i < span.
 template <class T>
-void rowsToLanes(const T* const* rows, std::int64_t m, std::int64_t stride, std::int64_t span, T* lanes)
+void rowsToLanes(
+  const T* const* rows, std::int64_t m, std::int64_t stride, std::int64_t span, T* lanes)
 {
   std::int64_t done = 0;
 #if VAO_HAVE_AVX2_TARGET

@@ -62,8 +62,9 @@ VAO_AVX512_TARGET inline __m512i scanLanes(__m512i x)
 VAO_AVX2_HELPER __m256i scanLanes(__m256i x)
 {
   x = _mm256_add_epi64(x, _mm256_slli_si256(x, 8));
-  return _mm256_add_epi64(
-    x, _mm256_blend_epi32(_mm256_setzero_si256(), _mm256_permute4x64_epi64(x, _MM_SHUFFLE(1, 1, 0, 0)), 0xF0));
+  return _mm256_add_epi64(x,
+    _mm256_blend_epi32(
+      _mm256_setzero_si256(), _mm256_permute4x64_epi64(x, _MM_SHUFFLE(1, 1, 0, 0)), 0xF0));
 }
 
 /// Of a and, with Both, of b, four at a time; the carried totals as in the 32-bit rows.
@@ -137,7 +138,10 @@ struct Lanes32
   static constexpr int kCount = 16;
   static VAO_AVX512_TARGET __m512i scan(__m512i x) { return scanLanes32(x); }
   static VAO_AVX512_TARGET __m512i add(__m512i x, __m512i y) { return _mm512_add_epi32(x, y); }
-  static VAO_AVX512_TARGET __m512i last(__m512i x) { return _mm512_permutexvar_epi32(_mm512_set1_epi32(15), x); }
+  static VAO_AVX512_TARGET __m512i last(__m512i x)
+  {
+    return _mm512_permutexvar_epi32(_mm512_set1_epi32(15), x);
+  }
 };
 
 struct Lanes64
@@ -145,7 +149,10 @@ struct Lanes64
   static constexpr int kCount = 8;
   static VAO_AVX512_TARGET __m512i scan(__m512i x) { return scanLanes(x); }
   static VAO_AVX512_TARGET __m512i add(__m512i x, __m512i y) { return _mm512_add_epi64(x, y); }
-  static VAO_AVX512_TARGET __m512i last(__m512i x) { return _mm512_permutexvar_epi64(_mm512_set1_epi64(7), x); }
+  static VAO_AVX512_TARGET __m512i last(__m512i x)
+  {
+    return _mm512_permutexvar_epi64(_mm512_set1_epi64(7), x);
+  }
 };
 
 /// Running totals of a and, with Both, of b, a vector at a time: the scan within the vector

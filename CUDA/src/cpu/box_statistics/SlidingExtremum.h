@@ -76,8 +76,8 @@ template <class T>
 struct LaneLoops
 {
   /// A block's first element starts both running results.
-  static VAO_ALWAYS_INLINE void start(const T* lo, const T* hi, T* __restrict runMin, T* __restrict runMax,
-    std::int64_t m)
+  static VAO_ALWAYS_INLINE void start(
+    const T* lo, const T* hi, T* __restrict runMin, T* __restrict runMax, std::int64_t m)
   {
     for (std::int64_t k = 0; k < m; ++k)
     {
@@ -98,7 +98,8 @@ struct LaneLoops
   }
 
   /// The suffix one position further: sufMin = min(lo, sufMin), sufMax = max(hi, sufMax).
-  static VAO_ALWAYS_INLINE void extendInPlace(const T* lo, const T* hi, T* sufMin, T* sufMax, std::int64_t m)
+  static VAO_ALWAYS_INLINE void extendInPlace(
+    const T* lo, const T* hi, T* sufMin, T* sufMax, std::int64_t m)
   {
     for (std::int64_t k = 0; k < m; ++k)
     {
@@ -165,19 +166,20 @@ struct SixteenLanes
     __builtin_memcpy(runMin, lo, sizeof(V));
     __builtin_memcpy(runMax, hi, sizeof(V));
   }
-  static VAO_ALWAYS_INLINE void extend(const T* lo, const T* hi, const T* prevMin, const T* prevMax, T* runMin,
-    T* runMax, std::int64_t)
+  static VAO_ALWAYS_INLINE void extend(const T* lo, const T* hi, const T* prevMin, const T* prevMax,
+    T* runMin, T* runMax, std::int64_t)
   {
     lesser(lo, prevMin, runMin);
     greater(hi, prevMax, runMax);
   }
-  static VAO_ALWAYS_INLINE void extendInPlace(const T* lo, const T* hi, T* sufMin, T* sufMax, std::int64_t)
+  static VAO_ALWAYS_INLINE void extendInPlace(
+    const T* lo, const T* hi, T* sufMin, T* sufMax, std::int64_t)
   {
     lesser(lo, sufMin, sufMin);
     greater(hi, sufMax, sufMax);
   }
-  static VAO_ALWAYS_INLINE void combine(const T* minA, const T* minB, const T* maxA, const T* maxB, T* om, T* ox,
-    std::int64_t)
+  static VAO_ALWAYS_INLINE void combine(
+    const T* minA, const T* minB, const T* maxA, const T* maxB, T* om, T* ox, std::int64_t)
   {
     lesser(minA, minB, om);
     greater(maxA, maxB, ox);
@@ -194,21 +196,21 @@ struct ExtremumPasses
   /// running lane vector: an output is written at its window's first position, where the
   /// suffix it takes is the running one, so the suffixes are never stored. Outputs sit at
   /// or after that position, so they may overwrite input already read.
-  static VAO_ALWAYS_INLINE void run(const T* inMin, const T* inMax, std::int64_t inStride, std::int64_t n,
-    std::int64_t m, std::int64_t w, T* preMin, T* sufMin, T* preMax, T* sufMax, const std::int64_t* first,
-    const std::int64_t* second, const std::int64_t* lo, std::int64_t outCount, T* outMin, T* outMax,
-    std::int64_t outStride)
+  static VAO_ALWAYS_INLINE void run(const T* inMin, const T* inMax, std::int64_t inStride,
+    std::int64_t n, std::int64_t m, std::int64_t w, T* preMin, T* sufMin, T* preMax, T* sufMax,
+    const std::int64_t* first, const std::int64_t* second, const std::int64_t* lo,
+    std::int64_t outCount, T* outMin, T* outMax, std::int64_t outStride)
   {
     for (std::int64_t blockStart = 0; blockStart < n; blockStart += w)
     {
       const std::int64_t blockEnd = blockStart + w < n ? blockStart + w : n;
       // The first element of a block starts both running results; the rest extend them.
-      Steps::start(inMin + blockStart * inStride, inMax + blockStart * inStride, preMin + blockStart * m,
-        preMax + blockStart * m, m);
+      Steps::start(inMin + blockStart * inStride, inMax + blockStart * inStride,
+        preMin + blockStart * m, preMax + blockStart * m, m);
       for (std::int64_t i = blockStart + 1; i < blockEnd; ++i)
       {
-        Steps::extend(inMin + i * inStride, inMax + i * inStride, preMin + (i - 1) * m, preMax + (i - 1) * m,
-          preMin + i * m, preMax + i * m, m);
+        Steps::extend(inMin + i * inStride, inMax + i * inStride, preMin + (i - 1) * m,
+          preMax + (i - 1) * m, preMin + i * m, preMax + i * m, m);
       }
     }
     std::int64_t o = outCount - 1;
@@ -254,11 +256,12 @@ void slidingMinMax(const T* inMin, const T* inMax, std::int64_t n, std::int64_t 
   T* preMin = scratch.minParts.data();
   T* preMax = scratch.maxParts.data();
   // AVX2 at most: AVX-512 brings these compare-and-store loops nothing.
-  const auto passes = [&](auto steps) {
+  const auto passes = [&](auto steps)
+  {
     runRows<ExtremumPasses<T, decltype(steps)>>(cpuSimdTierUpTo(SimdTier::Avx2), inMin, inMax,
       inStride < 0 ? m : inStride, n, m, 2 * r + 1, preMin, preMin + n * m, preMax, preMax + n * m,
-      scratch.plan.first.data(), scratch.plan.second.data(), scratch.plan.lo.data(), outCount, outMin, outMax,
-      outStride < 0 ? m : outStride);
+      scratch.plan.first.data(), scratch.plan.second.data(), scratch.plan.lo.data(), outCount,
+      outMin, outMax, outStride < 0 ? m : outStride);
   };
 #if defined(__GNUC__) || defined(__clang__)
   if constexpr (std::is_same<T, std::int16_t>::value || std::is_same<T, std::uint16_t>::value)

@@ -29,7 +29,8 @@ bool rowExtremesPlain(const float* v, std::int64_t n, float& lo, float& hi)
 }
 
 #if VAO_HAVE_AVX2_TARGET
-__attribute__((target("avx2,fma"))) bool rowExtremesAvx2(const float* v, std::int64_t n, float& lo, float& hi)
+__attribute__((target("avx2,fma"))) bool rowExtremesAvx2(
+  const float* v, std::int64_t n, float& lo, float& hi)
 {
   const __m256 zero = _mm256_setzero_ps();
   __m256 low = _mm256_set1_ps(lo), high = _mm256_set1_ps(hi);
@@ -63,7 +64,8 @@ VAO_AVX512_TARGET bool rowExtremesAvx512(const float* v, std::int64_t n, float& 
     const __m512 x = _mm512_loadu_ps(v + i);
     low = _mm512_min_ps(low, x);
     high = _mm512_max_ps(high, x);
-    infinite = static_cast<__mmask16>(infinite | _mm512_cmp_ps_mask(_mm512_mul_ps(x, zero), zero, _CMP_NEQ_UQ));
+    infinite = static_cast<__mmask16>(
+      infinite | _mm512_cmp_ps_mask(_mm512_mul_ps(x, zero), zero, _CMP_NEQ_UQ));
   }
   lo = _mm512_reduce_min_ps(low);
   hi = _mm512_reduce_max_ps(high);

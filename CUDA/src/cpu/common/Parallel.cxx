@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <condition_variable>
 #include <cstdlib>
-#include <initializer_list>
 #include <exception>
+#include <initializer_list>
 #include <mutex>
 #include <system_error>
 #include <thread>
@@ -80,7 +80,8 @@ int launcherNumber(std::initializer_list<const char*> names, int least, int fall
 /// Ranks of this job on this node, as the MPI launchers announce it (1 without one).
 int ranksOnNode()
 {
-  return launcherNumber({ "OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS", "MV2_COMM_WORLD_LOCAL_SIZE" }, 1, 1);
+  return launcherNumber(
+    { "OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS", "MV2_COMM_WORLD_LOCAL_SIZE" }, 1, 1);
 }
 
 /// Persistent workers that run one team job at a time (see Parallel.h).
@@ -103,7 +104,8 @@ public:
   {
     bool idle = false;
     // A forked child (Python's multiprocessing, say) has none of its parent's workers.
-    if (wanted <= 1 || processId() != this->Owner || !this->Busy.compare_exchange_strong(idle, true))
+    if (wanted <= 1 || processId() != this->Owner ||
+      !this->Busy.compare_exchange_strong(idle, true))
     {
       task(0, 1);
       return;
@@ -220,8 +222,9 @@ private:
 
 int nodeLocalRank()
 {
-  return launcherNumber(
-    { "OMPI_COMM_WORLD_LOCAL_RANK", "MPI_LOCALRANKID", "MV2_COMM_WORLD_LOCAL_RANK", "SLURM_LOCALID" }, 0, 0);
+  return launcherNumber({ "OMPI_COMM_WORLD_LOCAL_RANK", "MPI_LOCALRANKID",
+                          "MV2_COMM_WORLD_LOCAL_RANK", "SLURM_LOCALID" },
+    0, 0);
 }
 
 int resolveThreadCount(int requested)
@@ -230,7 +233,8 @@ int resolveThreadCount(int requested)
   {
     return requested;
   }
-  static const int fallback = [] {
+  static const int fallback = []
+  {
     bool restricted = false;
     const int cores = availableCores(restricted);
     return defaultThreadCount(cores, restricted, ranksOnNode());
@@ -293,21 +297,23 @@ bool parallelFor(std::int64_t n, int chunks, int threads, const Execution& execu
   }
   chunks = static_cast<int>(std::max<std::int64_t>(1, std::min<std::int64_t>(chunks, n)));
   const int wanted = std::max(1, std::min(resolveThreadCount(threads), chunks));
-  WorkerPool::shared().run(wanted, [&](int member, int team) {
-    ChunkProgress progress(control, member == 0);
-    try
+  WorkerPool::shared().run(wanted,
+    [&](int member, int team)
     {
-      for (int c = member; c < chunks && !control.stopped(); c += team)
+      ChunkProgress progress(control, member == 0);
+      try
       {
-        body(n * c / chunks, n * (c + 1) / chunks, progress);
+        for (int c = member; c < chunks && !control.stopped(); c += team)
+        {
+          body(n * c / chunks, n * (c + 1) / chunks, progress);
+        }
       }
-    }
-    catch (...)
-    {
-      control.stop();
-      throw;
-    }
-  });
+      catch (...)
+      {
+        control.stop();
+        throw;
+      }
+    });
   return !control.stopped();
 }
 
@@ -325,7 +331,8 @@ bool parallelRanges(std::int64_t n, const Execution& execution,
   // Enough chunks for progress to move and for uneven chunks to even out.
   const std::int64_t chunks = std::max<std::int64_t>(1, std::min<std::int64_t>(n, 16 * threads));
   return detail::parallelFor(n, static_cast<int>(chunks), threads, execution,
-    [&](std::int64_t begin, std::int64_t end, detail::ChunkProgress& progress) {
+    [&](std::int64_t begin, std::int64_t end, detail::ChunkProgress& progress)
+    {
       body(begin, end);
       progress.advance(end - begin);
     });

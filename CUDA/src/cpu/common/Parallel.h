@@ -89,7 +89,8 @@ private:
   bool OnCallingThread;
 };
 
-using ChunkBody = std::function<void(std::int64_t begin, std::int64_t end, ChunkProgress& progress)>;
+using ChunkBody =
+  std::function<void(std::int64_t begin, std::int64_t end, ChunkProgress& progress)>;
 
 /// Runs body over `chunks` equal chunks of [0, n) with up to `threads` threads (0: the
 /// default; chunk c goes to team member c mod team, in increasing order). Progress is the

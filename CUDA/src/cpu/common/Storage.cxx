@@ -61,7 +61,8 @@ void* allocateSparseStorage(std::size_t bytes)
     bytes = 1;
   }
 #if defined(__linux__)
-  void* block = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+  void* block = mmap(
+    nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
   if (block == MAP_FAILED)
   {
     return nullptr;
@@ -93,7 +94,8 @@ bool prepareSparseStorage(void* at, std::size_t bytes) noexcept
 {
 #if defined(__linux__)
 #if !defined(MADV_POPULATE_WRITE)
-  constexpr int MADV_POPULATE_WRITE = 23; // Linux 5.14; older kernels refuse it (EINVAL), harmlessly
+  constexpr int MADV_POPULATE_WRITE =
+    23; // Linux 5.14; older kernels refuse it (EINVAL), harmlessly
 #endif
   return madvise(at, bytes, MADV_POPULATE_WRITE) == 0 || errno != ENOMEM;
 #else

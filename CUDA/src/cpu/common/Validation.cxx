@@ -3,16 +3,16 @@
 #include "vao/Validation.h"
 #include "vao/HistogramCdf.h"
 
-#include "cpu/common/Parallel.h"
 #include "VolumeAccess.h"
+#include "cpu/common/Parallel.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <mutex>
-#include <type_traits>
 #include <new>
 #include <sstream>
+#include <type_traits>
 
 namespace vao
 {
@@ -42,8 +42,9 @@ Status checkVolume(const VolumeView& volume, std::int64_t minimumPerAxis, const 
   }
   else if (d[0] < minimumPerAxis || d[1] < minimumPerAxis || d[2] < minimumPerAxis)
   {
-    why << (method ? method : "the method") << " needs a 3-D volume with at least " << minimumPerAxis
-        << " voxels per axis (got " << d[0] << " x " << d[1] << " x " << d[2] << ")";
+    why << (method ? method : "the method") << " needs a 3-D volume with at least "
+        << minimumPerAxis << " voxels per axis (got " << d[0] << " x " << d[1] << " x " << d[2]
+        << ")";
   }
   const std::string message = why.str();
   return message.empty() ? Status::success() : Status::failure(message);
@@ -53,11 +54,13 @@ Status checkRegion(const VolumeView& volume, const Region& region)
 {
   for (int a = 0; a < 3; ++a)
   {
-    if (region.size[a] <= 0 || region.begin[a] < 0 || region.begin[a] + region.size[a] > volume.dims[a])
+    if (region.size[a] <= 0 || region.begin[a] < 0 ||
+      region.begin[a] + region.size[a] > volume.dims[a])
     {
       std::ostringstream why;
       why << "the output region [" << region.begin[a] << ", " << region.begin[a] + region.size[a]
-          << ") of axis " << a << " is empty or outside the volume's " << volume.dims[a] << " voxels";
+          << ") of axis " << a << " is empty or outside the volume's " << volume.dims[a]
+          << " voxels";
       return Status::failure(why.str());
     }
   }
@@ -83,8 +86,8 @@ Status checkSpacing(const std::array<double, 3>& spacing, const char* what)
     if (!std::isfinite(h) || !(h > 0.0))
     {
       std::ostringstream why;
-      why << what << " must be finite and positive (got " << spacing[0] << ", " << spacing[1] << ", "
-          << spacing[2] << ")";
+      why << what << " must be finite and positive (got " << spacing[0] << ", " << spacing[1]
+          << ", " << spacing[2] << ")";
       return Status::failure(why.str());
     }
   }
@@ -125,63 +128,72 @@ Status validate(const VolumeView& volume, const Region& region, const Radius& ra
 
 ValueScan scanValues(const VolumeView& view)
 {
-  return detail::dispatchScalarType(view.type, [&](auto tag) -> ValueScan {
-    using T = decltype(tag);
-    const std::int64_t n = view.voxelCount();
-    if (n <= 0 || !view.data)
+  return detail::dispatchScalarType(view.type,
+    [&](auto tag) -> ValueScan
     {
-      return {};
-    }
-    const T* data = static_cast<const T*>(view.data);
-    std::mutex merge;
-    ValueScan total;
-    total.firstNonFinite = n;
-    bool anyFinite = false;
-    const int threads = detail::resolveThreadCount(0);
-    const std::int64_t stride = view.voxelStride;
-    detail::parallelFor(n, 4 * threads, threads, [&](std::int64_t begin, std::int64_t end) {
-      std::int64_t count = 0, first = n;
-      // The range of the finite values: +-infinity start values, so no branch on the
-      // first one. The count of non-finite values and the range come first, in a loop
-      // without a data-dependent index (it vectorises; integers are all finite); the first
-      // non-finite value is looked for only where there is one.
-      T lo = std::numeric_limits<T>::has_infinity ? std::numeric_limits<T>::infinity() : std::numeric_limits<T>::max();
-      T hi = std::numeric_limits<T>::has_infinity ? -std::numeric_limits<T>::infinity() : std::numeric_limits<T>::lowest();
-      auto scan = [&](auto unit) {
-        const std::int64_t step = decltype(unit)::value ? 1 : stride;
-        for (std::int64_t i = begin; i < end; ++i)
+      using T = decltype(tag);
+      const std::int64_t n = view.voxelCount();
+      if (n <= 0 || !view.data)
+      {
+        return {};
+      }
+      const T* data = static_cast<const T*>(view.data);
+      std::mutex merge;
+      ValueScan total;
+      total.firstNonFinite = n;
+      bool anyFinite = false;
+      const int threads = detail::resolveThreadCount(0);
+      const std::int64_t stride = view.voxelStride;
+      detail::parallelFor(n, 4 * threads, threads,
+        [&](std::int64_t begin, std::int64_t end)
         {
-          const T v = data[i * step];
-          const bool bad = !std::is_integral<T>::value && !(v - v == v - v); // NaN or infinite
-          count += bad;
-          lo = bad || !(v < lo) ? lo : v;
-          hi = bad || !(hi < v) ? hi : v;
-        }
-      };
-      if (stride == 1)
-        scan(std::true_type{});
-      else
-        scan(std::false_type{});
-      for (std::int64_t i = begin; count > 0 && i < end && first == n; ++i)
+          std::int64_t count = 0, first = n;
+          // The range of the finite values: +-infinity start values, so no branch on the
+          // first one. The count of non-finite values and the range come first, in a loop
+          // without a data-dependent index (it vectorises; integers are all finite); the first
+          // non-finite value is looked for only where there is one.
+          T lo = std::numeric_limits<T>::has_infinity ? std::numeric_limits<T>::infinity()
+                                                      : std::numeric_limits<T>::max();
+          T hi = std::numeric_limits<T>::has_infinity ? -std::numeric_limits<T>::infinity()
+                                                      : std::numeric_limits<T>::lowest();
+          auto scan = [&](auto unit)
+          {
+            const std::int64_t step = decltype(unit)::value ? 1 : stride;
+            for (std::int64_t i = begin; i < end; ++i)
+            {
+              const T v = data[i * step];
+              const bool bad = !std::is_integral<T>::value && !(v - v == v - v); // NaN or infinite
+              count += bad;
+              lo = bad || !(v < lo) ? lo : v;
+              hi = bad || !(hi < v) ? hi : v;
+            }
+          };
+          if (stride == 1)
+            scan(std::true_type{});
+          else
+            scan(std::false_type{});
+          for (std::int64_t i = begin; count > 0 && i < end && first == n; ++i)
+          {
+            first = std::isfinite(static_cast<double>(data[i * stride])) ? n : i;
+          }
+          std::lock_guard<std::mutex> lock(merge);
+          total.nonFiniteCount += count;
+          total.firstNonFinite = std::min(total.firstNonFinite, first);
+          if (count < end - begin)
+          {
+            total.minimum = anyFinite ? std::min(total.minimum, static_cast<double>(lo))
+                                      : static_cast<double>(lo);
+            total.maximum = anyFinite ? std::max(total.maximum, static_cast<double>(hi))
+                                      : static_cast<double>(hi);
+            anyFinite = true;
+          }
+        });
+      if (total.nonFiniteCount == 0)
       {
-        first = std::isfinite(static_cast<double>(data[i * stride])) ? n : i;
+        total.firstNonFinite = -1;
       }
-      std::lock_guard<std::mutex> lock(merge);
-      total.nonFiniteCount += count;
-      total.firstNonFinite = std::min(total.firstNonFinite, first);
-      if (count < end - begin)
-      {
-        total.minimum = anyFinite ? std::min(total.minimum, static_cast<double>(lo)) : static_cast<double>(lo);
-        total.maximum = anyFinite ? std::max(total.maximum, static_cast<double>(hi)) : static_cast<double>(hi);
-        anyFinite = true;
-      }
+      return total;
     });
-    if (total.nonFiniteCount == 0)
-    {
-      total.firstNonFinite = -1;
-    }
-    return total;
-  });
 }
 
 std::string checkQuerySmoothing(double sigma)
@@ -207,7 +219,8 @@ Status checkHistogramThresholds(const std::vector<double>& thresholds)
   {
     if (!std::isfinite(thresholds[k]) || (k > 0 && !(thresholds[k] > thresholds[k - 1])))
     {
-      return Status::failure("Histogram CDF's thresholds must be finite and strictly ascending (threshold " +
+      return Status::failure(
+        "Histogram CDF's thresholds must be finite and strictly ascending (threshold " +
         std::to_string(k) + " is not)");
     }
   }
@@ -218,7 +231,8 @@ Status checkOpacityFunction(const OpacityFunction& function)
 {
   if (function.nodes.empty())
   {
-    return Status::failure("the opacity function has no points: give it at least one (x, opacity) point");
+    return Status::failure(
+      "the opacity function has no points: give it at least one (x, opacity) point");
   }
   for (std::size_t k = 0; k < function.nodes.size(); ++k)
   {
@@ -231,7 +245,8 @@ Status checkOpacityFunction(const OpacityFunction& function)
     }
     if (node.y < 0.0 || node.y > 1.0)
     {
-      return Status::failure(which + " has opacity " + std::to_string(node.y) + ": opacities must lie in [0, 1]");
+      return Status::failure(
+        which + " has opacity " + std::to_string(node.y) + ": opacities must lie in [0, 1]");
     }
     if (node.midpoint < 0.0 || node.midpoint > 1.0 || node.sharpness < 0.0 || node.sharpness > 1.0)
     {
@@ -239,8 +254,8 @@ Status checkOpacityFunction(const OpacityFunction& function)
     }
     if (k > 0 && node.x < function.nodes[k - 1].x)
     {
-      return Status::failure("the opacity function's points must be in ascending order of value (" + which +
-        " is not)");
+      return Status::failure(
+        "the opacity function's points must be in ascending order of value (" + which + " is not)");
     }
   }
   return Status::success();
@@ -248,7 +263,8 @@ Status checkOpacityFunction(const OpacityFunction& function)
 
 Status finiteStatus(const ValueScan& scan)
 {
-  return scan.nonFiniteCount > 0 ? Status::nonFinite(scan.nonFiniteCount, scan.firstNonFinite) : Status::success();
+  return scan.nonFiniteCount > 0 ? Status::nonFinite(scan.nonFiniteCount, scan.firstNonFinite)
+                                 : Status::success();
 }
 
 Status checkMomentMagnitude(const ValueScan& scan)
@@ -260,7 +276,8 @@ Status checkMomentMagnitude(const ValueScan& scan)
   }
   std::ostringstream why;
   why << "the values reach " << largest << " in magnitude; above " << kLargestMomentMagnitude
-      << " their squared sums overflow double precision: rescale the data (e.g. with the Calculator) first";
+      << " their squared sums overflow double precision: rescale the data (e.g. with the "
+         "Calculator) first";
   return Status::failure(why.str());
 }
 
@@ -280,7 +297,8 @@ Status checkPyramidSpan(const ValueScan& scan)
   return Status::failure(why.str());
 }
 
-Status validateMomentRequest(const VolumeView& volume, const Region& region, const Radius& radius, ValueScan& scan)
+Status validateMomentRequest(
+  const VolumeView& volume, const Region& region, const Radius& radius, ValueScan& scan)
 {
   Status status = validate(volume, region, radius);
   // One pass for the non-finite values and the range the double sums' rounding depends
@@ -309,9 +327,12 @@ std::int64_t countNonFinite(const VolumeView& view, std::int64_t* firstIndex)
 
 Status checkFiniteValues(const VolumeView& volume)
 {
-  return catchOutOfMemory("the scan for non-finite values", [&] {
-    return scalarTypeIsIntegral(volume.type) ? Status::success() : finiteStatus(scanValues(volume));
-  });
+  return catchOutOfMemory("the scan for non-finite values",
+    [&]
+    {
+      return scalarTypeIsIntegral(volume.type) ? Status::success()
+                                               : finiteStatus(scanValues(volume));
+    });
 }
 
 std::array<double, 2> valueRange(const VolumeView& volume)

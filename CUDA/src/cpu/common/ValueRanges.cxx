@@ -30,7 +30,8 @@ struct ChunkRanges
   double squaredHi = -std::numeric_limits<double>::infinity();
   bool finite = true;
 
-  ChunkRanges(const float* values, std::int64_t begin, std::int64_t end, int components, bool withNorm)
+  ChunkRanges(
+    const float* values, std::int64_t begin, std::int64_t end, int components, bool withNorm)
     : lo(static_cast<std::size_t>(components), kHugeFloat)
     , hi(static_cast<std::size_t>(components), -kHugeFloat)
   {
@@ -97,7 +98,8 @@ struct ChunkRanges
 };
 
 template <int NC>
-bool rangesOf(const float* values, std::int64_t tuples, int components, ValueRanges& ranges, int threads)
+bool rangesOf(
+  const float* values, std::int64_t tuples, int components, ValueRanges& ranges, int threads)
 {
   const auto nc = static_cast<std::size_t>(components);
   ranges.components.assign(2 * nc, 0.0);
@@ -106,22 +108,25 @@ bool rangesOf(const float* values, std::int64_t tuples, int components, ValueRan
     ranges.components[2 * c] = std::numeric_limits<double>::infinity();
     ranges.components[2 * c + 1] = -std::numeric_limits<double>::infinity();
   }
-  double squared[2] = { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() };
+  double squared[2] = { std::numeric_limits<double>::infinity(),
+    -std::numeric_limits<double>::infinity() };
   bool finite = true;
   std::mutex merge;
   const int team = detail::resolveThreadCount(threads);
-  detail::parallelFor(tuples, 4 * team, team, [&](std::int64_t begin, std::int64_t end) {
-    const ChunkRanges<NC> chunk(values, begin, end, components, components > 1);
-    std::lock_guard<std::mutex> lock(merge);
-    finite = finite && chunk.finite;
-    for (std::size_t c = 0; c < nc; ++c)
+  detail::parallelFor(tuples, 4 * team, team,
+    [&](std::int64_t begin, std::int64_t end)
     {
-      ranges.components[2 * c] = std::min<double>(ranges.components[2 * c], chunk.lo[c]);
-      ranges.components[2 * c + 1] = std::max<double>(ranges.components[2 * c + 1], chunk.hi[c]);
-    }
-    squared[0] = std::min(squared[0], chunk.squaredLo);
-    squared[1] = std::max(squared[1], chunk.squaredHi);
-  });
+      const ChunkRanges<NC> chunk(values, begin, end, components, components > 1);
+      std::lock_guard<std::mutex> lock(merge);
+      finite = finite && chunk.finite;
+      for (std::size_t c = 0; c < nc; ++c)
+      {
+        ranges.components[2 * c] = std::min<double>(ranges.components[2 * c], chunk.lo[c]);
+        ranges.components[2 * c + 1] = std::max<double>(ranges.components[2 * c + 1], chunk.hi[c]);
+      }
+      squared[0] = std::min(squared[0], chunk.squaredLo);
+      squared[1] = std::max(squared[1], chunk.squaredHi);
+    });
   // Every value finite: squares of floats and their sums stay finite in double.
   // One component: VTK's norm range is the component's range, so none is computed here.
   const double none = std::numeric_limits<double>::quiet_NaN();

@@ -1,7 +1,7 @@
 #include "cpu/exact_reference/ExactReference.h"
 
-#include "cpu/common/Parallel.h"
 #include "VolumeAccess.h"
+#include "cpu/common/Parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -54,14 +54,15 @@ std::int64_t rowHalfWidth(const Radius& r, std::int64_t dy, std::int64_t dz, boo
   return dx;
 }
 
-/// A voxel counts when double(v) <= q (docs/methods.md, Notation). Every value of a type of up to 32 bits
-/// is a double, so that test holds exactly when v <= t, t the largest value of the type at
+/// A voxel counts when double(v) <= q (docs/methods.md, Notation). Every value of a type of up to
+/// 32 bits is a double, so that test holds exactly when v <= t, t the largest value of the type at
 /// most q, and it runs in the type itself: 8 to 32 lanes a vector. 64-bit integers round
 /// on the way to double, so they compare as doubles.
 template <class T>
 struct AtMost
 {
-  using Type = typename std::conditional<std::is_integral<T>::value && sizeof(T) == 8, double, T>::type;
+  using Type =
+    typename std::conditional<std::is_integral<T>::value && sizeof(T) == 8, double, T>::type;
 
   /// The largest Type at most q; false when none is (q NaN or below every value).
   static bool threshold(double q, Type& t)
@@ -80,7 +81,8 @@ struct AtMost
       // Beyond the largest finite float only the infinity on q's side can count.
       if (q > static_cast<double>(Limits::max()) || q < static_cast<double>(Limits::lowest()))
       {
-        t = q == Limits::infinity() ? Limits::infinity() : (q > 0 ? Limits::max() : -Limits::infinity());
+        t = q == Limits::infinity() ? Limits::infinity()
+                                    : (q > 0 ? Limits::max() : -Limits::infinity());
       }
       else
       {
@@ -97,7 +99,8 @@ struct AtMost
       {
         return false;
       }
-      t = q >= static_cast<double>(Limits::max()) ? Limits::max() : static_cast<Type>(std::floor(q));
+      t =
+        q >= static_cast<double>(Limits::max()) ? Limits::max() : static_cast<Type>(std::floor(q));
     }
     return true;
   }
@@ -106,7 +109,8 @@ struct AtMost
 /// part[i] += 1 where row[i + dx] <= t[i], for i in [from, to): the neighbours at offset dx
 /// of a run of voxels, each against its own threshold.
 template <class T, class C>
-void countAtOffset(const T* row, const C* t, std::int64_t from, std::int64_t to, std::int64_t dx, std::uint32_t* part)
+void countAtOffset(const T* row, const C* t, std::int64_t from, std::int64_t to, std::int64_t dx,
+  std::uint32_t* part)
 {
   for (std::int64_t i = from; i < to; ++i)
   {
@@ -128,12 +132,14 @@ struct ExactRow
   std::vector<T> gathered;
 
   void run(const TypedVolume<T>& volume, const Region& region, const AmbientOcclusionParameters& p,
-    const std::vector<std::int64_t>& halfWidths, std::int64_t y, std::int64_t z, const double* query, float* out)
+    const std::vector<std::int64_t>& halfWidths, std::int64_t y, std::int64_t z,
+    const double* query, float* out)
   {
     const Radius& r = p.radius;
     const Index3& n = volume.dims;
     const std::int64_t x0 = region.begin[0], nx = region.size[0];
-    const std::int64_t first = ((z - region.begin[2]) * region.size[1] + (y - region.begin[1])) * nx;
+    const std::int64_t first =
+      ((z - region.begin[2]) * region.size[1] + (y - region.begin[1])) * nx;
     thresholds.resize(nx);
     counted.resize(nx);
     part.resize(nx);
@@ -141,9 +147,10 @@ struct ExactRow
     total.assign(nx, 0);
     for (std::int64_t i = 0; i < nx; ++i)
     {
-      const double q = query ? query[first + i]
-                             : (p.queryMode == QueryMode::IsoValue ? p.isoValue
-                                                                   : static_cast<double>(volume.value(x0 + i, y, z)));
+      const double q = query
+        ? query[first + i]
+        : (p.queryMode == QueryMode::IsoValue ? p.isoValue
+                                              : static_cast<double>(volume.value(x0 + i, y, z)));
       counted[i] = AtMost<T>::threshold(q, thresholds[i]) ? 1 : 0;
     }
     for (std::int64_t dz = -r.z; dz <= r.z; ++dz)
@@ -204,26 +211,32 @@ std::vector<std::int64_t> neighbourhoodRowHalfWidths(const Radius& r, bool spher
 }
 
 Status computeExactOpenness(const VolumeView& view, const Region& region,
-  const AmbientOcclusionParameters& p, const double* query, float* openness, const Execution& execution)
+  const AmbientOcclusionParameters& p, const double* query, float* openness,
+  const Execution& execution)
 {
-  const std::vector<std::int64_t> halfWidths = neighbourhoodRowHalfWidths(p.radius, p.method == Method::ExactSphere);
-  const bool finished = dispatchScalarType(view.type, [&](auto tag) {
-    using T = decltype(tag);
-    const TypedVolume<T> volume(view);
-    // One slice per chunk: slices cost the same, and progress moves often.
-    return parallelFor(region.size[2], static_cast<int>(region.size[2]), execution.threads, execution,
-      [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
-        ExactRow<T> rows;
-        for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
+  const std::vector<std::int64_t> halfWidths =
+    neighbourhoodRowHalfWidths(p.radius, p.method == Method::ExactSphere);
+  const bool finished = dispatchScalarType(view.type,
+    [&](auto tag)
+    {
+      using T = decltype(tag);
+      const TypedVolume<T> volume(view);
+      // One slice per chunk: slices cost the same, and progress moves often.
+      return parallelFor(region.size[2], static_cast<int>(region.size[2]), execution.threads,
+        execution,
+        [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
         {
-          for (std::int64_t y = region.begin[1]; y < region.begin[1] + region.size[1]; ++y)
+          ExactRow<T> rows;
+          for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
           {
-            rows.run(volume, region, p, halfWidths, y, region.begin[2] + k, query, openness);
+            for (std::int64_t y = region.begin[1]; y < region.begin[1] + region.size[1]; ++y)
+            {
+              rows.run(volume, region, p, halfWidths, y, region.begin[2] + k, query, openness);
+            }
+            progress.advance();
           }
-          progress.advance();
-        }
-      });
-  });
+        });
+    });
   return finished ? Status::success() : Status::cancelled();
 }
 

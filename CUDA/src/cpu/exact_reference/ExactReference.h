@@ -21,7 +21,8 @@ std::vector<std::int64_t> neighbourhoodRowHalfWidths(const Radius& radius, bool 
 /// `query`: the query of each region voxel (x fastest), or null for the voxel's own value
 /// or the iso value (parameters.queryMode).
 Status computeExactOpenness(const VolumeView& volume, const Region& region,
-  const AmbientOcclusionParameters& parameters, const double* query, float* openness, const Execution& execution);
+  const AmbientOcclusionParameters& parameters, const double* query, float* openness,
+  const Execution& execution);
 
 } // namespace detail
 } // namespace vao

@@ -16,9 +16,9 @@
 // below 2^16), else 32 bits. The lane loops are compiled for AVX2 as well (CpuDispatch.h).
 #include "cpu/histogram_cdf/HistogramChannels.h"
 
-#include "cpu/simd/CpuDispatch.h"
-#include "cpu/common/Parallel.h"
 #include "VolumeAccess.h"
+#include "cpu/common/Parallel.h"
+#include "cpu/simd/CpuDispatch.h"
 
 #include "vao/Estimators.h"
 
@@ -54,7 +54,8 @@ std::int64_t tileStateBytes(std::int64_t tile, const Radius& r, int lanes, int l
 /// their border), smaller when the workers' states would exceed an eighth of the input
 /// (the rest of the 25% the filter may add goes to buffers that do not shrink with the
 /// tile), down to 16.
-std::int64_t tileSize(std::int64_t inputBytes, const Radius& r, int lanes, int laneBytes, int threads)
+std::int64_t tileSize(
+  std::int64_t inputBytes, const Radius& r, int lanes, int laneBytes, int threads)
 {
   std::int64_t tile = 64;
   while (tile > 16 && threads * tileStateBytes(tile, r, lanes, laneBytes) > inputBytes / 8)
@@ -101,8 +102,8 @@ struct RowSums
 template <class L>
 struct SlideRun
 {
-  static VAO_ALWAYS_INLINE void run(L* __restrict run, const L* __restrict entering, const L* __restrict leaving,
-    std::int64_t values)
+  static VAO_ALWAYS_INLINE void run(L* __restrict run, const L* __restrict entering,
+    const L* __restrict leaving, std::int64_t values)
   {
     for (std::int64_t c = 0; c < values; ++c)
       run[c] = static_cast<L>(run[c] + entering[c] - leaving[c]);
@@ -115,8 +116,8 @@ struct SlideRun
 template <class L>
 struct MaskedPrefix
 {
-  static VAO_ALWAYS_INLINE void run(const L* histograms, const int* upper, std::int64_t count, int lanes,
-    const L* masks, std::uint32_t* below)
+  static VAO_ALWAYS_INLINE void run(const L* histograms, const int* upper, std::int64_t count,
+    int lanes, const L* masks, std::uint32_t* below)
   {
     for (std::int64_t i = 0; i < count; ++i)
     {
@@ -144,8 +145,8 @@ public:
       this->Table.resize(std::size_t(1) << (8 * sizeof(T)));
       for (std::size_t i = 0; i < this->Table.size(); ++i)
       {
-        this->Table[i] = static_cast<std::uint16_t>(
-          thresholdIndex(lowest + static_cast<double>(i), thresholds.data(), static_cast<int>(thresholds.size())));
+        this->Table[i] = static_cast<std::uint16_t>(thresholdIndex(
+          lowest + static_cast<double>(i), thresholds.data(), static_cast<int>(thresholds.size())));
       }
     }
   }
@@ -154,11 +155,13 @@ public:
   {
     if constexpr (kTable)
     {
-      return this->Table[static_cast<std::size_t>(static_cast<std::int64_t>(v) - std::numeric_limits<T>::lowest())];
+      return this->Table[static_cast<std::size_t>(
+        static_cast<std::int64_t>(v) - std::numeric_limits<T>::lowest())];
     }
     else
     {
-      return thresholdIndex(static_cast<double>(v), this->Thresholds.data(), static_cast<int>(this->Thresholds.size()));
+      return thresholdIndex(
+        static_cast<double>(v), this->Thresholds.data(), static_cast<int>(this->Thresholds.size()));
     }
   }
 
@@ -207,7 +210,8 @@ public:
   }
 
   /// Output columns [x0, x0 + nx) x [y0, y0 + ny) (volume coordinates), slices [z0, z1).
-  void compute(std::int64_t x0, std::int64_t nx, std::int64_t y0, std::int64_t ny, std::int64_t z0, std::int64_t z1)
+  void compute(std::int64_t x0, std::int64_t nx, std::int64_t y0, std::int64_t ny, std::int64_t z0,
+    std::int64_t z1)
   {
     const Index3& dims = this->Volume.dims;
     const Radius& r = this->Job.radius;
@@ -219,7 +223,8 @@ public:
     this->HY1 = std::min<std::int64_t>(dims[1], y0 + ny + r.y);
     const std::int64_t pixels = (this->HX1 - this->HX0) * (this->HY1 - this->HY0);
     std::fill(this->Window.begin(), this->Window.begin() + pixels * this->Lanes, L(0));
-    for (std::int64_t s = std::max<std::int64_t>(0, z0 - r.z); s <= std::min<std::int64_t>(dims[2] - 1, z0 + r.z); ++s)
+    for (std::int64_t s = std::max<std::int64_t>(0, z0 - r.z);
+         s <= std::min<std::int64_t>(dims[2] - 1, z0 + r.z); ++s)
     {
       this->moveSlice(s, -1);
     }
@@ -280,12 +285,14 @@ private:
     const std::int64_t rowValues = nx * this->Lanes;
     for (std::int64_t y = this->HY0; y < this->HY1; ++y)
     {
-      runRows<RowSums<L>>(this->Job.simd, static_cast<const L*>(&this->Window[(y - this->HY0) * width * this->Lanes]),
-        width, this->X0 - this->HX0, nx, std::int64_t(r.x), this->Lanes, this->zeros(),
+      runRows<RowSums<L>>(this->Job.simd,
+        static_cast<const L*>(&this->Window[(y - this->HY0) * width * this->Lanes]), width,
+        this->X0 - this->HX0, nx, std::int64_t(r.x), this->Lanes, this->zeros(),
         &this->Rows[(y - this->HY0) * rowValues]);
     }
     std::fill(this->Run.begin(), this->Run.end(), L(0));
-    for (std::int64_t y = std::max<std::int64_t>(0, y0 - r.y); y <= std::min<std::int64_t>(dims[1] - 1, y0 + r.y); ++y)
+    for (std::int64_t y = std::max<std::int64_t>(0, y0 - r.y);
+         y <= std::min<std::int64_t>(dims[1] - 1, y0 + r.y); ++y)
     {
       runRows<SlideRun<L>>(this->Job.simd, this->Run.data(),
         static_cast<const L*>(&this->Rows[(y - this->HY0) * rowValues]), this->zeros(), rowValues);
@@ -297,7 +304,8 @@ private:
     {
       const T* row = this->Volume.row(y, z);
       const std::int64_t out =
-        ((z - region.begin[2]) * region.size[1] + (y - region.begin[1])) * region.size[0] + (this->X0 - region.begin[0]);
+        ((z - region.begin[2]) * region.size[1] + (y - region.begin[1])) * region.size[0] +
+        (this->X0 - region.begin[0]);
       for (std::int64_t i = 0; i < nx; ++i)
       {
         const T v = row[(this->X0 + i) * this->Volume.stride];
@@ -307,17 +315,20 @@ private:
         else if (query.isoValue)
           q = *query.isoValue;
         this->Query[i] = q;
-        this->Upper[i] = query.values || query.isoValue ? thresholdIndex(q, t, this->Bins) : this->Bin(v);
+        this->Upper[i] =
+          query.values || query.isoValue ? thresholdIndex(q, t, this->Bins) : this->Bin(v);
       }
       runRows<MaskedPrefix<L>>(this->Job.simd, static_cast<const L*>(this->Run.data()),
-        static_cast<const int*>(this->Upper.data()), nx, this->Lanes, static_cast<const L*>(this->Masks.data()),
-        this->Below.data());
+        static_cast<const int*>(this->Upper.data()), nx, this->Lanes,
+        static_cast<const L*>(this->Masks.data()), this->Below.data());
       const double countYZ = static_cast<double>(clippedWindowCount(y, r.y, dims[1])) * countZ;
       for (std::int64_t i = 0; i < nx; ++i)
       {
         const int u = this->Upper[i];
-        const double at = u < this->Bins ? static_cast<double>(this->Run[i * this->Lanes + u]) : 0.0;
-        const double count = static_cast<double>(clippedWindowCount(this->X0 + i, r.x, dims[0])) * countYZ;
+        const double at =
+          u < this->Bins ? static_cast<double>(this->Run[i * this->Lanes + u]) : 0.0;
+        const double count =
+          static_cast<double>(clippedWindowCount(this->X0 + i, r.x, dims[0])) * countYZ;
         this->Job.openness[out + i] = static_cast<float>(
           opennessHistogramCdfAt(this->Query[i], t, this->Bins, u, count, this->Below[i], at));
       }
@@ -325,8 +336,12 @@ private:
       {
         const std::int64_t entering = y + r.y + 1, leaving = y - r.y;
         runRows<SlideRun<L>>(this->Job.simd, this->Run.data(),
-          entering < dims[1] ? static_cast<const L*>(&this->Rows[(entering - this->HY0) * rowValues]) : this->zeros(),
-          leaving >= 0 ? static_cast<const L*>(&this->Rows[(leaving - this->HY0) * rowValues]) : this->zeros(), rowValues);
+          entering < dims[1]
+            ? static_cast<const L*>(&this->Rows[(entering - this->HY0) * rowValues])
+            : this->zeros(),
+          leaving >= 0 ? static_cast<const L*>(&this->Rows[(leaving - this->HY0) * rowValues])
+                       : this->zeros(),
+          rowValues);
       }
     }
   }
@@ -354,11 +369,13 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
   const std::int64_t tilesY = (region.size[1] + tile - 1) / tile;
   const int threads = resolveThreadCount(execution.threads);
   // Enough units for every thread several times over; each z-range starts its window anew.
-  const std::int64_t zParts = std::min<std::int64_t>(
-    region.size[2], std::max<std::int64_t>(1, (4 * threads + tilesX * tilesY - 1) / (tilesX * tilesY)));
+  const std::int64_t zParts = std::min<std::int64_t>(region.size[2],
+    std::max<std::int64_t>(1, (4 * threads + tilesX * tilesY - 1) / (tilesX * tilesY)));
   const std::int64_t units = tilesX * tilesY * zParts;
-  return parallelFor(units, static_cast<int>(std::min<std::int64_t>(units, 1 << 20)), threads, execution,
-    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+  return parallelFor(units, static_cast<int>(std::min<std::int64_t>(units, 1 << 20)), threads,
+    execution,
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
+    {
       TileHistograms<T, L> state(volume, job, bin);
       for (std::int64_t u = begin; u < end && !progress.stopped(); ++u)
       {
@@ -377,7 +394,8 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
 } // namespace
 
 bool computeHistogramOpenness(const VolumeView& view, const Region& region, const Radius& radius,
-  const std::vector<double>& thresholds, const HistogramQuery& query, float* openness, const Execution& execution)
+  const std::vector<double>& thresholds, const HistogramQuery& query, float* openness,
+  const Execution& execution)
 {
   // The largest box: its count must fit the lanes.
   std::int64_t largest = 1;
@@ -386,15 +404,19 @@ bool computeHistogramOpenness(const VolumeView& view, const Region& region, cons
     largest *= std::min<std::int64_t>(2 * std::int64_t(r[a]) + 1, view.dims[a]);
   const int laneBytes = largest <= 0xFFFF ? 2 : 4;
   const int lanes = laneCount(static_cast<int>(thresholds.size()));
-  return dispatchScalarType(view.type, [&](auto tag) {
-    using T = decltype(tag);
-    const TypedVolume<T> volume(view);
-    const std::int64_t inputBytes = view.voxelCount() * static_cast<std::int64_t>(sizeof(T));
-    const HistogramJob job{ tileSize(inputBytes, radius, lanes, laneBytes, resolveThreadCount(execution.threads)),
-      region, radius, thresholds, query, openness, cpuSimdTierUpTo(SimdTier::Avx2) }; // AVX-512 loses here
-    return laneBytes == 2 ? computeTiles<T, std::uint16_t>(volume, job, execution)
-                          : computeTiles<T, std::uint32_t>(volume, job, execution);
-  });
+  return dispatchScalarType(view.type,
+    [&](auto tag)
+    {
+      using T = decltype(tag);
+      const TypedVolume<T> volume(view);
+      const std::int64_t inputBytes = view.voxelCount() * static_cast<std::int64_t>(sizeof(T));
+      const HistogramJob job{
+        tileSize(inputBytes, radius, lanes, laneBytes, resolveThreadCount(execution.threads)),
+        region, radius, thresholds, query, openness, cpuSimdTierUpTo(SimdTier::Avx2)
+      }; // AVX-512 loses here
+      return laneBytes == 2 ? computeTiles<T, std::uint16_t>(volume, job, execution)
+                            : computeTiles<T, std::uint32_t>(volume, job, execution);
+    });
 }
 
 } // namespace detail

@@ -21,7 +21,8 @@ struct HistogramQuery
 /// Histogram CDF openness of the region's voxels for the ascending thresholds (at most
 /// kMaximumHistogramBins of them). Returns false when cancelled.
 bool computeHistogramOpenness(const VolumeView& volume, const Region& region, const Radius& radius,
-  const std::vector<double>& thresholds, const HistogramQuery& query, float* openness, const Execution& execution);
+  const std::vector<double>& thresholds, const HistogramQuery& query, float* openness,
+  const Execution& execution);
 
 } // namespace detail
 } // namespace vao

@@ -1,8 +1,8 @@
 // The value summary and the threshold placement of Histogram CDF (vao/HistogramCdf.h).
 #include "vao/HistogramCdf.h"
 
-#include "cpu/common/Parallel.h"
 #include "VolumeAccess.h"
+#include "cpu/common/Parallel.h"
 
 #include "vao/Validation.h"
 
@@ -22,9 +22,10 @@ ValueHistogram ValueHistogram::forRange(ScalarType type, double lowest, double h
   h.highest = highest;
   // Integers spanning at most kMaximumCells values: one cell each, so that every distinct
   // value can become a threshold. (highest - lowest) is exact for such ranges.
-  h.integerCells = scalarTypeIsIntegral(type) && highest - lowest < static_cast<double>(kMaximumCells);
-  const std::int64_t cells =
-    h.integerCells ? static_cast<std::int64_t>(highest - lowest) + 1 : (highest > lowest ? kMaximumCells : 1);
+  h.integerCells =
+    scalarTypeIsIntegral(type) && highest - lowest < static_cast<double>(kMaximumCells);
+  const std::int64_t cells = h.integerCells ? static_cast<std::int64_t>(highest - lowest) + 1
+                                            : (highest > lowest ? kMaximumCells : 1);
   h.counts.assign(static_cast<std::size_t>(cells), 0);
   h.minimum.assign(static_cast<std::size_t>(cells), std::numeric_limits<double>::infinity());
   h.maximum.assign(static_cast<std::size_t>(cells), -std::numeric_limits<double>::infinity());
@@ -36,7 +37,8 @@ std::int64_t ValueHistogram::cell(double v) const
   const auto last = static_cast<std::int64_t>(this->counts.size()) - 1;
   if (this->integerCells)
   {
-    return std::min<std::int64_t>(last, std::max<std::int64_t>(0, static_cast<std::int64_t>(v - this->lowest)));
+    return std::min<std::int64_t>(
+      last, std::max<std::int64_t>(0, static_cast<std::int64_t>(v - this->lowest)));
   }
   // Halves: the width of a range near the largest doubles does not overflow.
   const double width = this->highest / 2 - this->lowest / 2;
@@ -66,72 +68,79 @@ void ValueHistogram::merge(const ValueHistogram& other)
   }
 }
 
-Status addToValueHistogram(
-  const VolumeView& view, const Region& region, ValueHistogram& histogram, const Execution& execution)
+Status addToValueHistogram(const VolumeView& view, const Region& region, ValueHistogram& histogram,
+  const Execution& execution)
 {
   Status status = checkRegion(view, region);
   if (!status.ok)
   {
     return status;
   }
-  return catchOutOfMemory("the value histogram of Histogram CDF", [&] {
-    std::mutex merging;
-    const bool finished = detail::dispatchScalarType(view.type, [&](auto tag) {
-      using T = decltype(tag);
-      const detail::TypedVolume<T> volume(view);
-      const int threads = detail::resolveThreadCount(execution.threads);
-      return detail::parallelFor(region.size[2], threads, threads, execution,
-        [&](std::int64_t begin, std::int64_t end, detail::ChunkProgress& progress) {
-          ValueHistogram part = histogram;
-          std::fill(part.counts.begin(), part.counts.end(), 0);
-          for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
-          {
-            for (std::int64_t j = 0; j < region.size[1]; ++j)
+  return catchOutOfMemory("the value histogram of Histogram CDF",
+    [&]
+    {
+      std::mutex merging;
+      const bool finished = detail::dispatchScalarType(view.type,
+        [&](auto tag)
+        {
+          using T = decltype(tag);
+          const detail::TypedVolume<T> volume(view);
+          const int threads = detail::resolveThreadCount(execution.threads);
+          return detail::parallelFor(region.size[2], threads, threads, execution,
+            [&](std::int64_t begin, std::int64_t end, detail::ChunkProgress& progress)
             {
-              const T* row = volume.row(region.begin[1] + j, region.begin[2] + k);
-              if constexpr (std::is_integral<T>::value && sizeof(T) <= 2)
+              ValueHistogram part = histogram;
+              std::fill(part.counts.begin(), part.counts.end(), 0);
+              for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
               {
-                // A cell per value: count only; the cells' extrema are their values.
-                const auto lowest = static_cast<std::int64_t>(part.lowest);
-                const auto last = static_cast<std::int64_t>(part.counts.size()) - 1;
-                for (std::int64_t i = region.begin[0]; i < region.begin[0] + region.size[0]; ++i)
+                for (std::int64_t j = 0; j < region.size[1]; ++j)
                 {
-                  const std::int64_t c = static_cast<std::int64_t>(row[i * volume.stride]) - lowest;
-                  ++part.counts[std::min(last, std::max<std::int64_t>(0, c))];
+                  const T* row = volume.row(region.begin[1] + j, region.begin[2] + k);
+                  if constexpr (std::is_integral<T>::value && sizeof(T) <= 2)
+                  {
+                    // A cell per value: count only; the cells' extrema are their values.
+                    const auto lowest = static_cast<std::int64_t>(part.lowest);
+                    const auto last = static_cast<std::int64_t>(part.counts.size()) - 1;
+                    for (std::int64_t i = region.begin[0]; i < region.begin[0] + region.size[0];
+                         ++i)
+                    {
+                      const std::int64_t c =
+                        static_cast<std::int64_t>(row[i * volume.stride]) - lowest;
+                      ++part.counts[std::min(last, std::max<std::int64_t>(0, c))];
+                    }
+                    continue;
+                  }
+                  for (std::int64_t i = region.begin[0]; i < region.begin[0] + region.size[0]; ++i)
+                  {
+                    const double v = static_cast<double>(row[i * volume.stride]);
+                    if (!std::isfinite(v))
+                      continue;
+                    const std::int64_t c = part.cell(v);
+                    ++part.counts[c];
+                    part.minimum[c] = std::min(part.minimum[c], v);
+                    part.maximum[c] = std::max(part.maximum[c], v);
+                  }
                 }
-                continue;
+                progress.advance();
               }
-              for (std::int64_t i = region.begin[0]; i < region.begin[0] + region.size[0]; ++i)
+              if (part.integerCells)
               {
-                const double v = static_cast<double>(row[i * volume.stride]);
-                if (!std::isfinite(v))
-                  continue;
-                const std::int64_t c = part.cell(v);
-                ++part.counts[c];
-                part.minimum[c] = std::min(part.minimum[c], v);
-                part.maximum[c] = std::max(part.maximum[c], v);
+                for (std::size_t c = 0; c < part.counts.size(); ++c)
+                  if (part.counts[c] > 0)
+                    part.minimum[c] = part.maximum[c] = part.lowest + static_cast<double>(c);
               }
-            }
-            progress.advance();
-          }
-          if (part.integerCells)
-          {
-            for (std::size_t c = 0; c < part.counts.size(); ++c)
-              if (part.counts[c] > 0)
-                part.minimum[c] = part.maximum[c] = part.lowest + static_cast<double>(c);
-          }
-          const std::lock_guard<std::mutex> lock(merging);
-          // Counts add and extrema combine in any order: the result does not depend on it.
-          for (std::size_t c = 0; c < part.counts.size(); ++c)
-          {
-            histogram.counts[c] += part.counts[c];
-            histogram.minimum[c] = std::min(histogram.minimum[c], part.minimum[c]);
-            histogram.maximum[c] = std::max(histogram.maximum[c], part.maximum[c]);
-          }
+              const std::lock_guard<std::mutex> lock(merging);
+              // Counts add and extrema combine in any order: the result does not depend on it.
+              for (std::size_t c = 0; c < part.counts.size(); ++c)
+              {
+                histogram.counts[c] += part.counts[c];
+                histogram.minimum[c] = std::min(histogram.minimum[c], part.minimum[c]);
+                histogram.maximum[c] = std::max(histogram.maximum[c], part.maximum[c]);
+              }
+            });
         });
+      return finished ? Status::success() : Status::cancelled();
     });
-    return finished ? Status::success() : Status::cancelled();
-  });
 }
 
 std::vector<double> histogramThresholds(const ValueHistogram& histogram, int bins)
@@ -158,7 +167,8 @@ std::vector<double> histogramThresholds(const ValueHistogram& histogram, int bin
   }
   // t_0: the lowest value, so that q below every value gives 0 and F_0 counts its tie.
   thresholds.push_back(histogram.maximum[cells[0]]);
-  auto weight = [&](std::size_t i) { return std::pow(static_cast<double>(histogram.counts[cells[i]]), 0.7); };
+  auto weight = [&](std::size_t i)
+  { return std::pow(static_cast<double>(histogram.counts[cells[i]]), 0.7); };
   double remaining = 0.0;
   for (std::size_t i = 1; i < n; ++i)
     remaining += weight(i);
@@ -170,7 +180,8 @@ std::vector<double> histogramThresholds(const ValueHistogram& histogram, int bin
     const bool last = i + 1 == n;
     // End a run when it holds its share of what is left, or when every cell left must
     // have a threshold of its own; the last threshold is always the highest value.
-    if (last || (left > 1 && (run >= remaining / static_cast<double>(left) || n - 1 - i <= left - 1)))
+    if (last ||
+      (left > 1 && (run >= remaining / static_cast<double>(left) || n - 1 - i <= left - 1)))
     {
       thresholds.push_back(histogram.maximum[cells[i]]);
       remaining -= run;
@@ -189,21 +200,23 @@ Status volumeThresholds(
   {
     return status;
   }
-  return catchOutOfMemory("the value histogram of Histogram CDF", [&] {
-    const ValueScan scan = scanValues(volume);
-    const Status finite = finiteStatus(scan);
-    if (!finite.ok)
+  return catchOutOfMemory("the value histogram of Histogram CDF",
+    [&]
     {
-      return finite;
-    }
-    ValueHistogram histogram = ValueHistogram::forRange(volume.type, scan.minimum, scan.maximum);
-    const Status added = addToValueHistogram(volume, Region::whole(volume), histogram, execution);
-    if (added.ok)
-    {
-      thresholds = histogramThresholds(histogram, bins);
-    }
-    return added;
-  });
+      const ValueScan scan = scanValues(volume);
+      const Status finite = finiteStatus(scan);
+      if (!finite.ok)
+      {
+        return finite;
+      }
+      ValueHistogram histogram = ValueHistogram::forRange(volume.type, scan.minimum, scan.maximum);
+      const Status added = addToValueHistogram(volume, Region::whole(volume), histogram, execution);
+      if (added.ok)
+      {
+        thresholds = histogramThresholds(histogram, bins);
+      }
+      return added;
+    });
 }
 
 std::string checkHistogramBins(int bins)

@@ -16,8 +16,8 @@ namespace detail
 {
 using namespace pyramid;
 
-LevelTiles::LevelTiles(
-  TilePool& pool, const VolumeView& volume, const MomentLevel& geometry, int level, int firstStep, double shift)
+LevelTiles::LevelTiles(TilePool& pool, const VolumeView& volume, const MomentLevel& geometry,
+  int level, int firstStep, double shift)
   : Volume(volume)
   , Level(level)
   , FirstStep(firstStep)
@@ -85,7 +85,8 @@ void TilePool::prepare()
   if (this->Used == this->Prepared)
     return;
   constexpr std::size_t kPage = 4096;
-  const std::size_t from = static_cast<std::size_t>(this->Prepared) * PyramidTiles::kTileBytes / kPage * kPage;
+  const std::size_t from =
+    static_cast<std::size_t>(this->Prepared) * PyramidTiles::kTileBytes / kPage * kPage;
   const std::size_t to = std::min(this->Bytes, (this->bytes() + kPage - 1) / kPage * kPage);
   if (!prepareSparseStorage(reinterpret_cast<char*>(this->Pool) + from, to - from))
     throw std::bad_alloc();
@@ -111,7 +112,7 @@ void LevelTiles::prepareGrid()
 {
   LevelGrid& g = this->Grid;
   g = LevelGrid(this->Geometry); // the geometry; the pointers and strides are the tiles'
-  g.mean = this->Pool.data(); // (mean, variance) pairs: every index and stride counts floats
+  g.mean = this->Pool.data();    // (mean, variance) pairs: every index and stride counts floats
   g.variance = this->Pool.data() + 1;
   g.tiled = true;
   g.stride[0] = 2;
@@ -131,7 +132,8 @@ void LevelTiles::forgetMarks()
 {
   // Tiles in use lie in the layers marked (built ones were marked first).
   const std::int64_t perLayer = this->Tiles[0] * this->Tiles[1];
-  for (std::int64_t t = this->lowestMarked() * perLayer; t < (this->highestMarked() + 1) * perLayer; ++t)
+  for (std::int64_t t = this->lowestMarked() * perLayer; t < (this->highestMarked() + 1) * perLayer;
+       ++t)
   {
     if (this->State[t].load(std::memory_order_relaxed) == kInUse)
       this->State[t].store(kBuilt, std::memory_order_relaxed);
@@ -195,7 +197,8 @@ bool LevelTiles::buildMarked(const Execution& execution)
     return true;
   }
   this->Pool.prepare();
-  return dispatchScalarType(this->Volume.type, [&](auto tag) { return this->build<decltype(tag)>(runs, execution); });
+  return dispatchScalarType(
+    this->Volume.type, [&](auto tag) { return this->build<decltype(tag)>(runs, execution); });
 }
 
 namespace
@@ -209,7 +212,8 @@ struct BlockVoxels
   std::int64_t lo[3] = { 0, 0, 0 };
   std::int64_t size[3] = { 0, 0, 0 };
 
-  std::pair<const float*, const float*> operator()(std::int64_t x, std::int64_t y, std::int64_t z) const
+  std::pair<const float*, const float*> operator()(
+    std::int64_t x, std::int64_t y, std::int64_t z) const
   {
     const float* voxel = mean + ((z - lo[2]) * size[1] + (y - lo[1])) * size[0] + (x - lo[0]);
     return { voxel, voxel + size[0] * size[1] * size[2] };
@@ -219,17 +223,20 @@ struct BlockVoxels
 /// Output voxels [lo, hi) of a blur (plan) into `block` (means then variances, rows of
 /// hi - lo x voxels), with the SliceBlur of the source narrowed to them.
 template <class Source>
-void blurBlock(SliceBlur<Source>& blur, const std::int64_t* lo, const std::int64_t* hi, float* block)
+void blurBlock(
+  SliceBlur<Source>& blur, const std::int64_t* lo, const std::int64_t* hi, float* block)
 {
   const std::int64_t nx = hi[0] - lo[0], ny = hi[1] - lo[1];
   const std::int64_t plane = nx * ny * (hi[2] - lo[2]);
   blur.setWindow({ lo[0], hi[0], lo[1], hi[1] });
   for (std::int64_t zo = lo[2]; zo < hi[2]; ++zo)
   {
-    blur.slice(zo, [&](std::int64_t yo) {
-      float* mean = block + ((zo - lo[2]) * ny + (yo - lo[1])) * nx;
-      return std::make_pair(mean, mean + plane);
-    });
+    blur.slice(zo,
+      [&](std::int64_t yo)
+      {
+        float* mean = block + ((zo - lo[2]) * ny + (yo - lo[1])) * nx;
+        return std::make_pair(mean, mean + plane);
+      });
   }
 }
 
@@ -238,7 +245,8 @@ void blurBlock(SliceBlur<Source>& blur, const std::int64_t* lo, const std::int64
 inline void runVoxels(std::int64_t first, std::int64_t count, const Index3& tiles, const Index3& n,
   std::int64_t* lo, std::int64_t* hi)
 {
-  const std::int64_t c[3] = { first % tiles[0], (first / tiles[0]) % tiles[1], first / (tiles[0] * tiles[1]) };
+  const std::int64_t c[3] = { first % tiles[0], (first / tiles[0]) % tiles[1],
+    first / (tiles[0] * tiles[1]) };
   for (int a = 0; a < 3; ++a)
   {
     lo[a] = c[a] * kTileSide;
@@ -251,8 +259,8 @@ inline void runVoxels(std::int64_t first, std::int64_t count, const Index3& tile
 /// points blur1's source at, and level 1's blur of it: level 1 is the blur of level 0
 /// (PyramidBuild.cxx builds each level from the one before), not of the volume.
 template <class Blur0, class Blur1>
-void blurFromLevel0(Blur0& blur0, Blur1& blur1, BlockVoxels& block0, const Index3& level0, const std::int64_t* lo,
-  const std::int64_t* hi, std::vector<float>& baseBlock, float* block)
+void blurFromLevel0(Blur0& blur0, Blur1& blur1, BlockVoxels& block0, const Index3& level0,
+  const std::int64_t* lo, const std::int64_t* hi, std::vector<float>& baseBlock, float* block)
 {
   std::int64_t baseHi[3];
   for (int a = 0; a < 3; ++a)
@@ -270,8 +278,8 @@ void blurFromLevel0(Blur0& blur0, Blur1& blur1, BlockVoxels& block0, const Index
 /// Tile k of a run from its block (means then variances, `ny` rows of `width` voxels a
 /// slice, `nz` slices): rows of (mean, variance) pairs, the layout the gathers read
 /// (LevelGrid's tiled strides). A partial tile's other voxels are never read.
-inline void blockToTile(const float* block, std::int64_t width, std::int64_t ny, std::int64_t nz, std::int64_t k,
-  float* tile)
+inline void blockToTile(const float* block, std::int64_t width, std::int64_t ny, std::int64_t nz,
+  std::int64_t k, float* tile)
 {
   const std::int64_t plane = width * ny * nz;
   const std::int64_t x0 = k * kTileSide, x1 = std::min(width, x0 + kTileSpan);
@@ -304,36 +312,39 @@ bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execut
   const auto count = static_cast<std::int64_t>(runs.size());
   const int chunks = static_cast<int>(std::min<std::int64_t>(count, std::max(1, threads) * 8));
   const Index3& n = this->Geometry.dims;
-  return parallelFor(count, chunks, threads, execution, [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
-    SliceBlur<RawSource<T>> blur0(source, plan0);
-    StoredSource<BlockVoxels> base{ {}, plan0.out, this->Shift }; // level 1: the block of level 0 its taps read
-    SliceBlur<StoredSource<BlockVoxels>> blur1(base, plan1);
-    std::vector<float> block, baseBlock; // a run's voxels before they go to their tiles
-    for (std::int64_t r = begin; r < end; ++r)
+  return parallelFor(count, chunks, threads, execution,
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
     {
-      const TileRun& run = runs[static_cast<std::size_t>(r)];
-      std::int64_t lo[3], hi[3];
-      runVoxels(run.first, run.count, this->Tiles, n, lo, hi);
-      const std::int64_t width = hi[0] - lo[0], rows = (hi[1] - lo[1]) * (hi[2] - lo[2]);
-      block.resize(static_cast<std::size_t>(2 * width * rows));
-      if (this->Level == 0)
-        blurBlock(blur0, lo, hi, block.data());
-      else
-        blurFromLevel0(blur0, blur1, base.at, plan0.out, lo, hi, baseBlock, block.data());
-      for (std::int64_t k = 0; k < run.count; ++k)
+      SliceBlur<RawSource<T>> blur0(source, plan0);
+      StoredSource<BlockVoxels> base{ {}, plan0.out,
+        this->Shift }; // level 1: the block of level 0 its taps read
+      SliceBlur<StoredSource<BlockVoxels>> blur1(base, plan1);
+      std::vector<float> block, baseBlock; // a run's voxels before they go to their tiles
+      for (std::int64_t r = begin; r < end; ++r)
       {
-        blockToTile(block.data(), width, hi[1] - lo[1], hi[2] - lo[2], k,
-          this->Pool.data() + this->Offsets[run.first + k]);
-        this->State[run.first + k].store(kInUse, std::memory_order_release);
+        const TileRun& run = runs[static_cast<std::size_t>(r)];
+        std::int64_t lo[3], hi[3];
+        runVoxels(run.first, run.count, this->Tiles, n, lo, hi);
+        const std::int64_t width = hi[0] - lo[0], rows = (hi[1] - lo[1]) * (hi[2] - lo[2]);
+        block.resize(static_cast<std::size_t>(2 * width * rows));
+        if (this->Level == 0)
+          blurBlock(blur0, lo, hi, block.data());
+        else
+          blurFromLevel0(blur0, blur1, base.at, plan0.out, lo, hi, baseBlock, block.data());
+        for (std::int64_t k = 0; k < run.count; ++k)
+        {
+          blockToTile(block.data(), width, hi[1] - lo[1], hi[2] - lo[2], k,
+            this->Pool.data() + this->Offsets[run.first + k]);
+          this->State[run.first + k].store(kInUse, std::memory_order_release);
+        }
+        this->Built.fetch_add(run.count, std::memory_order_relaxed);
+        this->Made.fetch_add(run.count, std::memory_order_relaxed);
+        if (!progress.advance())
+        {
+          return;
+        }
       }
-      this->Built.fetch_add(run.count, std::memory_order_relaxed);
-      this->Made.fetch_add(run.count, std::memory_order_relaxed);
-      if (!progress.advance())
-      {
-        return;
-      }
-    }
-  });
+    });
 }
 
 bool PyramidTiles::buildMarked(const Execution& execution)
@@ -377,9 +388,10 @@ void PyramidTiles::releaseBehind(bool up)
     LevelTiles& level = *this->levels[l];
     const std::int64_t top = level.layerCount() - 1;
     const bool marked = level.highestMarked() >= 0;
-    const std::int64_t layers =
-      !marked ? top + 1 : up ? level.highestMarked() + 1 : top + 1 - level.lowestMarked();
-    for (std::int64_t k = 0; k < layers && this->builtBytes(l) > this->keptBytes; ++k)
+    const std::int64_t layers = !marked ? top + 1
+      : up                              ? level.highestMarked() + 1
+                                        : top + 1 - level.lowestMarked();
+    for (std::int64_t k = 0; k<layers&& this->builtBytes(l)> this->keptBytes; ++k)
       level.releaseLayer(up ? k : top - k);
   }
 }

@@ -34,8 +34,8 @@ namespace detail
 {
 
 constexpr int kTileShift = 3;
-constexpr std::int64_t kTileSide = 1 << kTileShift;  // cells per tile and axis
-constexpr std::int64_t kTileSpan = kTileSide + 1;    // voxels per tile and axis
+constexpr std::int64_t kTileSide = 1 << kTileShift; // cells per tile and axis
+constexpr std::int64_t kTileSpan = kTileSide + 1;   // voxels per tile and axis
 constexpr std::int64_t kTileFloats = 2 * kTileSpan * kTileSpan * kTileSpan;
 
 /// The slots that the tiled levels' tiles take (kTileFloats floats each): a reservation
@@ -80,8 +80,8 @@ public:
   /// shifted by `shift`, its tiles in `pool` (which must outlive it). Throws std::bad_alloc
   /// when it cannot); builds nothing. The volume is read whenever tiles are built: it must
   /// outlive this object, unchanged.
-  LevelTiles(TilePool& pool, const VolumeView& volume, const MomentLevel& geometry, int level, int firstStep,
-    double shift);
+  LevelTiles(TilePool& pool, const VolumeView& volume, const MomentLevel& geometry, int level,
+    int firstStep, double shift);
   ~LevelTiles();
   LevelTiles(const LevelTiles&) = delete;
   LevelTiles& operator=(const LevelTiles&) = delete;
@@ -100,8 +100,10 @@ public:
   {
     // The cell's lower corner as trilinearSample finds it, from the same grid numbers: the
     // cell's tile holds all its corners.
-    const std::int64_t tile[3] = { this->tileAlong(0, x), this->tileAlong(1, y), this->tileAlong(2, z) };
-    std::atomic<std::uint8_t>& state = this->State[(tile[2] * this->Tiles[1] + tile[1]) * this->Tiles[0] + tile[0]];
+    const std::int64_t tile[3] = { this->tileAlong(0, x), this->tileAlong(1, y),
+      this->tileAlong(2, z) };
+    std::atomic<std::uint8_t>& state =
+      this->State[(tile[2] * this->Tiles[1] + tile[1]) * this->Tiles[0] + tile[0]];
     const std::uint8_t now = state.load(std::memory_order_relaxed);
     // Marked or in use: marked since forgetMarks, its layer already among those marked
     // (the points of a batch are neighbours: most of their samples share a tile).
@@ -155,7 +157,8 @@ private:
   std::int64_t tileAlong(int a, double p) const
   {
     const LevelGrid& g = this->Grid;
-    const double u = std::min(std::max((p - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
+    const double u =
+      std::min(std::max((p - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
     return static_cast<std::int64_t>(u) >> kTileShift;
   }
 
@@ -212,7 +215,10 @@ public:
   bool upward = true;
 
   /// Level l's tiles, or nullptr when level l is whole.
-  LevelTiles* at(int l) const { return l >= 0 && l < static_cast<int>(this->levels.size()) ? this->levels[l].get() : nullptr; }
+  LevelTiles* at(int l) const
+  {
+    return l >= 0 && l < static_cast<int>(this->levels.size()) ? this->levels[l].get() : nullptr;
+  }
   int count() const { return static_cast<int>(this->levels.size()); }
   /// buildMarked of every tiled level.
   bool buildMarked(const Execution& execution);
@@ -238,6 +244,9 @@ namespace vao
 struct SurfacePyramidAccess
 {
   static std::vector<MomentLevel>& levels(SurfacePyramid& pyramid) { return pyramid.Levels; }
-  static std::unique_ptr<detail::PyramidTiles>& tiles(SurfacePyramid& pyramid) { return pyramid.Tiles; }
+  static std::unique_ptr<detail::PyramidTiles>& tiles(SurfacePyramid& pyramid)
+  {
+    return pyramid.Tiles;
+  }
 };
 } // namespace vao

@@ -23,10 +23,10 @@
 
 #include "vao/VarianceOcclusionMap.h"
 
+#include "VolumeAccess.h"
 #include "cpu/common/Parallel.h"
 #include "cpu/moment_pyramid/PyramidPlan.h"
 #include "cpu/moment_pyramid/PyramidRows.h"
-#include "VolumeAccess.h"
 
 #include <algorithm>
 #include <cmath>
@@ -51,8 +51,9 @@ struct RawSource
   /// a[i] = sum_k w[k] d(x0 + i, y, z_k), b[i] = sum_k w[k] s(x0 + i, y, z_k) for i in
   /// [0, count) over the 5 rows (y, z[k]), for the `rows` rows y = y0, y0 + 1, ... (their
   /// outputs outRowStride apart); a clipped tap has weight 0 and a valid (clamped) row.
-  void blurRows(std::int64_t y0, std::int64_t rows, const std::int64_t* z, const double* w, std::int64_t x0,
-    std::int64_t count, double* a, double* b, std::int64_t outRowStride, SimdTier simd) const
+  void blurRows(std::int64_t y0, std::int64_t rows, const std::int64_t* z, const double* w,
+    std::int64_t x0, std::int64_t count, double* a, double* b, std::int64_t outRowStride,
+    SimdTier simd) const
   {
     const T* first[kTaps];
     for (int k = 0; k < kTaps; ++k)
@@ -61,9 +62,11 @@ struct RawSource
     }
     const std::int64_t inRowStride = volume.dims[0] * volume.stride;
     if (volume.stride == 1)
-      runRows<RawPlane<T, true>>(simd, &first[0], w, shift, std::int64_t(1), count, rows, inRowStride, outRowStride, a, b);
+      runRows<RawPlane<T, true>>(
+        simd, &first[0], w, shift, std::int64_t(1), count, rows, inRowStride, outRowStride, a, b);
     else
-      runRows<RawPlane<T, false>>(simd, &first[0], w, shift, volume.stride, count, rows, inRowStride, outRowStride, a, b);
+      runRows<RawPlane<T, false>>(
+        simd, &first[0], w, shift, volume.stride, count, rows, inRowStride, outRowStride, a, b);
   }
 };
 
@@ -79,8 +82,9 @@ struct StoredSource
 
   Index3 dims() const { return size; }
   /// RawSource::blurRows from the stored moments.
-  void blurRows(std::int64_t y0, std::int64_t rows, const std::int64_t* z, const double* w, std::int64_t x0,
-    std::int64_t count, double* a, double* b, std::int64_t outRowStride, SimdTier simd) const
+  void blurRows(std::int64_t y0, std::int64_t rows, const std::int64_t* z, const double* w,
+    std::int64_t x0, std::int64_t count, double* a, double* b, std::int64_t outRowStride,
+    SimdTier simd) const
   {
     const float* means[kTaps];
     const float* variances[kTaps];
@@ -92,7 +96,8 @@ struct StoredSource
     }
     // The voxels' rows are evenly spaced: the next row's first one gives the stride.
     const std::int64_t inRowStride = rows > 1 ? at(x0, y0 + 1, z[0]).first - means[0] : 0;
-    runRows<LevelPlane>(simd, &means[0], &variances[0], w, shift, count, rows, inRowStride, outRowStride, a, b);
+    runRows<LevelPlane>(
+      simd, &means[0], &variances[0], w, shift, count, rows, inRowStride, outRowStride, a, b);
   }
 };
 
@@ -100,7 +105,8 @@ struct StoredSource
 struct LevelVoxels
 {
   const MomentLevel* level;
-  std::pair<const float*, const float*> operator()(std::int64_t x, std::int64_t y, std::int64_t z) const
+  std::pair<const float*, const float*> operator()(
+    std::int64_t x, std::int64_t y, std::int64_t z) const
   {
     const std::int64_t offset = (z * level->dims[1] + y) * level->dims[0] + x;
     return { level->mean.data() + offset, level->variance.data() + offset };
@@ -180,7 +186,8 @@ public:
     this->Ya = std::max<std::int64_t>(0, window.y0 * p.step - kHalf);
     this->Yb = std::min<std::int64_t>(p.in[1], (window.y1 - 1) * p.step + kHalf + 1);
     const std::int64_t width = this->Xb - this->Xa;
-    this->PlaneMode = this->Yb - this->Ya <= kPlaneRows && width <= kPlaneWidth && window.y1 > window.y0;
+    this->PlaneMode =
+      this->Yb - this->Ya <= kPlaneRows && width <= kPlaneWidth && window.y1 > window.y0;
     if (this->PlaneMode)
     {
       // Each y-blurred row padded as RowA is, zeros where the x taps leave the volume.
@@ -217,12 +224,13 @@ public:
       const double* ib[kTaps];
       for (int k = 0; k < kTaps; ++k)
       {
-        const int slot = this->zBlurredRow(std::min(std::max<std::int64_t>(yo * p.step + k - kHalf, 0), p.in[1] - 1), zo);
+        const int slot = this->zBlurredRow(
+          std::min(std::max<std::int64_t>(yo * p.step + k - kHalf, 0), p.in[1] - 1), zo);
         ia[k] = &this->RingA[slot * nx + xa];
         ib[k] = &this->RingB[slot * nx + xa];
       }
-      runRows<ColumnRows>(p.simd, &ia[0], &ib[0], &p.wy[yo * kTaps], width, this->RowA.data() + kHalf + xa,
-        this->RowB.data() + kHalf + xa);
+      runRows<ColumnRows>(p.simd, &ia[0], &ib[0], &p.wy[yo * kTaps], width,
+        this->RowA.data() + kHalf + xa, this->RowB.data() + kHalf + xa);
       const auto out = rows(yo);
       this->xPass(this->RowA.data(), this->RowB.data(), 0, out.first, out.second);
     }
@@ -242,17 +250,18 @@ private:
   {
     const BlurPlan& p = this->Plan;
     const std::int64_t width = this->Xb - this->Xa;
-    this->Src.blurRows(this->Ya, this->Yb - this->Ya, this->ZRows, &p.wz[zo * kTaps], this->Xa, width,
-      this->PlaneA.data(), this->PlaneB.data(), width, p.simd);
+    this->Src.blurRows(this->Ya, this->Yb - this->Ya, this->ZRows, &p.wz[zo * kTaps], this->Xa,
+      width, this->PlaneA.data(), this->PlaneB.data(), width, p.simd);
     runRows<ColumnPlane>(p.simd, static_cast<const double*>(this->PlaneA.data()),
-      static_cast<const double*>(this->PlaneB.data()), width, this->Ya, p.in[1], static_cast<std::int64_t>(p.step),
-      p.wy.data(), this->Window.y0, this->Window.y1, width, this->YRowsA.data() + kHalf, this->YRowsB.data() + kHalf,
-      this->PaddedWidth);
+      static_cast<const double*>(this->PlaneB.data()), width, this->Ya, p.in[1],
+      static_cast<std::int64_t>(p.step), p.wy.data(), this->Window.y0, this->Window.y1, width,
+      this->YRowsA.data() + kHalf, this->YRowsB.data() + kHalf, this->PaddedWidth);
     for (std::int64_t yo = this->Window.y0; yo < this->Window.y1; ++yo)
     {
       const std::int64_t row = (yo - this->Window.y0) * this->PaddedWidth;
       const auto out = rows(yo);
-      this->xPass(this->YRowsA.data() + row, this->YRowsB.data() + row, this->Xa, out.first, out.second);
+      this->xPass(
+        this->YRowsA.data() + row, this->YRowsB.data() + row, this->Xa, out.first, out.second);
     }
   }
 
@@ -263,8 +272,9 @@ private:
     if (this->Tags[slot] != y)
     {
       const std::int64_t nx = this->Plan.in[0];
-      this->Src.blurRows(y, 1, this->ZRows, &this->Plan.wz[zo * kTaps], this->Xa, this->Xb - this->Xa,
-        &this->RingA[slot * nx + this->Xa], &this->RingB[slot * nx + this->Xa], 0, this->Plan.simd);
+      this->Src.blurRows(y, 1, this->ZRows, &this->Plan.wz[zo * kTaps], this->Xa,
+        this->Xb - this->Xa, &this->RingA[slot * nx + this->Xa], &this->RingB[slot * nx + this->Xa],
+        0, this->Plan.simd);
       this->Tags[slot] = y;
     }
     return slot;
@@ -274,17 +284,19 @@ private:
   /// value at input x = lo + i; the padding is zero and so are the clipped weights.
   /// Interior voxels take the constant weights in a vectorised loop. mean[0] is output
   /// voxel window.x0.
-  void xPass(const double* pa, const double* pb, std::int64_t lo, float* mean, float* variance) const
+  void xPass(
+    const double* pa, const double* pb, std::int64_t lo, float* mean, float* variance) const
   {
     const BlurPlan& p = this->Plan;
     const std::int64_t x0 = this->Window.x0, x1 = this->Window.x1, step = p.step;
     // The unclipped outputs of the whole row, then of the window.
     const std::int64_t rowBegin = std::min<std::int64_t>(p.out[0], (kHalf + step - 1) / step);
-    const std::int64_t rowEnd =
-      std::max<std::int64_t>(rowBegin, std::min<std::int64_t>(p.out[0], (p.in[0] - 1 - kHalf) / step + 1));
+    const std::int64_t rowEnd = std::max<std::int64_t>(
+      rowBegin, std::min<std::int64_t>(p.out[0], (p.in[0] - 1 - kHalf) / step + 1));
     const std::int64_t begin = std::max(x0, std::min(x1, rowBegin));
     const std::int64_t end = std::max(begin, std::min(x1, rowEnd));
-    auto clipped = [&](std::int64_t xo) {
+    auto clipped = [&](std::int64_t xo)
+    {
       const double* w = &p.wx[xo * kTaps];
       double sa = 0.0, sb = 0.0;
       for (int k = 0; k < kTaps; ++k)
@@ -299,11 +311,11 @@ private:
     // InteriorRow's output xo - begin reads from pa + step * xo - lo.
     const std::int64_t from = step * begin - lo;
     if (step == 1)
-      runRows<InteriorRow<1>>(p.simd, pa + from, pb + from, &p.kernel[0], p.shift, std::int64_t(0), end - begin,
-        mean + (begin - x0), variance + (begin - x0));
+      runRows<InteriorRow<1>>(p.simd, pa + from, pb + from, &p.kernel[0], p.shift, std::int64_t(0),
+        end - begin, mean + (begin - x0), variance + (begin - x0));
     else
-      runRows<InteriorRow<2>>(p.simd, pa + from, pb + from, &p.kernel[0], p.shift, std::int64_t(0), end - begin,
-        mean + (begin - x0), variance + (begin - x0));
+      runRows<InteriorRow<2>>(p.simd, pa + from, pb + from, &p.kernel[0], p.shift, std::int64_t(0),
+        end - begin, mean + (begin - x0), variance + (begin - x0));
     for (std::int64_t xo = end; xo < x1; ++xo)
       clipped(xo);
   }
@@ -326,7 +338,8 @@ private:
 /// The mean and variance rows of output slice zo of a whole level (dims `out`).
 inline auto levelRows(float* mean, float* variance, const Index3& out, std::int64_t zo)
 {
-  return [=](std::int64_t yo) {
+  return [=](std::int64_t yo)
+  {
     const std::int64_t o = (zo * out[1] + yo) * out[0];
     return std::make_pair(mean + o, variance + o);
   };
@@ -335,8 +348,8 @@ inline auto levelRows(float* mean, float* variance, const Index3& out, std::int6
 /// Blurs the source and keeps every `step`-th voxel per axis (step 1 or 2) into `out`
 /// (dims, mean and variance; geometry is the caller's). Returns false when cancelled.
 template <class Source>
-bool blurDecimate(const Source& source, int step, double shift, MomentLevel& out, const Execution& execution,
-  int threads)
+bool blurDecimate(const Source& source, int step, double shift, MomentLevel& out,
+  const Execution& execution, int threads)
 {
   const BlurPlan plan(source.dims(), step, shift);
   out.dims = plan.out;
@@ -345,9 +358,11 @@ bool blurDecimate(const Source& source, int step, double shift, MomentLevel& out
   const auto outCount = static_cast<std::size_t>(plan.out[0] * plan.out[1] * plan.out[2]);
   out.mean.resize(outCount);
   out.variance.resize(outCount);
-  const int chunks = static_cast<int>(std::min<std::int64_t>(plan.out[2], std::max(1, threads) * 4));
+  const int chunks =
+    static_cast<int>(std::min<std::int64_t>(plan.out[2], std::max(1, threads) * 4));
   return parallelFor(plan.out[2], chunks, threads, execution,
-    [&](std::int64_t zBegin, std::int64_t zEnd, ChunkProgress& progress) {
+    [&](std::int64_t zBegin, std::int64_t zEnd, ChunkProgress& progress)
+    {
       SliceBlur<Source> blur(source, plan);
       for (std::int64_t zo = zBegin; zo < zEnd; ++zo)
       {
@@ -364,7 +379,8 @@ bool blurDecimate(const Source& source, int step, double shift, MomentLevel& out
 /// kept every second voxel; level l reports its progress on stage(l). Returns false when
 /// cancelled.
 template <class Stage>
-bool blurCoarserLevels(std::vector<MomentLevel>& levels, int from, double shift, int threads, Stage&& stage)
+bool blurCoarserLevels(
+  std::vector<MomentLevel>& levels, int from, double shift, int threads, Stage&& stage)
 {
   for (int l = from; l < static_cast<int>(levels.size()); ++l)
   {

@@ -2,8 +2,8 @@
 // docs/methods.md, Penner and Mitchell).
 //
 // The blur itself, its precision and its windows: PyramidBlur.h.
-#include "vao/VarianceOcclusionMap.h"
 #include "vao/Validation.h"
+#include "vao/VarianceOcclusionMap.h"
 
 #include "cpu/moment_pyramid/PyramidBlur.h"
 
@@ -39,17 +39,21 @@ Status buildPyramid(const VolumeView& volume, const std::array<double, 3>& origi
   pyramid.clear();
   result.resize(static_cast<std::size_t>(levels));
   const double stageWidth = 1.0 / levels;
-  const bool firstDone = detail::dispatchScalarType(volume.type, [&](auto tag) {
-    using T = decltype(tag);
-    const RawSource<T> source{ detail::TypedVolume<T>(volume), shift };
-    return blurDecimate(source, setup.firstStep, shift, result[0], detail::stageExecution(execution, 0.0, stageWidth), threads);
-  });
+  const bool firstDone = detail::dispatchScalarType(volume.type,
+    [&](auto tag)
+    {
+      using T = decltype(tag);
+      const RawSource<T> source{ detail::TypedVolume<T>(volume), shift };
+      return blurDecimate(source, setup.firstStep, shift, result[0],
+        detail::stageExecution(execution, 0.0, stageWidth), threads);
+    });
   if (!firstDone)
   {
     return Status::cancelled();
   }
   if (!blurCoarserLevels(result, 1, shift, threads,
-        [&](int l) { return detail::stageExecution(execution, l * stageWidth, (l + 1) * stageWidth); }))
+        [&](int l)
+        { return detail::stageExecution(execution, l * stageWidth, (l + 1) * stageWidth); }))
   {
     return Status::cancelled();
   }
@@ -88,11 +92,10 @@ Status preparePyramid(const VolumeView& volume, const std::array<double, 3>& ori
   {
     return status;
   }
-  setup.shift = dispatchScalarType(volume.type, [&](auto tag) {
-    return sampledMean(TypedVolume<decltype(tag)>(volume));
-  });
-  setup.roundingVariance =
-    sumRoundingVariance(std::max(std::abs(scan.maximum - setup.shift), std::abs(scan.minimum - setup.shift)));
+  setup.shift = dispatchScalarType(
+    volume.type, [&](auto tag) { return sampledMean(TypedVolume<decltype(tag)>(volume)); });
+  setup.roundingVariance = sumRoundingVariance(
+    std::max(std::abs(scan.maximum - setup.shift), std::abs(scan.minimum - setup.shift)));
   setup.firstStep = parameters.startAtHalfResolution ? 2 : 1;
   return Status::success();
 }
@@ -146,7 +149,8 @@ void setLevelGeometry(std::vector<MomentLevel>& levels, const std::array<double,
     }
     // r_l: the 5-tap half-width (2 voxels) of the level's own grid, largest axis; it
     // doubles with every level.
-    level.kernelRadius = 2.0 * std::max(level.spacing[0], std::max(level.spacing[1], level.spacing[2]));
+    level.kernelRadius =
+      2.0 * std::max(level.spacing[0], std::max(level.spacing[1], level.spacing[2]));
     level.roundingVariance = setup.roundingVariance;
   }
 }

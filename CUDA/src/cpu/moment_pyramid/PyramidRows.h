@@ -36,8 +36,8 @@ VAO_ALWAYS_INLINE void shiftedTaps(const T* const* rows, std::int64_t i, double 
 template <class T, bool Unit>
 struct RawRows
 {
-  static VAO_ALWAYS_INLINE void run(const T* const* r, const double* w, double shift, std::int64_t stride,
-    std::int64_t nx, double* __restrict a, double* __restrict b)
+  static VAO_ALWAYS_INLINE void run(const T* const* r, const double* w, double shift,
+    std::int64_t stride, std::int64_t nx, double* __restrict a, double* __restrict b)
   {
     for (std::int64_t x = 0; x < nx; ++x)
     {
@@ -70,8 +70,8 @@ struct LevelRows
 /// y pass: out[x] = sum_k w_k in_k[x] for both moments.
 struct ColumnRows
 {
-  static VAO_ALWAYS_INLINE void run(const double* const* ia, const double* const* ib, const double* w,
-    std::int64_t nx, double* __restrict oa, double* __restrict ob)
+  static VAO_ALWAYS_INLINE void run(const double* const* ia, const double* const* ib,
+    const double* w, std::int64_t nx, double* __restrict oa, double* __restrict ob)
   {
     for (std::int64_t x = 0; x < nx; ++x)
     {
@@ -92,8 +92,9 @@ struct ColumnRows
 template <class T, bool Unit>
 struct RawPlane
 {
-  static VAO_ALWAYS_INLINE void run(const T* const* r, const double* w, double shift, std::int64_t stride,
-    std::int64_t nx, std::int64_t rows, std::int64_t inRowStride, std::int64_t outRowStride, double* a, double* b)
+  static VAO_ALWAYS_INLINE void run(const T* const* r, const double* w, double shift,
+    std::int64_t stride, std::int64_t nx, std::int64_t rows, std::int64_t inRowStride,
+    std::int64_t outRowStride, double* a, double* b)
   {
     for (std::int64_t j = 0; j < rows; ++j)
     {
@@ -107,8 +108,9 @@ struct RawPlane
 
 struct LevelPlane
 {
-  static VAO_ALWAYS_INLINE void run(const float* const* m, const float* const* v, const double* w, double shift,
-    std::int64_t nx, std::int64_t rows, std::int64_t inRowStride, std::int64_t outRowStride, double* a, double* b)
+  static VAO_ALWAYS_INLINE void run(const float* const* m, const float* const* v, const double* w,
+    double shift, std::int64_t nx, std::int64_t rows, std::int64_t inRowStride,
+    std::int64_t outRowStride, double* a, double* b)
   {
     for (std::int64_t j = 0; j < rows; ++j)
     {
@@ -129,9 +131,9 @@ struct LevelPlane
 /// the weights w + yo * kTaps (no library min/max: this is compiled for AVX2).
 struct ColumnPlane
 {
-  static VAO_ALWAYS_INLINE void run(const double* za, const double* zb, std::int64_t rowStride, std::int64_t ya,
-    std::int64_t ny, std::int64_t step, const double* w, std::int64_t y0, std::int64_t y1, std::int64_t nx,
-    double* oa, double* ob, std::int64_t outRowStride)
+  static VAO_ALWAYS_INLINE void run(const double* za, const double* zb, std::int64_t rowStride,
+    std::int64_t ya, std::int64_t ny, std::int64_t step, const double* w, std::int64_t y0,
+    std::int64_t y1, std::int64_t nx, double* oa, double* ob, std::int64_t outRowStride)
   {
     for (std::int64_t yo = y0; yo < y1; ++yo)
     {
@@ -144,7 +146,8 @@ struct ColumnPlane
         ia[k] = za + (y - ya) * rowStride;
         ib[k] = zb + (y - ya) * rowStride;
       }
-      ColumnRows::run(ia, ib, w + yo * kTaps, nx, oa + (yo - y0) * outRowStride, ob + (yo - y0) * outRowStride);
+      ColumnRows::run(
+        ia, ib, w + yo * kTaps, nx, oa + (yo - y0) * outRowStride, ob + (yo - y0) * outRowStride);
     }
   }
 };
@@ -154,13 +157,14 @@ struct ColumnPlane
 template <int Step>
 struct InteriorRow
 {
-  static VAO_ALWAYS_INLINE void run(const double* pa, const double* pb, const double* w, double shift,
-    std::int64_t begin, std::int64_t end, float* __restrict mean, float* __restrict variance)
+  static VAO_ALWAYS_INLINE void run(const double* pa, const double* pb, const double* w,
+    double shift, std::int64_t begin, std::int64_t end, float* __restrict mean,
+    float* __restrict variance)
   {
     for (std::int64_t xo = begin; xo < end; ++xo)
     {
-      blur::levelMoments(
-        tapSum(w, pa + Step * xo), tapSum(w, pb + Step * xo), shift, mean[xo - begin], variance[xo - begin]);
+      blur::levelMoments(tapSum(w, pa + Step * xo), tapSum(w, pb + Step * xo), shift,
+        mean[xo - begin], variance[xo - begin]);
     }
   }
 };

@@ -57,9 +57,10 @@ public:
       return;
     inputs(z);
     float* mean = this->Data.data() + 2 * (z % kTaps) * this->Plane;
-    this->Blur.slice(z, [&](std::int64_t yo) {
-      return std::make_pair(mean + yo * this->Dims[0], mean + this->Plane + yo * this->Dims[0]);
-    });
+    this->Blur.slice(z,
+      [&](std::int64_t yo) {
+        return std::make_pair(mean + yo * this->Dims[0], mean + this->Plane + yo * this->Dims[0]);
+      });
     this->Tags[z % kTaps] = z;
   }
 
@@ -76,7 +77,8 @@ template <class Ring>
 struct RingVoxels
 {
   const Ring* ring;
-  std::pair<const float*, const float*> operator()(std::int64_t x, std::int64_t y, std::int64_t z) const
+  std::pair<const float*, const float*> operator()(
+    std::int64_t x, std::int64_t y, std::int64_t z) const
   {
     const auto slice = (*ring)(z);
     const std::int64_t offset = y * ring->dims()[0] + x;
@@ -96,8 +98,8 @@ void forInputSlices(std::int64_t zo, const Index3& n, F&& f)
 /// `firstStep`-th voxel), levels 0 and 1 streaming through rings of slices: the same
 /// slices, hence the same level 2, as from the whole levels. Returns false when cancelled.
 template <class T>
-bool blurThroughStreamedLevels(const RawSource<T>& raw, int firstStep, double shift, MomentLevel& out,
-  const Execution& execution, int threads)
+bool blurThroughStreamedLevels(const RawSource<T>& raw, int firstStep, double shift,
+  MomentLevel& out, const Execution& execution, int threads)
 {
   const BlurPlan plan0(raw.dims(), firstStep, shift);
   const BlurPlan plan1(plan0.out, 2, shift);
@@ -111,7 +113,8 @@ bool blurThroughStreamedLevels(const RawSource<T>& raw, int firstStep, double sh
   // freed block).
   const int chunks = static_cast<int>(std::min<std::int64_t>(plan2.out[2], std::max(1, threads)));
   return parallelFor(plan2.out[2], chunks, threads, execution,
-    [&](std::int64_t zBegin, std::int64_t zEnd, ChunkProgress& progress) {
+    [&](std::int64_t zBegin, std::int64_t zEnd, ChunkProgress& progress)
+    {
       using Ring0 = SliceRing<RawSource<T>>;
       using Source1 = StoredSource<RingVoxels<Ring0>>;
       using Ring1 = SliceRing<Source1>;
@@ -122,11 +125,15 @@ bool blurThroughStreamedLevels(const RawSource<T>& raw, int firstStep, double sh
       SliceBlur<StoredSource<RingVoxels<Ring1>>> blur2(source2, plan2);
       for (std::int64_t zo = zBegin; zo < zEnd; ++zo)
       {
-        forInputSlices(zo, plan1.out, [&](std::int64_t z1) {
-          ring1.make(z1, [&](std::int64_t) {
-            forInputSlices(z1, plan0.out, [&](std::int64_t z0) { ring0.make(z0, [](std::int64_t) {}); });
+        forInputSlices(zo, plan1.out,
+          [&](std::int64_t z1)
+          {
+            ring1.make(z1,
+              [&](std::int64_t) {
+                forInputSlices(
+                  z1, plan0.out, [&](std::int64_t z0) { ring0.make(z0, [](std::int64_t) {}); });
+              });
           });
-        });
         blur2.slice(zo, levelRows(out.mean.data(), out.variance.data(), plan2.out, zo));
         if (!progress.advance())
         {
@@ -137,8 +144,8 @@ bool blurThroughStreamedLevels(const RawSource<T>& raw, int firstStep, double sh
 }
 
 Status buildSurfaceLevels(const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const PyramidParameters& parameters, SurfacePyramid& pyramid,
-  const Execution& execution)
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
+  SurfacePyramid& pyramid, const Execution& execution)
 {
   SurfacePyramidAccess::levels(pyramid).clear();
   SurfacePyramidAccess::tiles(pyramid).reset();
@@ -161,12 +168,14 @@ Status buildSurfaceLevels(const VolumeView& volume, const std::array<double, 3>&
   const double stageWidth = 1.0 / std::max(1, levels - 1);
   if (levels >= 3)
   {
-    const bool done = dispatchScalarType(volume.type, [&](auto tag) {
-      using T = decltype(tag);
-      const RawSource<T> raw{ TypedVolume<T>(volume), shift };
-      return blurThroughStreamedLevels(
-        raw, setup.firstStep, shift, result[2], stageExecution(execution, 0.0, 2 * stageWidth), threads);
-    });
+    const bool done = dispatchScalarType(volume.type,
+      [&](auto tag)
+      {
+        using T = decltype(tag);
+        const RawSource<T> raw{ TypedVolume<T>(volume), shift };
+        return blurThroughStreamedLevels(raw, setup.firstStep, shift, result[2],
+          stageExecution(execution, 0.0, 2 * stageWidth), threads);
+      });
     if (!done)
     {
       return Status::cancelled();
@@ -179,8 +188,10 @@ Status buildSurfaceLevels(const VolumeView& volume, const std::array<double, 3>&
   }
   setLevelGeometry(result, origin, spacing, setup);
   auto tiles = std::make_unique<PyramidTiles>();
-  tiles->keptBytes = std::max(kKeptTilesAtLeast, static_cast<std::size_t>(volume.voxelCount()) *
-      dispatchScalarType(volume.type, [](auto tag) { return sizeof(tag); }) / kKeptTilesPerInputByte);
+  tiles->keptBytes = std::max(kKeptTilesAtLeast,
+    static_cast<std::size_t>(volume.voxelCount()) *
+      dispatchScalarType(volume.type, [](auto tag) { return sizeof(tag); }) /
+      kKeptTilesPerInputByte);
   std::int64_t tileCount = 0;
   for (int l = 0; l < tiled; ++l)
   {
@@ -189,7 +200,8 @@ Status buildSurfaceLevels(const VolumeView& volume, const std::array<double, 3>&
   tiles->pool = std::make_unique<TilePool>(tileCount);
   for (int l = 0; l < tiled; ++l)
   {
-    tiles->levels.emplace_back(new LevelTiles(*tiles->pool, volume, result[l], l, setup.firstStep, shift));
+    tiles->levels.emplace_back(
+      new LevelTiles(*tiles->pool, volume, result[l], l, setup.firstStep, shift));
   }
   SurfacePyramidAccess::tiles(pyramid) = std::move(tiles);
   SurfacePyramidAccess::levels(pyramid) = std::move(result);
@@ -238,8 +250,8 @@ std::int64_t SurfacePyramid::tileCount(int level) const
 }
 
 Status buildSurfacePyramid(const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const PyramidParameters& parameters, SurfacePyramid& pyramid,
-  const Execution& execution)
+  const std::array<double, 3>& spacing, const PyramidParameters& parameters,
+  SurfacePyramid& pyramid, const Execution& execution)
 {
   const Status status = catchOutOfMemory("the levels of the moment pyramid",
     [&] { return buildSurfaceLevels(volume, origin, spacing, parameters, pyramid, execution); });

@@ -22,7 +22,8 @@ using namespace detail::sweeping;
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 constexpr int kFaceValues = 5; // D and four V_s per face voxel
-const char* const kSweepBuffers = "the sweeping buffers (signed distance, fixed voxels, octant visibility)";
+const char* const kSweepBuffers =
+  "the sweeping buffers (signed distance, fixed voxels, octant visibility)";
 
 SweepLayout blockLayout(const BlockPlacement& b, const std::array<double, 3>& spacing)
 {
@@ -161,22 +162,25 @@ Status BlockSweeper::initialise()
   {
     return status;
   }
-  return catchOutOfMemory(kSweepBuffers, [&] {
-    const std::int64_t count = s.layout.storage.count;
-    s.distance.assign(static_cast<std::size_t>(count), kInfinity); // ghosts: the open sky
-    s.vis = VisibilityStore();
-    s.vis.computed.fill(true);
-    s.vis.keep(s.layout.storage, nullptr);
-    std::fill(s.vis.storage.begin(), s.vis.storage.end(), 1.0f); // ghosts: the open sky
-    s.threads = detail::resolveThreadCount(s.execution.threads);
-    const BlockPlacement& b = s.placement;
-    const Index3 scalarOffset = { b.begin[0] > 0 ? 1 : 0, b.begin[1] > 0 ? 1 : 0, b.begin[2] > 0 ? 1 : 0 };
-    s.surfaceFound =
-      initialiseDistance(s.scalars, scalarOffset, s.layout, s.parameters, s.distance.data(), s.threads) > 0;
-    s.fixed.build(s.distance.data(), s.layout.storage.count, s.threads);
-    s.initialised = true;
-    return Status::success();
-  });
+  return catchOutOfMemory(kSweepBuffers,
+    [&]
+    {
+      const std::int64_t count = s.layout.storage.count;
+      s.distance.assign(static_cast<std::size_t>(count), kInfinity); // ghosts: the open sky
+      s.vis = VisibilityStore();
+      s.vis.computed.fill(true);
+      s.vis.keep(s.layout.storage, nullptr);
+      std::fill(s.vis.storage.begin(), s.vis.storage.end(), 1.0f); // ghosts: the open sky
+      s.threads = detail::resolveThreadCount(s.execution.threads);
+      const BlockPlacement& b = s.placement;
+      const Index3 scalarOffset = { b.begin[0] > 0 ? 1 : 0, b.begin[1] > 0 ? 1 : 0,
+        b.begin[2] > 0 ? 1 : 0 };
+      s.surfaceFound = initialiseDistance(s.scalars, scalarOffset, s.layout, s.parameters,
+                         s.distance.data(), s.threads) > 0;
+      s.fixed.build(s.distance.data(), s.layout.storage.count, s.threads);
+      s.initialised = true;
+      return Status::success();
+    });
 }
 
 bool BlockSweeper::surfaceFound() const
@@ -214,7 +218,11 @@ Status BlockSweeper::runRound(int maxPasses, SweepReport* report)
   r.surfaceFound = s.surfaceFound;
   const int sweepThreads = static_cast<int>(std::min<std::int64_t>(s.threads, s.layout.size[2]));
   const Status status = catchOutOfMemory(kSweepBuffers,
-    [&] { return runPasses(s.layout, p, s.distance.data(), s.fixed, s.vis, sweepThreads, s.execution, r); });
+    [&]
+    {
+      return runPasses(
+        s.layout, p, s.distance.data(), s.fixed, s.vis, sweepThreads, s.execution, r);
+    });
   r.lastChange *= unit;
   return status;
 }
@@ -241,12 +249,14 @@ void BlockSweeper::exportFace(int face, float* buffer) const
   }
   const State& s = *this->Impl;
   const std::array<int, 4> octants = State::octantsMoving(face / 2, (face & 1) ? 1 : -1);
-  s.forFaceVoxels(face, false, [&](std::int64_t i, std::int64_t k) {
-    float* out = buffer + kFaceValues * k;
-    out[0] = s.distance[i];
-    for (int o = 0; o < 4; ++o)
-      out[1 + o] = s.vis.field[octants[o]][i];
-  });
+  s.forFaceVoxels(face, false,
+    [&](std::int64_t i, std::int64_t k)
+    {
+      float* out = buffer + kFaceValues * k;
+      out[0] = s.distance[i];
+      for (int o = 0; o < 4; ++o)
+        out[1 + o] = s.vis.field[octants[o]][i];
+    });
 }
 
 double BlockSweeper::importFace(int face, const float* buffer)
@@ -260,17 +270,19 @@ double BlockSweeper::importFace(int face, const float* buffer)
   const std::array<int, 4> octants = State::octantsMoving(face / 2, (face & 1) ? -1 : 1);
   const double unit = sweepUnit(s.spacing); // D is exchanged in sweep units
   double largest = 0.0;
-  s.forFaceVoxels(face, true, [&](std::int64_t i, std::int64_t k) {
-    const float* in = buffer + kFaceValues * k;
-    largest = std::max(largest, changeOf(s.distance[i], in[0]) * unit);
-    s.distance[i] = in[0];
-    for (int o = 0; o < 4; ++o)
+  s.forFaceVoxels(face, true,
+    [&](std::int64_t i, std::int64_t k)
     {
-      float& v = s.vis.field[octants[o]][i];
-      largest = std::max(largest, changeOf(v, in[1 + o]));
-      v = in[1 + o];
-    }
-  });
+      const float* in = buffer + kFaceValues * k;
+      largest = std::max(largest, changeOf(s.distance[i], in[0]) * unit);
+      s.distance[i] = in[0];
+      for (int o = 0; o < 4; ++o)
+      {
+        float& v = s.vis.field[octants[o]][i];
+        largest = std::max(largest, changeOf(v, in[1 + o]));
+        v = in[1 + o];
+      }
+    });
   return largest;
 }
 
@@ -281,7 +293,8 @@ Status BlockSweeper::finish(const SweepOutput& output)
     return Status::failure("finish before a successful initialise()");
   }
   State& s = *this->Impl;
-  const Status status = validateSweepParameters(s.spacing, s.parameters, output); // the volume was checked by initialise()
+  const Status status = validateSweepParameters(
+    s.spacing, s.parameters, output); // the volume was checked by initialise()
   if (!status.ok)
   {
     return status;
@@ -299,9 +312,12 @@ Status BlockSweeper::finish(const SweepOutput& output)
           to[x] = row[x] * unit; // sweep units to world units (exact: a power of two)
       }
   }
-  return catchOutOfMemory(kSweepBuffers, [&] {
-    return combine(s.layout, s.parameters, output, s.distance.data(), s.vis, s.maskCount, s.threads, s.execution);
-  });
+  return catchOutOfMemory(kSweepBuffers,
+    [&]
+    {
+      return combine(s.layout, s.parameters, output, s.distance.data(), s.vis, s.maskCount,
+        s.threads, s.execution);
+    });
 }
 
 bool BlockSweeper::initialised() const

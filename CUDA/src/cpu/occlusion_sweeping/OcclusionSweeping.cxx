@@ -51,14 +51,17 @@ VisibilityStore planVisibility(
 void distanceToWorld(float* distance, std::int64_t count, double unit, int threads)
 {
   const float scale = static_cast<float>(unit);
-  detail::parallelFor(count, 4 * threads, threads, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t i = begin; i < end; ++i)
-      distance[i] *= scale;
-  });
+  detail::parallelFor(count, 4 * threads, threads,
+    [&](std::int64_t begin, std::int64_t end)
+    {
+      for (std::int64_t i = begin; i < end; ++i)
+        distance[i] *= scale;
+    });
 }
 
 Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& spacing,
-  const SweepParameters& parameters, const SweepOutput& out, const Execution& execution, SweepReport& report)
+  const SweepParameters& parameters, const SweepOutput& out, const Execution& execution,
+  SweepReport& report)
 {
   const double unit = sweepUnit(spacing);
   SweepParameters p = parameters;
@@ -79,7 +82,8 @@ Status occlusionSweeping(const VolumeView& volume, const std::array<double, 3>& 
   for (bool m : p.octantMask)
     maskCount += m;
 
-  const std::int64_t fixedCount = initialiseDistance(volume, { 0, 0, 0 }, layout, p, distance, threads);
+  const std::int64_t fixedCount =
+    initialiseDistance(volume, { 0, 0, 0 }, layout, p, distance, threads);
   FixedMask fixed;
   fixed.build(distance, grid.count, threads);
   report.surfaceFound = fixedCount > 0;
@@ -128,7 +132,11 @@ Status computeOcclusionSweeping(const VolumeView& volume, const std::array<doubl
   }
   SweepReport local;
   return catchOutOfMemory("the sweeping buffers (signed distance, fixed voxels, octant visibility)",
-    [&] { return occlusionSweeping(volume, spacing, parameters, output, execution, report ? *report : local); });
+    [&]
+    {
+      return occlusionSweeping(
+        volume, spacing, parameters, output, execution, report ? *report : local);
+    });
 }
 
 } // namespace vao

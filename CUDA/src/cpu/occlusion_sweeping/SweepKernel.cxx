@@ -8,8 +8,8 @@
 // comes after its upwind neighbours, so planes run as a wavefront on the members of one
 // parallelFor team: plane k may start row j once plane k-1 has finished row j. Each
 // member sweeps two planes at a time, the second a row behind, their rows interleaved.
-#include "cpu/occlusion_sweeping/SweepingCore.h"
 #include "cpu/occlusion_sweeping/SweepRows.h"
+#include "cpu/occlusion_sweeping/SweepingCore.h"
 
 #include "cpu/common/Parallel.h"
 
@@ -29,7 +29,8 @@ namespace sweeping
 namespace
 {
 
-static_assert(kPlanesTogether >= 1 && kPlanesTogether <= 2, "sweepRows takes one or two rows at a time");
+static_assert(
+  kPlanesTogether >= 1 && kPlanesTogether <= 2, "sweepRows takes one or two rows at a time");
 
 struct alignas(64) RowCounter
 {
@@ -50,7 +51,8 @@ public:
     , Threads(threads)
     , SkyDistance(layout.size[0], kInfinity)
     , SkyVisibility(layout.size[0], 1.0f)
-  {}
+  {
+  }
 
   /// The sweep of `octant` over the own voxels. Returns false when cancelled.
   bool sweep(int octant, bool visibility, const Execution& execution, RowResult& total)
@@ -60,19 +62,22 @@ public:
     // Pairs of planes per chunk: member t sweeps pairs t, t + T, ... (the wavefront,
     // Parallel.h), each pair's two planes together (sweepPlanes).
     const std::int64_t chunks = (planes + kPlanesTogether - 1) / kPlanesTogether;
-    const bool finished = detail::parallelFor(planes, static_cast<int>(chunks), this->Threads, execution,
-      [&](std::int64_t k0, std::int64_t k1, detail::ChunkProgress& progress) {
-        std::vector<float> scratch(static_cast<std::size_t>(kPlanesTogether * this->scratchPerRow()));
-        for (std::int64_t k = k0; k < k1 && !progress.stopped(); k += kPlanesTogether)
+    const bool finished =
+      detail::parallelFor(planes, static_cast<int>(chunks), this->Threads, execution,
+        [&](std::int64_t k0, std::int64_t k1, detail::ChunkProgress& progress)
         {
-          const int count = static_cast<int>(std::min<std::int64_t>(kPlanesTogether, k1 - k));
-          if (!this->sweepPlanes(state, k, count, scratch.data(), progress))
+          std::vector<float> scratch(
+            static_cast<std::size_t>(kPlanesTogether * this->scratchPerRow()));
+          for (std::int64_t k = k0; k < k1 && !progress.stopped(); k += kPlanesTogether)
           {
-            return;
+            const int count = static_cast<int>(std::min<std::int64_t>(kPlanesTogether, k1 - k));
+            if (!this->sweepPlanes(state, k, count, scratch.data(), progress))
+            {
+              return;
+            }
+            progress.advance(count);
           }
-          progress.advance(count);
-        }
-      });
+        });
     for (const RowResult& r : state.planeResults)
     {
       total.largestChange = std::max(total.largestChange, r.largestChange);
@@ -98,14 +103,15 @@ private:
       , rowKernel(rowFunction(dir[0], withVisibility))
       , rowsDone(static_cast<std::size_t>(planes))
       , planeResults(static_cast<std::size_t>(planes))
-    {}
+    {
+    }
   };
 
   /// Planes k and k + 1 (count 2) or plane k alone (count 1) of the sweep (k counts in
   /// sweep order). Row j of plane k waits for plane k - 1's; plane k + 1 follows one row
   /// behind plane k, so the two rows of a step are independent and run interleaved.
-  bool sweepPlanes(
-    SweepState& state, std::int64_t k, int count, float* scratch, const detail::ChunkProgress& progress)
+  bool sweepPlanes(SweepState& state, std::int64_t k, int count, float* scratch,
+    const detail::ChunkProgress& progress)
   {
     const std::int64_t rows = this->Layout.size[1];
     for (std::int64_t step = 0; step < rows + count - 1; ++step)
@@ -177,21 +183,26 @@ private:
   {
     const Grid& g = this->Storage;
     const std::int64_t y = this->storageY(state, j), z = this->storageZ(state, k);
-    const bool hasUpwindRow = this->Layout.ghosted || j > 0, hasUpwindPlane = this->Layout.ghosted || k > 0;
+    const bool hasUpwindRow = this->Layout.ghosted || j > 0,
+               hasUpwindPlane = this->Layout.ghosted || k > 0;
     const std::int64_t sky0 = state.dir[0] > 0 ? 0 : this->Layout.size[0] - 1; // in the sky rows
     const std::int64_t x0 = this->Layout.offset[0] + sky0;
     const std::int64_t rowStep = state.dir[1] * g.nx, planeStep = state.dir[2] * g.plane;
     const std::int64_t i = g.index(x0, y, z);
     const bool ghosted = this->Layout.ghosted;
-    RowView row{ this->Distance + i, hasUpwindRow ? this->Distance + i - rowStep : this->SkyDistance.data() + sky0,
-      hasUpwindPlane ? this->Distance + i - planeStep : this->SkyDistance.data() + sky0, this->Fixed, i, nullptr,
-      nullptr, nullptr, ghosted ? this->Distance[i - state.dir[0]] : kInfinity, 1.0f, scratch };
+    RowView row{ this->Distance + i,
+      hasUpwindRow ? this->Distance + i - rowStep : this->SkyDistance.data() + sky0,
+      hasUpwindPlane ? this->Distance + i - planeStep : this->SkyDistance.data() + sky0,
+      this->Fixed, i, nullptr, nullptr, nullptr,
+      ghosted ? this->Distance[i - state.dir[0]] : kInfinity, 1.0f, scratch };
     if (state.visibility)
     {
       VisibilityStore& vis = this->Visibility;
       row.v = vis.row(state.octant, y, z, g) + x0;
-      row.vy = hasUpwindRow ? row.v - state.dir[1] * vis.pitch(g) : this->SkyVisibility.data() + sky0;
-      row.vz = hasUpwindPlane ? vis.row(state.octant, y, z - state.dir[2], g) + x0 : this->SkyVisibility.data() + sky0;
+      row.vy =
+        hasUpwindRow ? row.v - state.dir[1] * vis.pitch(g) : this->SkyVisibility.data() + sky0;
+      row.vz = hasUpwindPlane ? vis.row(state.octant, y, z - state.dir[2], g) + x0
+                              : this->SkyVisibility.data() + sky0;
       row.startV = ghosted ? row.v[-state.dir[0]] : 1.0f;
     }
     return row;
@@ -237,9 +248,9 @@ Status runPasses(const SweepLayout& layout, const SweepParameters& p, float* dis
     {
       // V is recomputed in every pass. The workers zero it: in the first pass this is the
       // output's first touch.
-      detail::parallelFor(layout.storage.count, 4 * threads, threads, [&](std::int64_t begin, std::int64_t end) {
-        std::fill(vis.sum + begin, vis.sum + end, 0.0f);
-      });
+      detail::parallelFor(layout.storage.count, 4 * threads, threads,
+        [&](std::int64_t begin, std::int64_t end)
+        { std::fill(vis.sum + begin, vis.sum + end, 0.0f); });
     }
     RowResult total;
     for (int s = 0; s < 8; ++s)

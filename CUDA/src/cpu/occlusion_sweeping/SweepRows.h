@@ -64,7 +64,8 @@ inline float godunov(float ax, float ay, float az, const SweepConstants& k)
   float a[3] = { ax, ay, az };
   float h[3] = { k.h[0], k.h[1], k.h[2] };
   float w[3] = { k.w[0], k.w[1], k.w[2] };
-  auto order = [&](int i, int j) {
+  auto order = [&](int i, int j)
+  {
     if (a[j] < a[i])
     {
       std::swap(a[i], a[j]);
@@ -226,7 +227,8 @@ struct RowChain
 /// latency of its chain (the Godunov update's square root and division), and two chains
 /// in one loop keep the core busy while either waits.
 template <int Step, bool Visibility>
-void sweepRows(const RowView* rows, int rowCount, std::int64_t count, const SweepConstants& k, RowResult* results)
+void sweepRows(const RowView* rows, int rowCount, std::int64_t count, const SweepConstants& k,
+  RowResult* results)
 {
   RowChain<Step, Visibility> first(rows[0], count, k);
   if (rowCount == 2)

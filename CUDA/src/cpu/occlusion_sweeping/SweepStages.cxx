@@ -3,8 +3,8 @@
 // into the outputs (Singh et al. Eq. 4/5).
 #include "cpu/occlusion_sweeping/SweepingCore.h"
 
-#include "cpu/common/Parallel.h"
 #include "VolumeAccess.h"
+#include "cpu/common/Parallel.h"
 #include "vao/Validation.h"
 
 #include <algorithm>
@@ -70,9 +70,9 @@ Status validateSweepParameters(
   const auto [smallest, largest] = std::minmax({ spacing[0], spacing[1], spacing[2] });
   if (smallest < kSmallestSpacing || largest > kLargestSpacing)
   {
-    why << "occlusion sweeping needs spacings between " << kSmallestSpacing << " and " << kLargestSpacing
-        << " (its distances are float; got " << spacing[0] << ", " << spacing[1] << ", " << spacing[2]
-        << "): rescale the volume (e.g. with Change Spacing)";
+    why << "occlusion sweeping needs spacings between " << kSmallestSpacing << " and "
+        << kLargestSpacing << " (its distances are float; got " << spacing[0] << ", " << spacing[1]
+        << ", " << spacing[2] << "): rescale the volume (e.g. with Change Spacing)";
   }
   else if (p.iterations < 1)
   {
@@ -129,7 +129,9 @@ std::int64_t initialiseDistanceOf(const VolumeView& view, const Index3& scalarOf
   const std::int64_t steps[3] = { 1, extent[0], extent[0] * extent[1] };
   const std::array<double, 3>& h = layout.storage.h;
   std::atomic<std::int64_t> fixedCount{ 0 };
-  detail::parallelFor(layout.size[2], threads, threads, [&](std::int64_t z0, std::int64_t z1) {
+  detail::parallelFor(layout.size[2], threads, threads,
+    [&](std::int64_t z0, std::int64_t z1)
+    {
       std::int64_t local = 0;
       for (std::int64_t z = z0; z < z1; ++z)
         for (std::int64_t y = 0; y < layout.size[1]; ++y)
@@ -168,9 +170,12 @@ std::int64_t initialiseDistanceOf(const VolumeView& view, const Index3& scalarOf
 std::int64_t initialiseDistance(const VolumeView& scalars, const Index3& scalarOffset,
   const SweepLayout& layout, const SweepParameters& p, float* distance, int threads)
 {
-  return detail::dispatchScalarType(scalars.type, [&](auto tag) {
-    return initialiseDistanceOf<decltype(tag)>(scalars, scalarOffset, layout, p, distance, threads);
-  });
+  return detail::dispatchScalarType(scalars.type,
+    [&](auto tag)
+    {
+      return initialiseDistanceOf<decltype(tag)>(
+        scalars, scalarOffset, layout, p, distance, threads);
+    });
 }
 
 void FixedMask::build(const float* distance, std::int64_t count, int threads)
@@ -178,7 +183,9 @@ void FixedMask::build(const float* distance, std::int64_t count, int threads)
   const std::int64_t words = (count + 63) / 64;
   this->Words.assign(static_cast<std::size_t>(words), 0);
   std::uint64_t* out = this->Words.data();
-  detail::parallelFor(words, threads, threads, [&](std::int64_t w0, std::int64_t w1) {
+  detail::parallelFor(words, threads, threads,
+    [&](std::int64_t w0, std::int64_t w1)
+    {
       for (std::int64_t w = w0; w < w1; ++w)
       {
         std::uint64_t bits = 0;
@@ -253,13 +260,16 @@ struct Combiner
       const std::int64_t o = (z * n[1] + y) * n[0]; // the row's first output voxel
       if (this->vis.inOutput)
       {
-        const float* block = this->vis.field[0] + (z * n[1] + y) * this->vis.rowPitch; // whole volume
+        const float* block =
+          this->vis.field[0] + (z * n[1] + y) * this->vis.rowPitch; // whole volume
         rows.assign(block, block + 8 * n[0]);
       }
       // Row y of each octant's field (null where not computed: V = 0).
       const float* field[8] = {};
       for (int s = 0; s < 8 && this->vis.kept; ++s)
-        field[s] = this->vis.inOutput ? rows.data() + s * n[0] : this->vis.field[s] ? this->vis.field[s] + first : nullptr;
+        field[s] = this->vis.inOutput ? rows.data() + s * n[0]
+          : this->vis.field[s]        ? this->vis.field[s] + first
+                                      : nullptr;
       if (this->out.octantVisibility)
       {
         for (std::int64_t x = 0; x < n[0]; ++x)
@@ -327,8 +337,8 @@ struct Combiner
 
 } // namespace
 
-void fillWithoutSurface(
-  const SweepLayout& layout, bool allInside, float* distance, VisibilityStore& vis, double maskCount)
+void fillWithoutSurface(const SweepLayout& layout, bool allInside, float* distance,
+  VisibilityStore& vis, double maskCount)
 {
   const double diagonal = Grid(layout.whole, layout.storage.h).diagonal();
   const float d = static_cast<float>(allInside ? -diagonal : diagonal);
@@ -360,7 +370,8 @@ Status combine(const SweepLayout& layout, const SweepParameters& p, const SweepO
   }
   const Combiner combiner{ layout, p, out, distance, vis, maskCount };
   const bool finished = detail::parallelFor(layout.size[2], threads, threads, execution,
-    [&](std::int64_t z0, std::int64_t z1, detail::ChunkProgress& progress) {
+    [&](std::int64_t z0, std::int64_t z1, detail::ChunkProgress& progress)
+    {
       std::vector<float> rows;
       std::vector<double> occlusion;
       for (std::int64_t z = z0; z < z1 && !progress.stopped(); ++z)

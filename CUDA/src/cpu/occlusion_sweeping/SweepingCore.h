@@ -40,7 +40,8 @@ struct Grid
     , plane(dims[0] * dims[1])
     , count(dims[0] * dims[1] * dims[2])
     , h(spacing)
-  {}
+  {
+  }
   std::int64_t index(std::int64_t x, std::int64_t y, std::int64_t z) const
   {
     return (z * ny + y) * nx + x;
@@ -80,7 +81,7 @@ struct VisibilityStore
 {
   std::array<bool, 8> computed{};
   std::array<float*, 8> field{}; // kept: row (y, z) of field s at field[s] + (z ny + y) rowPitch
-  StorageArray<float> storage; // uninitialised: every sweep writes all of its field
+  StorageArray<float> storage;   // uninitialised: every sweep writes all of its field
   // Elements from one row of a kept field to the next: the storage's nx, or 8 nx when the
   // fields are the rows of the OctantVisibility output itself (row-interleaved: the eight
   // fields' rows (y, z) lie one after another where the output keeps that row's voxels;
@@ -200,8 +201,8 @@ Status runPasses(const SweepLayout& layout, const SweepParameters& p, float* dis
 
 /// No edge of the whole volume crosses the iso value: D = +-(the whole volume's diagonal)
 /// with the sign of inside, every octant open (all outside) or closed (all inside).
-void fillWithoutSurface(
-  const SweepLayout& layout, bool allInside, float* distance, VisibilityStore& vis, double maskCount);
+void fillWithoutSurface(const SweepLayout& layout, bool allInside, float* distance,
+  VisibilityStore& vis, double maskCount);
 
 /// Writes the outputs of the own voxels (x fastest over layout.size): OctantVisibility and
 /// AmbientOcclusion (not D). N of the geometry term: central differences of D, one-sided

@@ -81,10 +81,10 @@ __attribute__((target("avx2,fma"))) void runAvx2(Args... args)
 // GCC vectorises for 256 bits on AVX-512 unless told to use the full width; Clang takes
 // min_vector_width for the same.
 #if defined(__clang__)
-#define VAO_AVX512_TARGET                                                                                    \
+#define VAO_AVX512_TARGET                                                                          \
   __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"), min_vector_width(512)))
 #else
-#define VAO_AVX512_TARGET                                                                                    \
+#define VAO_AVX512_TARGET                                                                          \
   __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma,prefer-vector-width=512")))
 #endif
 

@@ -27,7 +27,8 @@ VAO_ALWAYS_INLINE __m128i loadPairs(const float* base, std::int32_t i, std::int3
   const char* bytes = reinterpret_cast<const char*>(base);
   return _mm_unpacklo_epi64(
     _mm_loadl_epi64(reinterpret_cast<const __m128i*>(bytes + static_cast<std::int64_t>(i) * Scale)),
-    _mm_loadl_epi64(reinterpret_cast<const __m128i*>(bytes + static_cast<std::int64_t>(j) * Scale)));
+    _mm_loadl_epi64(
+      reinterpret_cast<const __m128i*>(bytes + static_cast<std::int64_t>(j) * Scale)));
 }
 
 namespace avx2
@@ -35,27 +36,57 @@ namespace avx2
 using Idx = __m128i;
 #define VAO_LANES VAO_AVX2_HELPER
 
-VAO_LANES Idx indices(std::int64_t x) { return _mm_set1_epi32(static_cast<int>(x)); }
-VAO_LANES Idx add(Idx a, Idx b) { return _mm_add_epi32(a, b); }
-VAO_LANES Idx mul(Idx a, Idx b) { return _mm_mullo_epi32(a, b); }
-VAO_LANES Idx min(Idx a, Idx b) { return _mm_min_epi32(a, b); }
+VAO_LANES Idx indices(std::int64_t x)
+{
+  return _mm_set1_epi32(static_cast<int>(x));
+}
+VAO_LANES Idx add(Idx a, Idx b)
+{
+  return _mm_add_epi32(a, b);
+}
+VAO_LANES Idx mul(Idx a, Idx b)
+{
+  return _mm_mullo_epi32(a, b);
+}
+VAO_LANES Idx min(Idx a, Idx b)
+{
+  return _mm_min_epi32(a, b);
+}
 /// x / 8 and x % 8 of non-negative indices (a tile and the place within it).
-VAO_LANES Idx eighth(Idx x) { return _mm_srli_epi32(x, 3); }
-VAO_LANES Idx remainderOfEight(Idx x) { return _mm_and_si128(x, _mm_set1_epi32(7)); }
+VAO_LANES Idx eighth(Idx x)
+{
+  return _mm_srli_epi32(x, 3);
+}
+VAO_LANES Idx remainderOfEight(Idx x)
+{
+  return _mm_and_si128(x, _mm_set1_epi32(7));
+}
 /// Truncation of doubles in [0, 2^31) and back.
-VAO_LANES Idx truncate(D u) { return _mm256_cvttpd_epi32(u); }
-VAO_LANES D toDouble(Idx x) { return _mm256_cvtepi32_pd(x); }
+VAO_LANES Idx truncate(D u)
+{
+  return _mm256_cvttpd_epi32(u);
+}
+VAO_LANES D toDouble(Idx x)
+{
+  return _mm256_cvtepi32_pd(x);
+}
 /// x where m, else 0.
 VAO_LANES Idx onlyWhere(Mask m, Idx x)
 {
   // The 64-bit lane masks narrowed to 32 bits.
   const __m256i wide = _mm256_castpd_si256(m);
-  const __m128i narrow =
-    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(wide, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
+  const __m128i narrow = _mm256_castsi256_si128(
+    _mm256_permutevar8x32_epi32(wide, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
   return _mm_and_si128(narrow, x);
 }
-VAO_LANES void storeIndices(std::int32_t* to, Idx x) { _mm_storeu_si128(reinterpret_cast<__m128i*>(to), x); }
-VAO_LANES Idx loadIndices(const std::int32_t* from) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(from)); }
+VAO_LANES void storeIndices(std::int32_t* to, Idx x)
+{
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(to), x);
+}
+VAO_LANES Idx loadIndices(const std::int32_t* from)
+{
+  return _mm_loadu_si128(reinterpret_cast<const __m128i*>(from));
+}
 VAO_LANES Idx gather(const std::int32_t* base, Idx at)
 {
   alignas(16) std::int32_t i[4];
@@ -91,16 +122,46 @@ namespace avx512
 using Idx = __m256i;
 #define VAO_LANES VAO_AVX512_HELPER
 
-VAO_LANES Idx indices(std::int64_t x) { return _mm256_set1_epi32(static_cast<int>(x)); }
-VAO_LANES Idx add(Idx a, Idx b) { return _mm256_add_epi32(a, b); }
-VAO_LANES Idx mul(Idx a, Idx b) { return _mm256_mullo_epi32(a, b); }
-VAO_LANES Idx min(Idx a, Idx b) { return _mm256_min_epi32(a, b); }
-VAO_LANES Idx eighth(Idx x) { return _mm256_srli_epi32(x, 3); }
-VAO_LANES Idx remainderOfEight(Idx x) { return _mm256_and_si256(x, _mm256_set1_epi32(7)); }
-VAO_LANES Idx truncate(D u) { return _mm512_cvttpd_epi32(u); }
-VAO_LANES D toDouble(Idx x) { return _mm512_cvtepi32_pd(x); }
-VAO_LANES Idx onlyWhere(Mask m, Idx x) { return _mm256_maskz_mov_epi32(m, x); }
-VAO_LANES void storeIndices(std::int32_t* to, Idx x) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(to), x); }
+VAO_LANES Idx indices(std::int64_t x)
+{
+  return _mm256_set1_epi32(static_cast<int>(x));
+}
+VAO_LANES Idx add(Idx a, Idx b)
+{
+  return _mm256_add_epi32(a, b);
+}
+VAO_LANES Idx mul(Idx a, Idx b)
+{
+  return _mm256_mullo_epi32(a, b);
+}
+VAO_LANES Idx min(Idx a, Idx b)
+{
+  return _mm256_min_epi32(a, b);
+}
+VAO_LANES Idx eighth(Idx x)
+{
+  return _mm256_srli_epi32(x, 3);
+}
+VAO_LANES Idx remainderOfEight(Idx x)
+{
+  return _mm256_and_si256(x, _mm256_set1_epi32(7));
+}
+VAO_LANES Idx truncate(D u)
+{
+  return _mm512_cvttpd_epi32(u);
+}
+VAO_LANES D toDouble(Idx x)
+{
+  return _mm512_cvtepi32_pd(x);
+}
+VAO_LANES Idx onlyWhere(Mask m, Idx x)
+{
+  return _mm256_maskz_mov_epi32(m, x);
+}
+VAO_LANES void storeIndices(std::int32_t* to, Idx x)
+{
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(to), x);
+}
 VAO_LANES Idx loadIndices(const std::int32_t* from)
 {
   return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(from));
@@ -116,8 +177,8 @@ VAO_LANES D gatherFloats(const float* base, Idx at)
 {
   alignas(32) std::int32_t i[8];
   storeIndices(i, at);
-  return _mm512_cvtps_pd(
-    _mm256_setr_ps(base[i[0]], base[i[1]], base[i[2]], base[i[3]], base[i[4]], base[i[5]], base[i[6]], base[i[7]]));
+  return _mm512_cvtps_pd(_mm256_setr_ps(base[i[0]], base[i[1]], base[i[2]], base[i[3]], base[i[4]],
+    base[i[5]], base[i[6]], base[i[7]]));
 }
 template <int Scale>
 VAO_LANES void gatherPairs(const float* base, Idx at, D& first, D& second)
@@ -130,8 +191,9 @@ VAO_LANES void gatherPairs(const float* base, Idx at, D& first, D& second)
   const __m256i low = _mm256_inserti128_si256(_mm256_castsi128_si256(quarter[0]), quarter[1], 1);
   const __m256i high = _mm256_inserti128_si256(_mm256_castsi128_si256(quarter[2]), quarter[3], 1);
   const __m512i pairs = _mm512_inserti64x4(_mm512_castsi256_si512(low), high, 1);
-  const __m512 grouped = _mm512_permutexvar_ps(
-    _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 1, 3, 5, 7, 9, 11, 13, 15), _mm512_castsi512_ps(pairs));
+  const __m512 grouped =
+    _mm512_permutexvar_ps(_mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 1, 3, 5, 7, 9, 11, 13, 15),
+      _mm512_castsi512_ps(pairs));
   first = _mm512_cvtps_pd(_mm512_castps512_ps256(grouped));
   second = _mm512_cvtps_pd(_mm512_extractf32x8_ps(grouped, 1));
 }

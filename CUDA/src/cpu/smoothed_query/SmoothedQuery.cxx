@@ -8,8 +8,8 @@
 // its slices through a ring of 2 ceil(3 sigma) + 1 planes smoothed in x and y.
 #include "cpu/smoothed_query/SmoothedQuery.h"
 
-#include "cpu/common/Parallel.h"
 #include "VolumeAccess.h"
+#include "cpu/common/Parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -64,7 +64,8 @@ struct AxisWeights
 
 /// centre + sum_k w_k (v[first + k] - centre), values read through `at`.
 template <class At>
-double centredAverage(double centre, const double* w, std::int64_t first, std::int64_t size, At&& at)
+double centredAverage(
+  double centre, const double* w, std::int64_t first, std::int64_t size, At&& at)
 {
   double sum = 0.0;
   for (std::int64_t k = 0; k < size; ++k)
@@ -118,8 +119,8 @@ public:
     const double* w = this->Wz.of(k);
     for (std::int64_t p = 0; p < plane; ++p)
     {
-      const double q = centredAverage(centre[p], w, first, size,
-        [&](std::int64_t s) { return this->planeOf(s)[p]; });
+      const double q = centredAverage(
+        centre[p], w, first, size, [&](std::int64_t s) { return this->planeOf(s)[p]; });
       out[p] = std::is_integral<T>::value ? snapToInteger(q) : q;
     }
   }
@@ -178,27 +179,30 @@ private:
 
 } // namespace
 
-bool computeSmoothedQuery(
-  const VolumeView& view, const Region& region, double sigma, double* query, const Execution& execution)
+bool computeSmoothedQuery(const VolumeView& view, const Region& region, double sigma, double* query,
+  const Execution& execution)
 {
   const AxisWeights wx(region.begin[0], region.size[0], view.dims[0], sigma);
   const AxisWeights wy(region.begin[1], region.size[1], view.dims[1], sigma);
   const AxisWeights wz(region.begin[2], region.size[2], view.dims[2], sigma);
   const std::int64_t plane = region.size[0] * region.size[1];
-  return dispatchScalarType(view.type, [&](auto tag) {
-    using T = decltype(tag);
-    const TypedVolume<T> volume(view);
-    const int threads = resolveThreadCount(execution.threads);
-    return parallelFor(region.size[2], threads, threads, execution,
-      [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
-        QueryPlanes<T> planes(volume, region, wx, wy, wz);
-        for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
+  return dispatchScalarType(view.type,
+    [&](auto tag)
+    {
+      using T = decltype(tag);
+      const TypedVolume<T> volume(view);
+      const int threads = resolveThreadCount(execution.threads);
+      return parallelFor(region.size[2], threads, threads, execution,
+        [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
         {
-          planes.slice(region.begin[2] + k, query + k * plane);
-          progress.advance();
-        }
-      });
-  });
+          QueryPlanes<T> planes(volume, region, wx, wy, wz);
+          for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
+          {
+            planes.slice(region.begin[2] + k, query + k * plane);
+            progress.advance();
+          }
+        });
+    });
 }
 
 } // namespace detail

@@ -63,7 +63,8 @@ struct LevelGrid
     }
     this->stride[1] = level.dims[0];
     this->stride[2] = level.dims[0] * level.dims[1];
-    this->narrowIndices = this->stride[2] * level.dims[2] <= std::numeric_limits<std::int32_t>::max();
+    this->narrowIndices =
+      this->stride[2] * level.dims[2] <= std::numeric_limits<std::int32_t>::max();
     this->pairedRows = level.dims[0] >= 2;
   }
 };
@@ -89,7 +90,8 @@ public:
     // Separable: each voxel takes the maximum of itself and its upper neighbour (where
     // there is one) along x, then y, then z.
     const std::int64_t nx = level.dims[0], ny = level.dims[1], nz = level.dims[2];
-    auto take = [this](std::int64_t i, std::int64_t j) {
+    auto take = [this](std::int64_t i, std::int64_t j)
+    {
       this->pairs[2 * i] = std::max(this->pairs[2 * i], this->pairs[2 * j]);
       this->pairs[2 * i + 1] = std::max(this->pairs[2 * i + 1], this->pairs[2 * j + 1]);
     };
@@ -112,7 +114,8 @@ private:
 /// Trilinear mean and variance (clamped at 0) of the level at world (x, y, z), clamped to
 /// the level's bounds: the cell's lower corner, the fractions towards the upper one, and
 /// nested lerps along x, y, z.
-inline void trilinearSample(const LevelGrid& g, double x, double y, double z, double& mean, double& variance)
+inline void trilinearSample(
+  const LevelGrid& g, double x, double y, double z, double& mean, double& variance)
 {
   using IndexT = std::int64_t;
   const double p[3] = { x, y, z };
@@ -121,7 +124,8 @@ inline void trilinearSample(const LevelGrid& g, double x, double y, double z, do
   double f[3];
   for (int a = 0; a < 3; ++a)
   {
-    const double u = std::min(std::max((p[a] - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
+    const double u =
+      std::min(std::max((p[a] - g.origin[a]) * g.inverseSpacing[a], 0.0), g.maxIndex[a]);
     const IndexT lower = static_cast<IndexT>(u); // u >= 0: truncation is the floor
     f[a] = u - static_cast<double>(lower);
     if (g.tiled)
@@ -137,7 +141,8 @@ inline void trilinearSample(const LevelGrid& g, double x, double y, double z, do
   }
   if (g.tiled)
     base += g.tileOffsets[tile];
-  auto blend = [&](const float* c) {
+  auto blend = [&](const float* c)
+  {
     auto lerp = [](double a, double b, double t) { return a + t * (b - a); };
     auto row = [&](IndexT i) { return lerp(c[i], c[i + step[0]], f[0]); };
     const double lowerPlane = lerp(row(base), row(base + step[1]), f[1]);
@@ -150,8 +155,8 @@ inline void trilinearSample(const LevelGrid& g, double x, double y, double z, do
 
 /// occlusion[k] = 1 - the estimator's openness of query[k] at world (x[k], y[k], z[k]) of
 /// one level, for the kLanes lanes: the definition, and the path without AVX2.
-inline void occlusionLanesPlain(const LevelGrid& g, Method estimator, const double* x, const double* y,
-  const double* z, const double* query, double* occlusion)
+inline void occlusionLanesPlain(const LevelGrid& g, Method estimator, const double* x,
+  const double* y, const double* z, const double* query, double* occlusion)
 {
   for (int k = 0; k < kLanes; ++k)
   {
@@ -160,7 +165,8 @@ inline void occlusionLanesPlain(const LevelGrid& g, Method estimator, const doub
     occlusion[k] = 1.0 -
       (estimator == Method::Chebyshev
           ? opennessChebyshevWithin(query[k], mean, variance, g.roundingVariance, g.roundingSpread)
-          : opennessFromStats(estimator, query[k], { mean, variance, mean, mean, g.roundingVariance }, ErfMode::Exact));
+          : opennessFromStats(estimator, query[k],
+              { mean, variance, mean, mean, g.roundingVariance }, ErfMode::Exact));
   }
 }
 

@@ -81,8 +81,10 @@ private:
   static Reach reachable(double move, std::int64_t top, double maxIndex)
   {
     constexpr double kSlack = 1e-6; // index units: far above the positions' rounding
-    auto cellOf = [&](double u) {
-      return std::min(top, static_cast<std::int64_t>(std::floor(std::min(std::max(u, 0.0), maxIndex))));
+    auto cellOf = [&](double u)
+    {
+      return std::min(
+        top, static_cast<std::int64_t>(std::floor(std::min(std::max(u, 0.0), maxIndex))));
     };
     Reach reach;
     reach.first.resize(static_cast<std::size_t>(top + 1));

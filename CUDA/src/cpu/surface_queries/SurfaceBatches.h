@@ -3,8 +3,8 @@
 // and unit normals either way, and the box the shadow march stays in.
 #pragma once
 
-#include "cpu/surface_queries/LevelGrid.h"
 #include "cpu/common/Parallel.h"
+#include "cpu/surface_queries/LevelGrid.h"
 
 #include <algorithm>
 #include <array>
@@ -45,10 +45,10 @@ struct PointLanes
     for (int k = 0; k < kLanes; ++k)
     {
       const std::int64_t i = range[batch * kLanes + std::min(k, this->used - 1)];
-      const double p[3] = { static_cast<double>(points[3 * i]), static_cast<double>(points[3 * i + 1]),
-        static_cast<double>(points[3 * i + 2]) };
-      const double n[3] = { static_cast<double>(normals[3 * i]), static_cast<double>(normals[3 * i + 1]),
-        static_cast<double>(normals[3 * i + 2]) };
+      const double p[3] = { static_cast<double>(points[3 * i]),
+        static_cast<double>(points[3 * i + 1]), static_cast<double>(points[3 * i + 2]) };
+      const double n[3] = { static_cast<double>(normals[3 * i]),
+        static_cast<double>(normals[3 * i + 1]), static_cast<double>(normals[3 * i + 2]) };
       const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
       this->index[k] = i;
       this->x[k] = p[0];
@@ -63,7 +63,8 @@ struct PointLanes
   /// The world position at distance d from point k along its normal.
   std::array<double, 3> along(int k, double d) const
   {
-    return { this->x[k] + d * this->nx[k], this->y[k] + d * this->ny[k], this->z[k] + d * this->nz[k] };
+    return { this->x[k] + d * this->nx[k], this->y[k] + d * this->ny[k],
+      this->z[k] + d * this->nz[k] };
   }
 
   /// Those positions of every lane, as three arrays (the vector lanes' input).
@@ -82,20 +83,23 @@ struct PointLanes
 /// f(lanes) for every batch of kLanes points of `range`, on every thread, reporting
 /// progress every 64 batches. Returns false when cancelled.
 template <class P, class PerBatch>
-bool forEachBatch(const P* points, const P* normals, const PointRange& range, const Execution& execution,
-  PerBatch&& f)
+bool forEachBatch(const P* points, const P* normals, const PointRange& range,
+  const Execution& execution, PerBatch&& f)
 {
   constexpr int kProgressBatches = 64;
   const std::int64_t batches = (range.count + kLanes - 1) / kLanes;
   const int threads = resolveThreadCount(execution.threads);
-  const int chunks = static_cast<int>(std::min<std::int64_t>(std::max<std::int64_t>(batches, 1), threads * 8));
+  const int chunks =
+    static_cast<int>(std::min<std::int64_t>(std::max<std::int64_t>(batches, 1), threads * 8));
   return parallelFor(batches, chunks, threads, execution,
-    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
+    {
       for (std::int64_t b = begin; b < end; ++b)
       {
         PointLanes lanes(points, normals, range, b);
         f(lanes);
-        if ((b - begin) % kProgressBatches == kProgressBatches - 1 && !progress.advance(kProgressBatches))
+        if ((b - begin) % kProgressBatches == kProgressBatches - 1 &&
+          !progress.advance(kProgressBatches))
         {
           return;
         }
@@ -123,7 +127,8 @@ struct MarchBounds
     for (int a = 0; a < 3; ++a)
     {
       this->lo[a] = window ? level.wholeBounds[2 * a] : level.origin[a];
-      this->hi[a] = window ? level.wholeBounds[2 * a + 1] : level.origin[a] + (level.dims[a] - 1) * level.spacing[a];
+      this->hi[a] = window ? level.wholeBounds[2 * a + 1]
+                           : level.origin[a] + (level.dims[a] - 1) * level.spacing[a];
       const double slack = kFaceSlack * std::max(std::abs(this->lo[a]), std::abs(this->hi[a]));
       this->lo[a] -= slack;
       this->hi[a] += slack;
@@ -140,8 +145,8 @@ struct MarchBounds
 
   bool contains(const double* p) const
   {
-    return p[0] >= this->lo[0] && p[0] <= this->hi[0] && p[1] >= this->lo[1] && p[1] <= this->hi[1] &&
-      p[2] >= this->lo[2] && p[2] <= this->hi[2];
+    return p[0] >= this->lo[0] && p[0] <= this->hi[0] && p[1] >= this->lo[1] &&
+      p[1] <= this->hi[1] && p[2] >= this->lo[2] && p[2] <= this->hi[2];
   }
 };
 

@@ -31,7 +31,8 @@ inline std::string pointMessage(const char* what, std::int64_t i)
 
 /// Checks the pyramid and resolves the number of levels used.
 /// `tiled`: the first levels of a SurfacePyramid, in tiles (LevelTiles.h), have no arrays.
-inline Status checkPyramid(const std::vector<MomentLevel>& pyramid, int requested, int& levels, int tiled = 0)
+inline Status checkPyramid(
+  const std::vector<MomentLevel>& pyramid, int requested, int& levels, int tiled = 0)
 {
   if (pyramid.empty())
   {
@@ -39,12 +40,14 @@ inline Status checkPyramid(const std::vector<MomentLevel>& pyramid, int requeste
   }
   for (const MomentLevel& level : pyramid)
   {
-    const std::int64_t n = &level - &pyramid[0] < tiled ? 0 : level.dims[0] * level.dims[1] * level.dims[2];
+    const std::int64_t n =
+      &level - &pyramid[0] < tiled ? 0 : level.dims[0] * level.dims[1] * level.dims[2];
     if (level.dims[0] < 1 || level.dims[1] < 1 || level.dims[2] < 1 ||
       static_cast<std::int64_t>(level.mean.size()) != n ||
       static_cast<std::int64_t>(level.variance.size()) != n || !(level.kernelRadius > 0.0))
     {
-      return Status::failure("a level of the moment pyramid is inconsistent (dims, arrays or radius)");
+      return Status::failure(
+        "a level of the moment pyramid is inconsistent (dims, arrays or radius)");
     }
   }
   const int available = static_cast<int>(pyramid.size());
@@ -83,7 +86,8 @@ inline Status checkParameters(const SurfaceOcclusionParameters& p)
   {
     return Status::failure("the surface estimator must be Chebyshev or Gaussian CDF");
   }
-  if (p.combination != LevelCombination::MaximumOcclusion && p.combination != LevelCombination::Mean)
+  if (p.combination != LevelCombination::MaximumOcclusion &&
+    p.combination != LevelCombination::Mean)
   {
     return Status::failure("unknown level combination");
   }
@@ -125,8 +129,9 @@ Status checkPoints(const P* points, const P* normals, std::int64_t count)
 /// The checks both surface queries share: the pyramid and the levels used, the
 /// parameters, the points and normals, and somewhere to write.
 template <class P>
-Status checkQuery(const std::vector<MomentLevel>& pyramid, const SurfaceOcclusionParameters& parameters,
-  const P* points, const P* normals, std::int64_t count, const float* out, int& levels, int tiled = 0)
+Status checkQuery(const std::vector<MomentLevel>& pyramid,
+  const SurfaceOcclusionParameters& parameters, const P* points, const P* normals,
+  std::int64_t count, const float* out, int& levels, int tiled = 0)
 {
   Status status = checkPyramid(pyramid, parameters.levels, levels, tiled);
   if (status.ok)

@@ -34,7 +34,8 @@ VAO_LANES Cells cellsOf(const LevelGrid& g, const D* position)
   for (int a = 0; a < 3; ++a)
   {
     const D maxIndex = set1(g.maxIndex[a]);
-    const D u = min(max(mul(sub(position[a], set1(g.origin[a])), set1(g.inverseSpacing[a])), zero()), maxIndex);
+    const D u = min(
+      max(mul(sub(position[a], set1(g.origin[a])), set1(g.inverseSpacing[a])), zero()), maxIndex);
     Idx lower = truncate(u);
     if (a == 0 && g.pairedRows) // the last voxel as the upper corner of the cell below it
       lower = min(lower, indices(static_cast<std::int64_t>(g.maxIndex[0]) - 1));
@@ -93,11 +94,13 @@ VAO_LANES void blend(const LevelGrid& g, const Cells& c, D& mean, D& variance)
     else
     {
       means[r] = lerp(gatherFloats(g.mean, row[r]), gatherFloats(g.mean, upper), c.f[0]);
-      variances[r] = lerp(gatherFloats(g.variance, row[r]), gatherFloats(g.variance, upper), c.f[0]);
+      variances[r] =
+        lerp(gatherFloats(g.variance, row[r]), gatherFloats(g.variance, upper), c.f[0]);
     }
   }
   mean = lerp(lerp(means[0], means[1], c.f[1]), lerp(means[2], means[3], c.f[1]), c.f[2]);
-  variance = lerp(lerp(variances[0], variances[1], c.f[1]), lerp(variances[2], variances[3], c.f[1]), c.f[2]);
+  variance = lerp(
+    lerp(variances[0], variances[1], c.f[1]), lerp(variances[2], variances[3], c.f[1]), c.f[2]);
 }
 
 /// The Chebyshev occlusion of q in the cells (occlusionLanesPlain's formula).
@@ -105,8 +108,9 @@ VAO_LANES D chebyshevOcclusion(const LevelGrid& g, const Cells& c, D q)
 {
   D mean, variance;
   blend(g, c, mean, variance);
-  return sub(set1(1.0), chebyshevOpenness(q, mean, max(variance, zero()), set1(g.roundingVariance),
-    set1(g.roundingSpread)));
+  return sub(set1(1.0),
+    chebyshevOpenness(
+      q, mean, max(variance, zero()), set1(g.roundingVariance), set1(g.roundingSpread)));
 }
 
 /// Upper bounds of the Chebyshev occlusion of q from (largest mean, largest variance)
@@ -123,7 +127,8 @@ VAO_LANES D chebyshevBound(const float* pairs, const Cells& c, D q)
 
 /// Asks for the cache lines of the cells' rows (x pairs) at the lanes' positions, so that
 /// a batch's samples of a level far larger than the caches wait on their misses together.
-VAO_LANES_ENTRY void prefetchLanes(const LevelGrid& g, const double* x, const double* y, const double* z)
+VAO_LANES_ENTRY void prefetchLanes(
+  const LevelGrid& g, const double* x, const double* y, const double* z)
 {
   for (int h = 0; h < kLanes; h += kWidth)
   {
@@ -182,7 +187,8 @@ VAO_LANES D rawRow(const T* data, Idx at, Idx step, D g, D f)
 /// RawSampler's values at kLanes positions: its clamps, cells and blends, operation for
 /// operation (no fused multiply-add), so the same bits.
 template <class T>
-VAO_LANES_ENTRY void rawLanes(const RawSampler<T>& s, const double* x, const double* y, const double* z, double* out)
+VAO_LANES_ENTRY void rawLanes(
+  const RawSampler<T>& s, const double* x, const double* y, const double* z, double* out)
 {
   const D one = set1(1.0);
   for (int h = 0; h < kLanes; h += kWidth)
@@ -194,7 +200,8 @@ VAO_LANES_ENTRY void rawLanes(const RawSampler<T>& s, const double* x, const dou
     {
       const D maxIndex = set1(s.maxIndex[a]);
       // max(x, 0) gives 0 for NaN, as RawSampler's std::max(0.0, x) does.
-      const D u = min(max(mul(sub(position[a], set1(s.origin[a])), set1(s.inverseSpacing[a])), zero()), maxIndex);
+      const D u = min(
+        max(mul(sub(position[a], set1(s.origin[a])), set1(s.inverseSpacing[a])), zero()), maxIndex);
       const Idx lower = truncate(u);
       f[a] = sub(u, toDouble(lower));
       g[a] = sub(one, f[a]);
@@ -213,7 +220,8 @@ VAO_LANES_ENTRY void rawLanes(const RawSampler<T>& s, const double* x, const dou
 
 /// trilinearSample's means at kLanes positions, but for the rounding of the blends' fused
 /// multiply-adds.
-VAO_LANES_ENTRY void meanLanes(const LevelGrid& g, const double* x, const double* y, const double* z, double* mean)
+VAO_LANES_ENTRY void meanLanes(
+  const LevelGrid& g, const double* x, const double* y, const double* z, double* mean)
 {
   for (int h = 0; h < kLanes; h += kWidth)
   {
@@ -225,8 +233,8 @@ VAO_LANES_ENTRY void meanLanes(const LevelGrid& g, const double* x, const double
 }
 
 /// occlusionLanesPlain for Chebyshev.
-VAO_LANES_ENTRY void chebyshevLanes(const LevelGrid& g, const double* x, const double* y, const double* z,
-  const double* query, double* occlusion)
+VAO_LANES_ENTRY void chebyshevLanes(const LevelGrid& g, const double* x, const double* y,
+  const double* z, const double* query, double* occlusion)
 {
   for (int h = 0; h < kLanes; h += kWidth)
   {
@@ -240,9 +248,9 @@ VAO_LANES_ENTRY void chebyshevLanes(const LevelGrid& g, const double* x, const d
 /// marching in registers: from start (x, y, z per lane) along the unit light, inside
 /// [lo, hi], the steps of `schedule` (marchSchedule), on levels whose indices fit in 32
 /// bits. `rays`: null, or the RayBounds of level `rayLevel`, the schedule's last.
-VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const MarchStep* schedule, std::size_t steps,
-  const double* lo, const double* hi, const double* const* start, const double* light, const double* query,
-  double* occlusion, const float* rays, int rayLevel)
+VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const MarchStep* schedule,
+  std::size_t steps, const double* lo, const double* hi, const double* const* start,
+  const double* light, const double* query, double* occlusion, const float* rays, int rayLevel)
 {
   const D full = set1(kMarchFullOcclusion);
   D occ[kVectors], q[kVectors], from[kVectors][3];
@@ -267,7 +275,8 @@ VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const MarchStep* sch
         // start + t * light rounded as the plain loop does (no fused multiply-add): both
         // forms stop at the same step on a bound.
         at[h][a] = add(from[h][a], mul(set1(t), set1(light[a])));
-        alive[h] = both(alive[h], both(greaterEqual(at[h][a], set1(lo[a])), lessEqual(at[h][a], set1(hi[a]))));
+        alive[h] = both(
+          alive[h], both(greaterEqual(at[h][a], set1(lo[a])), lessEqual(at[h][a], set1(hi[a]))));
       }
       any = any || !none(alive[h]);
     }
@@ -282,7 +291,8 @@ VAO_LANES_ENTRY void chebyshevMarch(const LevelGrid* grids, const MarchStep* sch
       // No lane still marching can rise above its occlusion here: the sample is passed
       // over, as the maximum it would enter is already held. Lanes that nothing on the
       // rest of their ray can raise stop.
-      if (grid.cellBounds && none(butNot(alive[h], lessEqual(chebyshevBound(grid.cellBounds, cells, q[h]), occ[h]))))
+      if (grid.cellBounds &&
+        none(butNot(alive[h], lessEqual(chebyshevBound(grid.cellBounds, cells, q[h]), occ[h]))))
       {
         if (rays && schedule[s].level == rayLevel)
           alive[h] = butNot(alive[h], lessEqual(chebyshevBound(rays, cells, q[h]), occ[h]));

@@ -80,20 +80,22 @@ namespace avx512
 /// The Chebyshev shadow march of a batch (SurfaceLanes-inl.h) in the widest tier the
 /// processor has: `tier` is Avx2 or Avx512. `rays`: null, or the RayBounds (their data)
 /// of the schedule's last level, `rayLevel`.
-inline void chebyshevMarch(SimdTier tier, const LevelGrid* grids, const std::vector<MarchStep>& schedule,
-  const double* lo, const double* hi, const double* const* start, const double* light, const double* query,
-  double* occlusion, const float* rays = nullptr, int rayLevel = -1)
+inline void chebyshevMarch(SimdTier tier, const LevelGrid* grids,
+  const std::vector<MarchStep>& schedule, const double* lo, const double* hi,
+  const double* const* start, const double* light, const double* query, double* occlusion,
+  const float* rays = nullptr, int rayLevel = -1)
 {
   const auto march = tier == SimdTier::Avx512 ? avx512::chebyshevMarch : avx2::chebyshevMarch;
-  march(grids, schedule.data(), schedule.size(), lo, hi, start, light, query, occlusion, rays, rayLevel);
+  march(grids, schedule.data(), schedule.size(), lo, hi, start, light, query, occlusion, rays,
+    rayLevel);
 }
 #endif
 
 /// The occlusions of kLanes samples of one level with the given estimator: Chebyshev on
 /// AVX2 or AVX-512 where the indices fit in 32 bits, else the plain loop (the exact erf
 /// has no vector form here).
-inline void occlusionLanes(const LevelGrid& g, Method estimator, const double* x, const double* y, const double* z,
-  const double* query, double* occlusion)
+inline void occlusionLanes(const LevelGrid& g, Method estimator, const double* x, const double* y,
+  const double* z, const double* query, double* occlusion)
 {
 #if VAO_HAVE_AVX2_TARGET
   const SimdTier tier = cpuSimdTier();
@@ -112,7 +114,8 @@ inline void occlusionLanes(const LevelGrid& g, Method estimator, const double* x
 /// RawSampler's values at kLanes positions: rawLanes (SurfaceLanes-inl.h) on AVX2 or
 /// AVX-512 where the volume's indices fit in 32 bits, else one position at a time.
 template <class T>
-void rawLanes(const RawSampler<T>& s, const double* x, const double* y, const double* z, double* out)
+void rawLanes(
+  const RawSampler<T>& s, const double* x, const double* y, const double* z, double* out)
 {
 #if VAO_HAVE_AVX2_TARGET
   const SimdTier tier = cpuSimdTier();
@@ -131,7 +134,8 @@ void rawLanes(const RawSampler<T>& s, const double* x, const double* y, const do
 
 /// trilinearSample's means at kLanes positions: meanLanes (SurfaceLanes-inl.h) where the
 /// vector lanes apply.
-inline void meanLanes(const LevelGrid& g, const double* x, const double* y, const double* z, double* mean)
+inline void meanLanes(
+  const LevelGrid& g, const double* x, const double* y, const double* z, double* mean)
 {
 #if VAO_HAVE_AVX2_TARGET
   const SimdTier tier = cpuSimdTier();

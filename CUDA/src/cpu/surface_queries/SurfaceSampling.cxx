@@ -1,16 +1,16 @@
 // Surface ambient occlusion and soft shadows sampled from the moment pyramid (Penner &
 // Mitchell 2008; docs/methods.md, Penner and Mitchell).
-#include "vao/VarianceOcclusionMap.h"
 #include "vao/Validation.h"
+#include "vao/VarianceOcclusionMap.h"
 
-#include "cpu/moment_pyramid/LevelTiles.h"
+#include "VolumeAccess.h"
 #include "cpu/common/Parallel.h"
+#include "cpu/moment_pyramid/LevelTiles.h"
 #include "cpu/surface_queries/RayBounds.h"
 #include "cpu/surface_queries/SurfaceBatches.h"
 #include "cpu/surface_queries/SurfaceChecks.h"
 #include "cpu/surface_queries/SurfaceLanes.h"
 #include "cpu/surface_queries/SurfaceWalk.h"
-#include "VolumeAccess.h"
 
 #include <algorithm>
 #include <cmath>
@@ -37,7 +37,8 @@ struct PreparedPyramid
   bool vectorMarch = tier >= detail::SimdTier::Avx2;
 
   /// `tiles`: a SurfacePyramid's tiled levels (read where their tiles are built).
-  PreparedPyramid(const std::vector<MomentLevel>& pyramid, int levels, const detail::PyramidTiles* tiles)
+  PreparedPyramid(
+    const std::vector<MomentLevel>& pyramid, int levels, const detail::PyramidTiles* tiles)
   {
     for (int l = 0; l < levels; ++l)
     {
@@ -70,10 +71,14 @@ struct PreparedPyramid
   {
     const int last = static_cast<int>(this->grids.size()) - 1;
     if (last >= 0 && this->grids[last].cellBounds)
-      this->rays.emplace_back(this->grids[last], detail::kMarchStepFraction * this->kernelRadius[last], light);
+      this->rays.emplace_back(
+        this->grids[last], detail::kMarchStepFraction * this->kernelRadius[last], light);
   }
   /// The ray bounds (null without them) and their level, the last.
-  const float* rayBounds() const { return this->rays.empty() ? nullptr : this->rays.front().data(); }
+  const float* rayBounds() const
+  {
+    return this->rays.empty() ? nullptr : this->rays.front().data();
+  }
   int rayLevel() const { return static_cast<int>(this->grids.size()) - 1; }
 
 private:
@@ -87,15 +92,19 @@ private:
 double sampleVolume(const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const std::array<double, 3>& position)
 {
-  return detail::dispatchScalarType(volume.type, [&](auto tag) {
-    using T = decltype(tag);
-    return RawSampler<T>(detail::TypedVolume<T>(volume), origin, spacing)(position);
-  });
+  return detail::dispatchScalarType(volume.type,
+    [&](auto tag)
+    {
+      using T = decltype(tag);
+      return RawSampler<T>(detail::TypedVolume<T>(volume), origin, spacing)(position);
+    });
 }
 
-void sampleLevel(const MomentLevel& level, const std::array<double, 3>& position, double& mean, double& variance)
+void sampleLevel(
+  const MomentLevel& level, const std::array<double, 3>& position, double& mean, double& variance)
 {
-  detail::trilinearSample(detail::LevelGrid(level), position[0], position[1], position[2], mean, variance);
+  detail::trilinearSample(
+    detail::LevelGrid(level), position[0], position[1], position[2], mean, variance);
 }
 
 namespace
@@ -111,9 +120,8 @@ void batchOcclusion(const PreparedPyramid& pyramid, int levels, PointLanes& lane
   double x[2][W], y[2][W], z[2][W], occlusion[W];
   std::fill(combined, combined + W, 0.0);
   // Level l's sample positions, in slot l % 2.
-  const auto positions = [&](int l) {
-    lanes.along(parameters.offsetFactor * pyramid.kernelRadius[l], x[l % 2], y[l % 2], z[l % 2]);
-  };
+  const auto positions = [&](int l)
+  { lanes.along(parameters.offsetFactor * pyramid.kernelRadius[l], x[l % 2], y[l % 2], z[l % 2]); };
   // Levels 0 and 1 (96% of a pyramid's bytes) are far larger than the caches: the batch
   // first asks for their lines, so their misses overlap instead of following one another.
   for (int l = 0; l < std::min(levels, 2); ++l)
@@ -127,11 +135,13 @@ void batchOcclusion(const PreparedPyramid& pyramid, int levels, PointLanes& lane
     if (l >= 2)
       positions(l);
     const int slot = l % 2;
-    detail::occlusionLanes(pyramid.grids[l], parameters.estimator, x[slot], y[slot], z[slot], lanes.query, occlusion);
+    detail::occlusionLanes(
+      pyramid.grids[l], parameters.estimator, x[slot], y[slot], z[slot], lanes.query, occlusion);
     for (int k = 0; k < W; ++k)
     {
-      combined[k] = parameters.combination == LevelCombination::Mean ? combined[k] + occlusion[k] / levels
-                                                                     : std::max(combined[k], occlusion[k]);
+      combined[k] = parameters.combination == LevelCombination::Mean
+        ? combined[k] + occlusion[k] / levels
+        : std::max(combined[k], occlusion[k]);
     }
   }
 }
@@ -139,8 +149,9 @@ void batchOcclusion(const PreparedPyramid& pyramid, int levels, PointLanes& lane
 /// The largest occlusion each lane's march meets from p + r_0 n along the unit `light`.
 /// The lanes share the steps (t and the level depend on the distance alone); a lane stops
 /// on leaving the bounds or at full occlusion, the batch when every lane has.
-void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, const std::vector<detail::MarchStep>& schedule,
-  const PointLanes& lanes, const std::array<double, 3>& light, Method estimator, double* occlusion)
+void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds,
+  const std::vector<detail::MarchStep>& schedule, const PointLanes& lanes,
+  const std::array<double, 3>& light, Method estimator, double* occlusion)
 {
   constexpr int W = detail::kLanes;
   const double r0 = pyramid.kernelRadius[0];
@@ -156,9 +167,8 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, const
   if (estimator == Method::Chebyshev && pyramid.vectorMarch)
   {
     const double* start[3] = { sx, sy, sz };
-    detail::chebyshevMarch(
-      pyramid.tier, pyramid.grids.data(), schedule, bounds.lo, bounds.hi, start, light.data(), lanes.query, occlusion,
-      pyramid.rayBounds(), pyramid.rayLevel());
+    detail::chebyshevMarch(pyramid.tier, pyramid.grids.data(), schedule, bounds.lo, bounds.hi,
+      start, light.data(), lanes.query, occlusion, pyramid.rayBounds(), pyramid.rayLevel());
     return;
   }
 #endif
@@ -196,13 +206,14 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds, const
 
 /// `tiles`: a SurfacePyramid's tiled levels; the tiles the samples reach are built first.
 template <class P>
-Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles, const VolumeView& volume,
-  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const P* points, const P* normals,
-  std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
+Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles,
+  const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const P* points, const P* normals, std::int64_t count,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
   int levels = 0;
-  Status status =
-    detail::checkQuery(pyramid, parameters, points, normals, count, out, levels, tiles ? tiles->count() : 0);
+  Status status = detail::checkQuery(
+    pyramid, parameters, points, normals, count, out, levels, tiles ? tiles->count() : 0);
   const bool half = parameters.query == SurfaceQuery::HalfVoxelInside;
   if (status.ok && half)
   {
@@ -220,7 +231,8 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles
   }
   const double h = std::min(spacing[0], std::min(spacing[1], spacing[2]));
   // The tiled levels' samples: at p + k r_l n (batchOcclusion's positions).
-  const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t) {
+  const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t)
+  {
     for (int l = 0; l < std::min(levels, t.count()); ++l)
     {
       const double offset = parameters.offsetFactor * pyramid[l].kernelRadius;
@@ -232,39 +244,47 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles
     }
   };
   const PreparedPyramid prepared(pyramid, levels, tiles);
-  const bool finished = detail::dispatchScalarType(half ? volume.type : ScalarType::Float32, [&](auto tag) {
-    const RawSampler<decltype(tag)> raw(detail::TypedVolume<decltype(tag)>(half ? volume : VolumeView{}),
-      half ? origin : std::array<double, 3>{ 0, 0, 0 }, half ? spacing : std::array<double, 3>{ 1, 1, 1 });
-    const auto query = [&](PointLanes& lanes) {
-      if (half)
+  const bool finished = detail::dispatchScalarType(half ? volume.type : ScalarType::Float32,
+    [&](auto tag)
+    {
+      const RawSampler<decltype(tag)> raw(
+        detail::TypedVolume<decltype(tag)>(half ? volume : VolumeView{}),
+        half ? origin : std::array<double, 3>{ 0, 0, 0 },
+        half ? spacing : std::array<double, 3>{ 1, 1, 1 });
+      const auto query = [&](PointLanes& lanes)
       {
-        double x[detail::kLanes], y[detail::kLanes], z[detail::kLanes];
-        lanes.along(-0.5 * h, x, y, z);
-        detail::rawLanes(raw, x, y, z, lanes.query);
-      }
-      else
-        std::fill(lanes.query, lanes.query + detail::kLanes, parameters.isoValue);
-    };
-    return detail::sweepPoints(tiles, points, normals, count, execution, mark, [&](PointLanes& lanes) {
-      double occlusion[detail::kLanes];
-      batchOcclusion(prepared, levels, lanes, parameters, query, occlusion);
-      for (int k = 0; k < lanes.used; ++k)
-      {
-        out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
-      }
+        if (half)
+        {
+          double x[detail::kLanes], y[detail::kLanes], z[detail::kLanes];
+          lanes.along(-0.5 * h, x, y, z);
+          detail::rawLanes(raw, x, y, z, lanes.query);
+        }
+        else
+          std::fill(lanes.query, lanes.query + detail::kLanes, parameters.isoValue);
+      };
+      return detail::sweepPoints(tiles, points, normals, count, execution, mark,
+        [&](PointLanes& lanes)
+        {
+          double occlusion[detail::kLanes];
+          batchOcclusion(prepared, levels, lanes, parameters, query, occlusion);
+          for (int k = 0; k < lanes.used; ++k)
+          {
+            out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
+          }
+        });
     });
-  });
   return finished ? Status::success() : Status::cancelled();
 }
 
 template <class P>
-Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles, const P* points, const P* normals,
-  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
+Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles,
+  const P* points, const P* normals, std::int64_t count,
+  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
   float* out, const Execution& execution)
 {
   int levels = 0;
-  Status status =
-    detail::checkQuery(pyramid, parameters, points, normals, count, out, levels, tiles ? tiles->count() : 0);
+  Status status = detail::checkQuery(
+    pyramid, parameters, points, normals, count, out, levels, tiles ? tiles->count() : 0);
   if (status.ok)
     status = checkFinitePoint(lightDirection, "the light direction");
   if (!status.ok)
@@ -277,8 +297,8 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
   {
     return Status::failure("the light direction must not be zero");
   }
-  const std::array<double, 3> light = { lightDirection[0] / lightLength, lightDirection[1] / lightLength,
-    lightDirection[2] / lightLength };
+  const std::array<double, 3> light = { lightDirection[0] / lightLength,
+    lightDirection[1] / lightLength, lightDirection[2] / lightLength };
   const MomentLevel& base = pyramid[0];
   const double h = std::min(base.spacing[0], std::min(base.spacing[1], base.spacing[2]));
   const MarchBounds bounds(base);
@@ -288,7 +308,8 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
   PreparedPyramid prepared(pyramid, levels, tiles);
   const std::vector<detail::MarchStep> schedule =
     detail::marchSchedule(prepared.kernelRadius.data(), levels, 2.0 * bounds.diagonal());
-  const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t) {
+  const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t)
+  {
     for (int k = 0; k < lanes.used; ++k)
     {
       const std::array<double, 3> inside = lanes.along(k, -0.5 * h);
@@ -297,7 +318,8 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
       for (const detail::MarchStep& step : schedule)
       {
         const double s = step.t;
-        const double at[3] = { start[0] + s * light[0], start[1] + s * light[1], start[2] + s * light[2] };
+        const double at[3] = { start[0] + s * light[0], start[1] + s * light[1],
+          start[2] + s * light[2] };
         if (!t.at(step.level) || !bounds.contains(at))
           break;
         t.at(step.level)->markAround(at[0], at[1], at[2]);
@@ -306,23 +328,25 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
   };
   prepared.boundCells(count);
   prepared.boundRays(light);
-  const bool finished = detail::sweepPoints(tiles, points, normals, count, execution, mark, [&](PointLanes& lanes) {
-    if (parameters.query == SurfaceQuery::HalfVoxelInside)
+  const bool finished = detail::sweepPoints(tiles, points, normals, count, execution, mark,
+    [&](PointLanes& lanes)
     {
-      // No raw volume here: level 0's (blurred) mean half a voxel inside.
-      double x[detail::kLanes], y[detail::kLanes], z[detail::kLanes];
-      lanes.along(-0.5 * h, x, y, z);
-      detail::meanLanes(prepared.grids[0], x, y, z, lanes.query);
-    }
-    else
-      std::fill(lanes.query, lanes.query + detail::kLanes, parameters.isoValue);
-    double occlusion[detail::kLanes];
-    batchMarch(prepared, bounds, schedule, lanes, light, parameters.estimator, occlusion);
-    for (int k = 0; k < lanes.used; ++k)
-    {
-      out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
-    }
-  });
+      if (parameters.query == SurfaceQuery::HalfVoxelInside)
+      {
+        // No raw volume here: level 0's (blurred) mean half a voxel inside.
+        double x[detail::kLanes], y[detail::kLanes], z[detail::kLanes];
+        lanes.along(-0.5 * h, x, y, z);
+        detail::meanLanes(prepared.grids[0], x, y, z, lanes.query);
+      }
+      else
+        std::fill(lanes.query, lanes.query + detail::kLanes, parameters.isoValue);
+      double occlusion[detail::kLanes];
+      batchMarch(prepared, bounds, schedule, lanes, light, parameters.estimator, occlusion);
+      for (int k = 0; k < lanes.used; ++k)
+      {
+        out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
+      }
+    });
   return finished ? Status::success() : Status::cancelled();
 }
 
@@ -331,87 +355,101 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
 const char* const kQueryBuffers = "the surface query's buffers (tiles, cell and ray bounds)";
 
 template <class P>
-Status guardedOcclusion(const std::vector<MomentLevel>& levels, detail::PyramidTiles* tiles, const VolumeView& volume,
-  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const P* points, const P* normals,
-  std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
+Status guardedOcclusion(const std::vector<MomentLevel>& levels, detail::PyramidTiles* tiles,
+  const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const P* points, const P* normals, std::int64_t count,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
-  return catchOutOfMemory(kQueryBuffers, [&] {
-    return occlusionOf(levels, tiles, volume, origin, spacing, points, normals, count, parameters, out, execution);
-  });
+  return catchOutOfMemory(kQueryBuffers,
+    [&]
+    {
+      return occlusionOf(
+        levels, tiles, volume, origin, spacing, points, normals, count, parameters, out, execution);
+    });
 }
 
 template <class P>
-Status guardedShadow(const std::vector<MomentLevel>& levels, detail::PyramidTiles* tiles, const P* points,
-  const P* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
-  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
+Status guardedShadow(const std::vector<MomentLevel>& levels, detail::PyramidTiles* tiles,
+  const P* points, const P* normals, std::int64_t count,
+  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution)
 {
-  return catchOutOfMemory(kQueryBuffers, [&] {
-    return shadowOf(levels, tiles, points, normals, count, lightDirection, parameters, out, execution);
-  });
+  return catchOutOfMemory(kQueryBuffers,
+    [&]
+    {
+      return shadowOf(
+        levels, tiles, points, normals, count, lightDirection, parameters, out, execution);
+    });
 }
 
 } // namespace
 
 Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
   const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const double* points,
-  const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution)
+  const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution)
 {
-  return guardedOcclusion(pyramid, nullptr, volume, origin, spacing, points, normals, count, parameters, out, execution);
+  return guardedOcclusion(
+    pyramid, nullptr, volume, origin, spacing, points, normals, count, parameters, out, execution);
 }
 
 Status surfaceAmbientOcclusion(const std::vector<MomentLevel>& pyramid, const VolumeView& volume,
   const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const float* points,
-  const float* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution)
-{
-  return guardedOcclusion(pyramid, nullptr, volume, origin, spacing, points, normals, count, parameters, out, execution);
-}
-
-Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* points, const double* normals,
-  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
+  const float* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters,
   float* out, const Execution& execution)
 {
-  return guardedShadow(pyramid, nullptr, points, normals, count, lightDirection, parameters, out, execution);
+  return guardedOcclusion(
+    pyramid, nullptr, volume, origin, spacing, points, normals, count, parameters, out, execution);
 }
 
-Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const float* points, const float* normals,
-  std::int64_t count, const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
+Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const double* points,
+  const double* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
+{
+  return guardedShadow(
+    pyramid, nullptr, points, normals, count, lightDirection, parameters, out, execution);
+}
+
+Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const float* points,
+  const float* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
+{
+  return guardedShadow(
+    pyramid, nullptr, points, normals, count, lightDirection, parameters, out, execution);
+}
+
+Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const double* points,
+  const double* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters,
   float* out, const Execution& execution)
 {
-  return guardedShadow(pyramid, nullptr, points, normals, count, lightDirection, parameters, out, execution);
+  return guardedOcclusion(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), volume,
+    origin, spacing, points, normals, count, parameters, out, execution);
 }
 
-Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const double* points, const double* normals, std::int64_t count,
+Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const float* points,
+  const float* normals, std::int64_t count, const SurfaceOcclusionParameters& parameters,
+  float* out, const Execution& execution)
+{
+  return guardedOcclusion(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), volume,
+    origin, spacing, points, normals, count, parameters, out, execution);
+}
+
+Status surfaceShadow(SurfacePyramid& pyramid, const double* points, const double* normals,
+  std::int64_t count, const std::array<double, 3>& lightDirection,
   const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
-  return guardedOcclusion(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), volume, origin, spacing,
-    points, normals, count, parameters, out, execution);
+  return guardedShadow(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), points,
+    normals, count, lightDirection, parameters, out, execution);
 }
 
-Status surfaceAmbientOcclusion(SurfacePyramid& pyramid, const VolumeView& volume, const std::array<double, 3>& origin,
-  const std::array<double, 3>& spacing, const float* points, const float* normals, std::int64_t count,
+Status surfaceShadow(SurfacePyramid& pyramid, const float* points, const float* normals,
+  std::int64_t count, const std::array<double, 3>& lightDirection,
   const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
-  return guardedOcclusion(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), volume, origin, spacing,
-    points, normals, count, parameters, out, execution);
-}
-
-Status surfaceShadow(SurfacePyramid& pyramid, const double* points, const double* normals, std::int64_t count,
-  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution)
-{
-  return guardedShadow(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), points, normals, count,
-    lightDirection, parameters, out, execution);
-}
-
-Status surfaceShadow(SurfacePyramid& pyramid, const float* points, const float* normals, std::int64_t count,
-  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters, float* out,
-  const Execution& execution)
-{
-  return guardedShadow(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), points, normals, count,
-    lightDirection, parameters, out, execution);
+  return guardedShadow(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), points,
+    normals, count, lightDirection, parameters, out, execution);
 }
 
 } // namespace vao

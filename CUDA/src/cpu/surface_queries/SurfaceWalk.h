@@ -3,8 +3,8 @@
 // one layer of level 0's tiles each: a slab marks the tiles its samples reach, gives back
 // the tiles out of use that the sweep has left behind while more than the pyramid's
 // keptBytes are built, builds the new ones and samples. The tiles held at once are then
-// those near one slab plus what the pyramid keeps, instead of all that the surface reaches (on the bone
-// surface of a CT head, 73% of the int16 input). Each point's result depends on its own
+// those near one slab plus what the pyramid keeps, instead of all that the surface reaches (on the
+// bone surface of a CT head, 73% of the int16 input). Each point's result depends on its own
 // samples only, so the order changes no bit.
 #pragma once
 
@@ -41,7 +41,8 @@ SlabOrder slabOrder(const LevelTiles& level, const P* points, std::int64_t count
   slabs.order.resize(static_cast<std::size_t>(count));
   std::vector<std::int64_t> next(slabs.begin.begin(), slabs.begin.end() - 1);
   for (std::int64_t i = 0; i < count; ++i)
-    slabs.order[next[level.layerOf(static_cast<double>(points[3 * i + 2]))]++] = static_cast<std::uint32_t>(i);
+    slabs.order[next[level.layerOf(static_cast<double>(points[3 * i + 2]))]++] =
+      static_cast<std::uint32_t>(i);
   return slabs;
 }
 

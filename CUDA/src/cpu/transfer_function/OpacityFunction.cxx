@@ -33,7 +33,8 @@ double segmentPosition(const OpacityFunction& f, double x, double x1, double x2)
 double segmentOpacity(const OpacityNode& a, const OpacityNode& b, double scale)
 {
   const double midpoint = std::min(std::max(a.midpoint, kMidpointMargin), 1.0 - kMidpointMargin);
-  scale = scale < midpoint ? 0.5 * scale / midpoint : 0.5 + 0.5 * (scale - midpoint) / (1.0 - midpoint);
+  scale =
+    scale < midpoint ? 0.5 * scale / midpoint : 0.5 + 0.5 * (scale - midpoint) / (1.0 - midpoint);
   const double sharpness = a.sharpness;
   if (sharpness < 0.01)
   {

@@ -60,7 +60,8 @@ bool writeOpacities(const VolumeView& view, const OpacityFunction& function, flo
   const std::int64_t ny = view.dims[1];
   const int threads = resolveThreadCount(execution.threads);
   return parallelFor(view.dims[2], threads, threads, execution,
-    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress) {
+    [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
+    {
       bool nan = false;
       for (std::int64_t z = begin; z < end; ++z)
       {
@@ -72,7 +73,8 @@ bool writeOpacities(const VolumeView& view, const OpacityFunction& function, flo
           {
             const T v = in[x * volume.stride];
             if constexpr (tabulated)
-              out[x] = table[static_cast<std::size_t>(std::int64_t(v) - std::numeric_limits<T>::min())];
+              out[x] =
+                table[static_cast<std::size_t>(std::int64_t(v) - std::numeric_limits<T>::min())];
             else
               out[x] = fixedOpacity(function, static_cast<double>(v));
             nan = nan || std::isnan(out[x]);
@@ -97,21 +99,24 @@ bool writeOpenness(const VolumeView& alphaView, const Region& region, const Radi
   const MomentScale exact{ 0.0, 0.0 }; // no shift: the sums stay integers
   const std::int64_t nx = region.size[0];
   const std::int64_t ny = region.size[1];
-  return streamMoments<float, double>(alpha, geometry, exact, false, execution, [&] {
-    return [&](const MomentSlice<float, double>& slice) {
-      float* out = openness + (slice.z - region.begin[2]) * nx * ny;
-      for (std::int64_t y = 0; y < ny; ++y)
+  return streamMoments<float, double>(alpha, geometry, exact, false, execution,
+    [&]
+    {
+      return [&](const MomentSlice<float, double>& slice)
       {
-        const double rowCount = static_cast<double>(countY[y] * slice.countZ) * kOpacityUnit;
-        const double* sums = slice.sum + y * nx;
-        for (std::int64_t x = 0; x < nx; ++x)
+        float* out = openness + (slice.z - region.begin[2]) * nx * ny;
+        for (std::int64_t y = 0; y < ny; ++y)
         {
-          const double total = rowCount * static_cast<double>(countX[x]);
-          out[y * nx + x] = static_cast<float>((total - sums[x]) / total);
+          const double rowCount = static_cast<double>(countY[y] * slice.countZ) * kOpacityUnit;
+          const double* sums = slice.sum + y * nx;
+          for (std::int64_t x = 0; x < nx; ++x)
+          {
+            const double total = rowCount * static_cast<double>(countX[x]);
+            out[y * nx + x] = static_cast<float>((total - sums[x]) / total);
+          }
         }
-      }
-    };
-  });
+      };
+    });
 }
 
 } // namespace
@@ -123,15 +128,18 @@ Status computeTransferFunctionOpenness(const VolumeView& volume, const Region& r
   StorageArray<float> alpha;
   alpha.resize(static_cast<std::size_t>(volume.voxelCount()));
   std::atomic<bool> undefined{ false };
-  const bool written = dispatchScalarType(volume.type, [&](auto tag) {
-    return writeOpacities<decltype(tag)>(
-      volume, function, alpha.data(), undefined, stageExecution(execution, 0.0, 0.3));
-  });
+  const bool written = dispatchScalarType(volume.type,
+    [&](auto tag)
+    {
+      return writeOpacities<decltype(tag)>(
+        volume, function, alpha.data(), undefined, stageExecution(execution, 0.0, 0.3));
+    });
   if (!written)
     return Status::cancelled();
   if (undefined.load())
-    return Status::failure("the opacity function is undefined at some of the values: its log scale needs "
-                           "values and points above 0");
+    return Status::failure(
+      "the opacity function is undefined at some of the values: its log scale needs "
+      "values and points above 0");
   VolumeView alphaView;
   alphaView.data = alpha.data();
   alphaView.type = ScalarType::Float32;

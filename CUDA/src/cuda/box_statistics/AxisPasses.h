@@ -34,7 +34,10 @@ struct LaneLayout
   Index outerStride; // elements between consecutive outer lanes
   Index step;        // elements between consecutive voxels along the axis
 
-  VAO_HD Index at(Index lane, Index i) const { return (lane / inner) * outerStride + lane % inner + i * step; }
+  VAO_HD Index at(Index lane, Index i) const
+  {
+    return (lane / inner) * outerStride + lane % inner + i * step;
+  }
 };
 
 /// One sliding-window pass along an axis: n input voxels per lane, outCount outputs for

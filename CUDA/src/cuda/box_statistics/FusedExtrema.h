@@ -35,7 +35,10 @@ struct FusedExtrema
   {
     Index width, height, depth; // the tile with its halo; deque slots per column
     VAO_HD Index values() const { return width * height; }
-    VAO_HD Index tValues() const { return 3 * values() + 4 * height * kTileX + 2 * kTileColumns + 2 * depth * kTileColumns; }
+    VAO_HD Index tValues() const
+    {
+      return 3 * values() + 4 * height * kTileX + 2 * kTileColumns + 2 * depth * kTileColumns;
+    }
     VAO_HD Index ints() const { return 2 * depth * kTileColumns + 4 * kTileColumns; }
   };
 
@@ -52,7 +55,8 @@ struct FusedExtrema
   /// The arrays, carved from `shared` (16-byte aligned).
   struct Arrays
   {
-    T *value, *rowSufMin, *rowSufMax, *rowMin, *rowMax, *colSufMin, *colSufMax, *xyMin, *xyMax, *dqMin, *dqMax;
+    T *value, *rowSufMin, *rowSufMax, *rowMin, *rowMax, *colSufMin, *colSufMax, *xyMin, *xyMax,
+      *dqMin, *dqMax;
     int *dqMinSlice, *dqMaxSlice, *minHead, *minCount, *maxHead, *maxCount;
   };
   VAO_HD static Arrays arrays(const RegionGeometry& g, unsigned char* shared)
@@ -71,7 +75,8 @@ struct FusedExtrema
     a.xyMax = a.xyMin + kTileColumns;
     a.dqMin = a.xyMax + kTileColumns;
     a.dqMax = a.dqMin + l.depth * kTileColumns;
-    int* n = reinterpret_cast<int*>(shared + (l.tValues() * static_cast<Index>(sizeof(T)) + 15) / 16 * 16);
+    int* n =
+      reinterpret_cast<int*>(shared + (l.tValues() * static_cast<Index>(sizeof(T)) + 15) / 16 * 16);
     a.dqMinSlice = n;
     a.dqMaxSlice = n + l.depth * kTileColumns;
     a.minHead = a.dqMaxSlice + l.depth * kTileColumns;
@@ -84,15 +89,17 @@ struct FusedExtrema
   /// Window minima of inMin and maxima of inMax for `count` outputs, window k = 2 r + 1,
   /// over count + k - 1 inputs at stride `step`: van Herk with the blocks' suffixes in
   /// suf*, a running prefix.
-  VAO_HD static void windows(const T* inMin, const T* inMax, Index step, Index count, Index k, T* sufMin, T* sufMax,
-    T* outMin, T* outMax, Index outStep)
+  VAO_HD static void windows(const T* inMin, const T* inMax, Index step, Index count, Index k,
+    T* sufMin, T* sufMax, T* outMin, T* outMax, Index outStep)
   {
     const Index n = count + k - 1;
     for (Index p = n - 1; p >= 0; --p)
     {
       const bool blockEnd = p == n - 1 || (p + 1) % k == 0;
-      sufMin[p * step] = blockEnd ? inMin[p * step] : lower(inMin[p * step], sufMin[(p + 1) * step]);
-      sufMax[p * step] = blockEnd ? inMax[p * step] : greater(inMax[p * step], sufMax[(p + 1) * step]);
+      sufMin[p * step] =
+        blockEnd ? inMin[p * step] : lower(inMin[p * step], sufMin[(p + 1) * step]);
+      sufMax[p * step] =
+        blockEnd ? inMax[p * step] : greater(inMax[p * step], sufMax[(p + 1) * step]);
     }
     T preMin = inMin[0], preMax = inMax[0];
     for (Index p = 0; p < n; ++p)
@@ -112,63 +119,72 @@ struct FusedExtrema
   VAO_HD void reset(const Block& block, const RegionGeometry& g, unsigned char* shared) const
   {
     const Arrays a = arrays(g, shared);
-    block.each(kTileColumns, [&](Index c) {
-      a.minHead[c] = a.minCount[c] = a.maxHead[c] = a.maxCount[c] = 0;
-    });
+    block.each(kTileColumns,
+      [&](Index c) { a.minHead[c] = a.minCount[c] = a.maxHead[c] = a.maxCount[c] = 0; });
   }
 
   /// Item i of the tile with its halo at block (bx, by) of slice j, into the loaded
   /// values (in the sums' load phase). Outside the block no voxel exists: the edge value
   /// stands in, which no window of a region voxel changes (its clipped window holds that
   /// voxel already).
-  VAO_HD void load(const RegionGeometry& g, unsigned char* shared, Index i, Index bx, Index by, Index j) const
+  VAO_HD void load(
+    const RegionGeometry& g, unsigned char* shared, Index i, Index bx, Index by, Index j) const
   {
-    const Index x = lower(greater(bx, Index(0)), g.sx - 1), y = lower(greater(by, Index(0)), g.sy - 1);
+    const Index x = lower(greater(bx, Index(0)), g.sx - 1),
+                y = lower(greater(by, Index(0)), g.sy - 1);
     arrays(g, shared).value[i] = input[(j * g.sy + y) * g.sx + x];
   }
 
   /// Slice j, loaded, enters the columns' windows.
   template <class Block>
-  VAO_HD void enter(const Block& block, const RegionGeometry& g, unsigned char* shared, Index j) const
+  VAO_HD void enter(
+    const Block& block, const RegionGeometry& g, unsigned char* shared, Index j) const
   {
     const Layout l = layout(g);
     const Arrays a = arrays(g, shared);
     const Index rx = g.radius[0], ry = g.radius[1];
-    block.each(l.height, [&](Index row) {
-      const T* values = a.value + row * l.width;
-      windows(values, values, 1, kTileX, 2 * rx + 1, a.rowSufMin + row * l.width, a.rowSufMax + row * l.width,
-        a.rowMin + row * kTileX, a.rowMax + row * kTileX, 1);
-    });
-    block.each(kTileX, [&](Index c) {
-      windows(a.rowMin + c, a.rowMax + c, kTileX, kTileY, 2 * ry + 1, a.colSufMin + c, a.colSufMax + c, a.xyMin + c,
-        a.xyMax + c, kTileX);
-    });
-    block.each(kTileColumns, [&](Index c) {
-      push(a.dqMin + c * l.depth, a.dqMinSlice + c * l.depth, a.minHead[c], a.minCount[c], l.depth, j, a.xyMin[c],
-        true);
-      push(a.dqMax + c * l.depth, a.dqMaxSlice + c * l.depth, a.maxHead[c], a.maxCount[c], l.depth, j, a.xyMax[c],
-        false);
-    });
+    block.each(l.height,
+      [&](Index row)
+      {
+        const T* values = a.value + row * l.width;
+        windows(values, values, 1, kTileX, 2 * rx + 1, a.rowSufMin + row * l.width,
+          a.rowSufMax + row * l.width, a.rowMin + row * kTileX, a.rowMax + row * kTileX, 1);
+      });
+    block.each(kTileX,
+      [&](Index c)
+      {
+        windows(a.rowMin + c, a.rowMax + c, kTileX, kTileY, 2 * ry + 1, a.colSufMin + c,
+          a.colSufMax + c, a.xyMin + c, a.xyMax + c, kTileX);
+      });
+    block.each(kTileColumns,
+      [&](Index c)
+      {
+        push(a.dqMin + c * l.depth, a.dqMinSlice + c * l.depth, a.minHead[c], a.minCount[c],
+          l.depth, j, a.xyMin[c], true);
+        push(a.dqMax + c * l.depth, a.dqMaxSlice + c * l.depth, a.maxHead[c], a.maxCount[c],
+          l.depth, j, a.xyMax[c], false);
+      });
   }
 
   /// Column c's extrema over block slices [z - rz, z + rz] (all entered): the deques'
   /// fronts once the slices before the window are gone.
-  VAO_HD void window(const RegionGeometry& g, unsigned char* shared, Index c, Index z, double& minimum,
-    double& maximum) const
+  VAO_HD void window(const RegionGeometry& g, unsigned char* shared, Index c, Index z,
+    double& minimum, double& maximum) const
   {
     const Layout l = layout(g);
     const Arrays a = arrays(g, shared);
     const Index first = z - g.radius[2];
-    minimum = static_cast<double>(front(a.dqMin + c * l.depth, a.dqMinSlice + c * l.depth, a.minHead[c],
-      a.minCount[c], l.depth, first));
-    maximum = static_cast<double>(front(a.dqMax + c * l.depth, a.dqMaxSlice + c * l.depth, a.maxHead[c],
-      a.maxCount[c], l.depth, first));
+    minimum = static_cast<double>(front(a.dqMin + c * l.depth, a.dqMinSlice + c * l.depth,
+      a.minHead[c], a.minCount[c], l.depth, first));
+    maximum = static_cast<double>(front(a.dqMax + c * l.depth, a.dqMaxSlice + c * l.depth,
+      a.maxHead[c], a.maxCount[c], l.depth, first));
   }
 
 private:
   /// Pushes (slice, v) at the back, dropping the entries it makes useless (not below it
   /// for the minimum, not above it for the maximum).
-  VAO_HD static void push(T* value, int* slice, int& head, int& count, Index depth, Index j, T v, bool isMin)
+  VAO_HD static void push(
+    T* value, int* slice, int& head, int& count, Index depth, Index j, T v, bool isMin)
   {
     while (count > 0)
     {
@@ -181,7 +197,8 @@ private:
     slice[(head + count) % depth] = static_cast<int>(j);
     ++count;
   }
-  VAO_HD static T front(const T* value, const int* slice, int& head, int& count, Index depth, Index first)
+  VAO_HD static T front(
+    const T* value, const int* slice, int& head, int& count, Index depth, Index first)
   {
     while (slice[head] < first)
     {

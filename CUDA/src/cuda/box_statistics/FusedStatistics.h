@@ -69,8 +69,8 @@ struct SumArrays
 /// `step`, outputs at stride `outStep`, a running window moved by one addition and one
 /// subtraction per output.
 template <class Acc>
-VAO_HD void windowSums(const Acc* in1, const Acc* in2, Index step, Index count, Index k, Acc* out1, Acc* out2,
-  Index outStep)
+VAO_HD void windowSums(const Acc* in1, const Acc* in2, Index step, Index count, Index k, Acc* out1,
+  Acc* out2, Index outStep)
 {
   Acc s1 = 0, s2 = 0;
   for (Index i = 0; i < k; ++i)
@@ -116,7 +116,10 @@ struct FusedBoxSums
 
   VAO_HD Index tilesX() const { return (g.rx + kTileX - 1) / kTileX; }
   VAO_HD Index tilesY() const { return (g.ry + kTileY - 1) / kTileY; }
-  VAO_HD Index blocks() const { return tilesX() * tilesY() * segmentsOf(sliceEnd - sliceBegin, segment); }
+  VAO_HD Index blocks() const
+  {
+    return tilesX() * tilesY() * segmentsOf(sliceEnd - sliceBegin, segment);
+  }
   /// The sums' accumulators, then (16-byte aligned) the extrema's arrays.
   VAO_HD Index sumBytes() const { return fusedSumBytes<Acc>(g); }
   VAO_HD Index sharedBytes() const { return sumBytes() + extrema.bytes(g); }
@@ -132,10 +135,12 @@ struct FusedBoxSums
     const Index rz = g.radius[2];
 
     unsigned char* extremaShared = reinterpret_cast<unsigned char*>(shared) + sumBytes();
-    block.each(kTileColumns, [&](Index c) {
-      a.z1[c] = 0;
-      a.z2[c] = 0;
-    });
+    block.each(kTileColumns,
+      [&](Index c)
+      {
+        a.z1[c] = 0;
+        a.z2[c] = 0;
+      });
     if constexpr (Extrema::kEnabled)
       extrema.reset(block, g, extremaShared);
     const Index lo = greater(Index(0), g.oz + first - rz), hi = lower(g.sz - 1, g.oz + first + rz);
@@ -146,18 +151,20 @@ struct FusedBoxSums
     for (Index k = first; k < last; ++k)
     {
       const Index z = g.oz + k;
-      block.each(kTileColumns, [&](Index c) {
-        const Index x = x0 + c % kTileX, y = y0 + c / kTileX;
-        if constexpr (Extrema::kEnabled)
+      block.each(kTileColumns,
+        [&](Index c)
         {
-          double minimum, maximum; // every column's deques move on, inside the region or not
-          extrema.window(g, extremaShared, c, z, minimum, maximum);
-          if (x < g.rx && y < g.ry)
-            sink.write((k * g.ry + y) * g.rx + x, z, x, y, a.z1[c], a.z2[c], minimum, maximum);
-        }
-        else if (x < g.rx && y < g.ry)
-          sink.write((k * g.ry + y) * g.rx + x, z, x, y, a.z1[c], a.z2[c]);
-      });
+          const Index x = x0 + c % kTileX, y = y0 + c / kTileX;
+          if constexpr (Extrema::kEnabled)
+          {
+            double minimum, maximum; // every column's deques move on, inside the region or not
+            extrema.window(g, extremaShared, c, z, minimum, maximum);
+            if (x < g.rx && y < g.ry)
+              sink.write((k * g.ry + y) * g.rx + x, z, x, y, a.z1[c], a.z2[c], minimum, maximum);
+          }
+          else if (x < g.rx && y < g.ry)
+            sink.write((k * g.ry + y) * g.rx + x, z, x, y, a.z1[c], a.z2[c]);
+        });
       if (k + 1 == last)
         break;
       if (z + rz + 1 <= g.sz - 1)
@@ -178,32 +185,39 @@ struct FusedBoxSums
     // The tile and its halo; zero outside the block, which holds every voxel of the
     // volume a window of the region reaches. The extrema's copy of an entering slice is
     // loaded in the same phase.
-    block.each(layout.loaded(), [&](Index i) {
-      const Index bx = g.ox + x0 - rx + i % layout.width, by = g.oy + y0 - ry + i / layout.width;
-      Acc m1 = 0, m2 = 0;
-      if (bx >= 0 && bx < g.sx && by >= 0 && by < g.sy)
-        source.load((j * g.sy + by) * g.sx + bx, m1, m2);
-      a.v1[i] = m1;
-      a.v2[i] = m2;
-      if constexpr (Extrema::kEnabled)
+    block.each(layout.loaded(),
+      [&](Index i)
       {
-        if (add)
-          extrema.load(g, extremaShared, i, bx, by, j);
-      }
-    });
+        const Index bx = g.ox + x0 - rx + i % layout.width, by = g.oy + y0 - ry + i / layout.width;
+        Acc m1 = 0, m2 = 0;
+        if (bx >= 0 && bx < g.sx && by >= 0 && by < g.sy)
+          source.load((j * g.sy + by) * g.sx + bx, m1, m2);
+        a.v1[i] = m1;
+        a.v2[i] = m2;
+        if constexpr (Extrema::kEnabled)
+        {
+          if (add)
+            extrema.load(g, extremaShared, i, bx, by, j);
+        }
+      });
     // Each loaded row's sums over the x windows of the tile's columns.
-    block.each(layout.height, [&](Index row) {
-      windowSums(a.v1 + row * layout.width, a.v2 + row * layout.width, 1, kTileX, 2 * rx + 1, a.r1 + row * kTileX,
-        a.r2 + row * kTileX, 1);
-    });
+    block.each(layout.height,
+      [&](Index row)
+      {
+        windowSums(a.v1 + row * layout.width, a.v2 + row * layout.width, 1, kTileX, 2 * rx + 1,
+          a.r1 + row * kTileX, a.r2 + row * kTileX, 1);
+      });
     // Each column's sums of those over the y windows.
-    block.each(kTileX, [&](Index c) {
-      windowSums(a.r1 + c, a.r2 + c, kTileX, kTileY, 2 * ry + 1, a.xy1 + c, a.xy2 + c, kTileX);
-    });
-    block.each(kTileColumns, [&](Index c) {
-      a.z1[c] = add ? a.z1[c] + a.xy1[c] : a.z1[c] - a.xy1[c];
-      a.z2[c] = add ? a.z2[c] + a.xy2[c] : a.z2[c] - a.xy2[c];
-    });
+    block.each(kTileX,
+      [&](Index c) {
+        windowSums(a.r1 + c, a.r2 + c, kTileX, kTileY, 2 * ry + 1, a.xy1 + c, a.xy2 + c, kTileX);
+      });
+    block.each(kTileColumns,
+      [&](Index c)
+      {
+        a.z1[c] = add ? a.z1[c] + a.xy1[c] : a.z1[c] - a.xy1[c];
+        a.z2[c] = add ? a.z2[c] + a.xy2[c] : a.z2[c] - a.xy2[c];
+      });
     if constexpr (Extrema::kEnabled)
     {
       if (add) // a leaving slice leaves the deques by itself
@@ -216,20 +230,23 @@ struct FusedBoxSums
 /// block, the estimator's writer; with the extrema (CDF Reconstruction, the statistics'
 /// minimum and maximum) or without.
 template <class T, class Acc, class Extrema = NoExtrema>
-using FusedStatisticsKernel = FusedBoxSums<MomentSource<T, Acc, true>, StatisticsWriter<T, Acc>, Acc, Extrema>;
+using FusedStatisticsKernel =
+  FusedBoxSums<MomentSource<T, Acc, true>, StatisticsWriter<T, Acc>, Acc, Extrema>;
 
 template <class T, class Acc>
 FusedStatisticsKernel<T, Acc> fusedStatistics(
   const StatisticsWriter<T, Acc>& writer, Index sliceBegin, Index sliceEnd, Index segment)
 {
-  return { { writer.input, nullptr, writer.shift }, writer, writer.g, sliceBegin, sliceEnd, segment, {} };
+  return { { writer.input, nullptr, writer.shift }, writer, writer.g, sliceBegin, sliceEnd, segment,
+    {} };
 }
 
 template <class T, class Acc>
 FusedStatisticsKernel<T, Acc, FusedExtrema<T>> fusedStatisticsWithExtrema(
   const StatisticsWriter<T, Acc>& writer, Index sliceBegin, Index sliceEnd, Index segment)
 {
-  return { { writer.input, nullptr, writer.shift }, writer, writer.g, sliceBegin, sliceEnd, segment, { writer.input } };
+  return { { writer.input, nullptr, writer.shift }, writer, writer.g, sliceBegin, sliceEnd, segment,
+    { writer.input } };
 }
 
 /// Whether the fused pass fits a block's shared memory (`sharedLimit` bytes) for sums in
@@ -237,7 +254,8 @@ FusedStatisticsKernel<T, Acc, FusedExtrema<T>> fusedStatisticsWithExtrema(
 template <class Acc, class T>
 bool fusedPassFits(const RegionGeometry& g, bool withExtrema, Index sharedLimit)
 {
-  return fusedSumBytes<Acc>(g) + (withExtrema ? FusedExtrema<T>{ nullptr }.bytes(g) : 0) <= sharedLimit;
+  return fusedSumBytes<Acc>(g) + (withExtrema ? FusedExtrema<T>{ nullptr }.bytes(g) : 0) <=
+    sharedLimit;
 }
 
 } // namespace gpu

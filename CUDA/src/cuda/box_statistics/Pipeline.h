@@ -61,8 +61,9 @@ inline RegionGeometry geometryFor(const Index3& dims, const Region& region, cons
     lo[a] = std::max<Index>(0, region.begin[a] - r[a]);
     size[a] = std::min<Index>(dims[a], region.begin[a] + region.size[a] + r[a]) - lo[a];
   }
-  return RegionGeometry{ size[0], size[1], size[2], region.begin[0] - lo[0], region.begin[1] - lo[1],
-    region.begin[2] - lo[2], region.size[0], region.size[1], region.size[2], { r[0], r[1], r[2] } };
+  return RegionGeometry{ size[0], size[1], size[2], region.begin[0] - lo[0],
+    region.begin[1] - lo[1], region.begin[2] - lo[2], region.size[0], region.size[1],
+    region.size[2], { r[0], r[1], r[2] } };
 }
 
 /// What to compute: the estimator and its query (ignored for the statistics).
@@ -79,8 +80,8 @@ struct EstimatorSetting
 /// one (x, y) column of the region and a segment of its slices; visit(index, z, x, y, s1,
 /// s2) gets each voxel's box sums (index in the region, x fastest; z in the block).
 template <class Acc, class Visit>
-VAO_HD void zRunningSums(const Acc* sum1, const Acc* sum2, const RegionGeometry& g, Index segment, Index thread,
-  Visit&& visit)
+VAO_HD void zRunningSums(const Acc* sum1, const Acc* sum2, const RegionGeometry& g, Index segment,
+  Index thread, Visit&& visit)
 {
   const Index lanes = g.rx * g.ry;
   const Index lane = thread % lanes;
@@ -129,8 +130,8 @@ struct StatisticsWriter
   /// Voxel (x, y) of the region in block slice z: how many voxels its clipped box holds.
   VAO_HD long long count(Index x, Index y, Index z) const
   {
-    return clippedWindowCount(g.ox + x, g.radius[0], g.sx) * clippedWindowCount(g.oy + y, g.radius[1], g.sy) *
-      clippedWindowCount(z, g.radius[2], g.sz);
+    return clippedWindowCount(g.ox + x, g.radius[0], g.sx) *
+      clippedWindowCount(g.oy + y, g.radius[1], g.sy) * clippedWindowCount(z, g.radius[2], g.sz);
   }
 
   /// With the extrema from extremaMin/Max (the separate passes) or none.
@@ -140,7 +141,8 @@ struct StatisticsWriter
       extremaMax ? static_cast<double>(extremaMax[index]) : 0.0);
   }
 
-  VAO_HD void write(Index index, Index z, Index x, Index y, Acc s1, Acc s2, double minimum, double maximum) const
+  VAO_HD void write(
+    Index index, Index z, Index x, Index y, Acc s1, Acc s2, double minimum, double maximum) const
   {
     const long long n = this->count(x, y, z);
     NeighbourhoodStats s{ 0.0, 0.0, minimum, maximum, estimator.roundingVariance };
@@ -150,7 +152,8 @@ struct StatisticsWriter
       const double q = estimator.query == QueryMode::VoxelValue
         ? static_cast<double>(input[(z * g.sy + g.oy + y) * g.sx + g.ox + x])
         : estimator.isoValue;
-      out.openness[index] = static_cast<float>(opennessFromStats(estimator.method, q, s, estimator.erfMode));
+      out.openness[index] =
+        static_cast<float>(opennessFromStats(estimator.method, q, s, estimator.erfMode));
     }
     if (out.variance)
       out.variance[index] = static_cast<float>(reportedVariance(s.variance, s.roundingVariance));
@@ -170,7 +173,8 @@ struct StatisticsWriter
   double bytesPerVoxel() const
   {
     return (out.openness ? 4.0 : 0.0) + (out.variance ? 4.0 : 0.0) +
-      8.0 * ((out.count != nullptr) + (out.mean != nullptr) + (out.varianceD != nullptr) +
+      8.0 *
+      ((out.count != nullptr) + (out.mean != nullptr) + (out.varianceD != nullptr) +
         (out.minimum != nullptr) + (out.maximum != nullptr));
   }
 };
@@ -185,12 +189,16 @@ struct FinalKernel
   StatisticsWriter<T, Acc> writer;
   Index segment;
 
-  VAO_HD Index threads() const { return writer.g.rx * writer.g.ry * segmentsOf(writer.g.rz, segment); }
+  VAO_HD Index threads() const
+  {
+    return writer.g.rx * writer.g.ry * segmentsOf(writer.g.rz, segment);
+  }
 
   VAO_HD void operator()(Index thread) const
   {
     zRunningSums(sum1, sum2, writer.g, segment, thread,
-      [&](Index index, Index z, Index x, Index y, Acc s1, Acc s2) { writer.write(index, z, x, y, s1, s2); });
+      [&](Index index, Index z, Index x, Index y, Acc s1, Acc s2)
+      { writer.write(index, z, x, y, s1, s2); });
   }
 };
 
@@ -204,12 +212,12 @@ template <class T, class Acc, class Executor>
 void runPasses(Executor& ex, const T* input, const RegionGeometry& g, bool withExtrema, Acc shift,
   const EstimatorSetting& estimator, const FinalOutputs& out)
 {
-  const AxisPass xPass{ g.sy * g.sz, g.sx, g.radius[0], g.ox, g.rx, LaneLayout{ g.sy, g.sx * g.sy, g.sy },
-    LaneLayout{ g.sy, g.rx * g.sy, g.sy } };
-  const AxisPass yPass{ g.rx * g.sz, g.sy, g.radius[1], g.oy, g.ry, LaneLayout{ g.rx, g.sy * g.rx, g.rx },
-    LaneLayout{ g.rx, g.ry * g.rx, g.rx } };
-  const AxisPass zPass{ g.rx * g.ry, g.sz, g.radius[2], g.oz, g.rz, LaneLayout{ g.rx * g.ry, 0, g.rx * g.ry },
-    LaneLayout{ g.rx * g.ry, 0, g.rx * g.ry } };
+  const AxisPass xPass{ g.sy * g.sz, g.sx, g.radius[0], g.ox, g.rx,
+    LaneLayout{ g.sy, g.sx * g.sy, g.sy }, LaneLayout{ g.sy, g.rx * g.sy, g.sy } };
+  const AxisPass yPass{ g.rx * g.sz, g.sy, g.radius[1], g.oy, g.ry,
+    LaneLayout{ g.rx, g.sy * g.rx, g.rx }, LaneLayout{ g.rx, g.ry * g.rx, g.rx } };
+  const AxisPass zPass{ g.rx * g.ry, g.sz, g.radius[2], g.oz, g.rz,
+    LaneLayout{ g.rx * g.ry, 0, g.rx * g.ry }, LaneLayout{ g.rx * g.ry, 0, g.rx * g.ry } };
 
   // x passes run on the transposed block: lanes are (y, z), x is the axis.
   auto transposed = ex.template allocate<T>(g.block());
@@ -218,46 +226,55 @@ void runPasses(Executor& ex, const T* input, const RegionGeometry& g, bool withE
   // Moments along x and y; z in the final pass.
   auto a1 = ex.template allocate<Acc>(g.afterX()), a2 = ex.template allocate<Acc>(g.afterX());
   auto b1 = ex.template allocate<Acc>(g.afterX()), b2 = ex.template allocate<Acc>(g.afterX());
-  const MomentKernel<T, Acc, true> momentsX{ { transposed.get(), nullptr, shift }, a1.get(), a2.get(), xPass,
-    segmentLength(xPass.r) };
+  const MomentKernel<T, Acc, true> momentsX{ { transposed.get(), nullptr, shift }, a1.get(),
+    a2.get(), xPass, segmentLength(xPass.r) };
   ex.launch(momentsX, "moments x", g.block() * sizeof(T) + 2.0 * g.afterX() * sizeof(Acc));
   ex.transpose(a1.get(), b1.get(), g.sy, g.rx, g.sz, "transpose moments"); // -> [z][y][x]
   ex.transpose(a2.get(), b2.get(), g.sy, g.rx, g.sz, "transpose moments");
-  const MomentKernel<Acc, Acc, false> momentsY{ { b1.get(), b2.get(), Acc(0) }, a1.get(), a2.get(), yPass,
-    segmentLength(yPass.r) };
+  const MomentKernel<Acc, Acc, false> momentsY{ { b1.get(), b2.get(), Acc(0) }, a1.get(), a2.get(),
+    yPass, segmentLength(yPass.r) };
   ex.launch(momentsY, "moments y", 2.0 * (g.afterX() + g.afterY()) * sizeof(Acc));
   ex.progress(0.4);
 
   // Extrema (CDF Reconstruction, statistics): the same three axes with van Herk blocks.
   // x: transposed -> e (suffixes in f), transpose e -> f, y: f -> e, z: e -> f.
   const Index room = withExtrema ? (g.block() > g.afterX() ? g.block() : g.afterX()) : 0;
-  auto e1 = ex.template allocate<T>(withExtrema ? g.afterX() : 0), e2 = ex.template allocate<T>(withExtrema ? g.afterX() : 0);
+  auto e1 = ex.template allocate<T>(withExtrema ? g.afterX() : 0),
+       e2 = ex.template allocate<T>(withExtrema ? g.afterX() : 0);
   auto f1 = ex.template allocate<T>(room), f2 = ex.template allocate<T>(room);
-  auto s1 = ex.template allocate<T>(withExtrema ? g.afterX() : 0), s2 = ex.template allocate<T>(withExtrema ? g.afterX() : 0);
+  auto s1 = ex.template allocate<T>(withExtrema ? g.afterX() : 0),
+       s2 = ex.template allocate<T>(withExtrema ? g.afterX() : 0);
   if (withExtrema)
   {
-    ex.launch(VanHerkKernel<T, VanHerkStep::Suffix>{ transposed.get(), transposed.get(), f1.get(), f2.get(), nullptr, nullptr, xPass },
+    ex.launch(VanHerkKernel<T, VanHerkStep::Suffix>{ transposed.get(), transposed.get(), f1.get(),
+                f2.get(), nullptr, nullptr, xPass },
       "extrema x suffix", 3.0 * g.block() * sizeof(T));
-    ex.launch(VanHerkKernel<T, VanHerkStep::Output>{ transposed.get(), transposed.get(), f1.get(), f2.get(), e1.get(), e2.get(), xPass },
+    ex.launch(VanHerkKernel<T, VanHerkStep::Output>{ transposed.get(), transposed.get(), f1.get(),
+                f2.get(), e1.get(), e2.get(), xPass },
       "extrema x", 2.0 * g.block() * sizeof(T) + 2.0 * g.afterX() * sizeof(T));
     ex.transpose(e1.get(), f1.get(), g.sy, g.rx, g.sz, "transpose extrema");
     ex.transpose(e2.get(), f2.get(), g.sy, g.rx, g.sz, "transpose extrema");
-    ex.launch(VanHerkKernel<T, VanHerkStep::Suffix>{ f1.get(), f2.get(), s1.get(), s2.get(), nullptr, nullptr, yPass }, "extrema y suffix",
-      4.0 * g.afterX() * sizeof(T));
-    ex.launch(VanHerkKernel<T, VanHerkStep::Output>{ f1.get(), f2.get(), s1.get(), s2.get(), e1.get(), e2.get(), yPass },
+    ex.launch(VanHerkKernel<T, VanHerkStep::Suffix>{ f1.get(), f2.get(), s1.get(), s2.get(),
+                nullptr, nullptr, yPass },
+      "extrema y suffix", 4.0 * g.afterX() * sizeof(T));
+    ex.launch(VanHerkKernel<T, VanHerkStep::Output>{ f1.get(), f2.get(), s1.get(), s2.get(),
+                e1.get(), e2.get(), yPass },
       "extrema y", 4.0 * g.afterX() * sizeof(T) + 2.0 * g.afterY() * sizeof(T));
-    ex.launch(VanHerkKernel<T, VanHerkStep::Suffix>{ e1.get(), e2.get(), s1.get(), s2.get(), nullptr, nullptr, zPass }, "extrema z suffix",
-      4.0 * g.afterY() * sizeof(T));
-    ex.launch(VanHerkKernel<T, VanHerkStep::Output>{ e1.get(), e2.get(), s1.get(), s2.get(), f1.get(), f2.get(), zPass },
+    ex.launch(VanHerkKernel<T, VanHerkStep::Suffix>{ e1.get(), e2.get(), s1.get(), s2.get(),
+                nullptr, nullptr, zPass },
+      "extrema z suffix", 4.0 * g.afterY() * sizeof(T));
+    ex.launch(VanHerkKernel<T, VanHerkStep::Output>{ e1.get(), e2.get(), s1.get(), s2.get(),
+                f1.get(), f2.get(), zPass },
       "extrema z", 4.0 * g.afterY() * sizeof(T) + 2.0 * g.region() * sizeof(T));
   }
   ex.progress(0.6);
 
-  const StatisticsWriter<T, Acc> writer{ withExtrema ? f1.get() : nullptr, withExtrema ? f2.get() : nullptr, input, g,
-    shift, estimator, out };
+  const StatisticsWriter<T, Acc> writer{ withExtrema ? f1.get() : nullptr,
+    withExtrema ? f2.get() : nullptr, input, g, shift, estimator, out };
   const FinalKernel<T, Acc> final{ a1.get(), a2.get(), writer, segmentLength(g.radius[2]) };
   ex.launch(final, "z + estimator",
-    2.0 * g.afterY() * sizeof(Acc) + g.region() * (sizeof(T) * (withExtrema ? 3.0 : 1.0) + writer.bytesPerVoxel()));
+    2.0 * g.afterY() * sizeof(Acc) +
+      g.region() * (sizeof(T) * (withExtrema ? 3.0 : 1.0) + writer.bytesPerVoxel()));
   ex.progress(0.9);
 }
 

@@ -49,7 +49,11 @@ public:
     }
   }
   ~DeviceBuffer() { cudaFree(this->Data); }
-  DeviceBuffer(DeviceBuffer&& other) noexcept : Data(other.Data) { other.Data = nullptr; }
+  DeviceBuffer(DeviceBuffer&& other) noexcept
+    : Data(other.Data)
+  {
+    other.Data = nullptr;
+  }
   DeviceBuffer& operator=(DeviceBuffer&& other) noexcept
   {
     if (this != &other)

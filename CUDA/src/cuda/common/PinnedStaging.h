@@ -42,7 +42,8 @@ public:
       cudaFreeHost(this->Data);
       this->Data = nullptr;
       this->Size = 0;
-      check(cudaHostAlloc(reinterpret_cast<void**>(&this->Data), bytes, cudaHostAllocDefault), "pinned allocation");
+      check(cudaHostAlloc(reinterpret_cast<void**>(&this->Data), bytes, cudaHostAllocDefault),
+        "pinned allocation");
       this->Size = bytes;
     }
     return this->Data;
@@ -117,33 +118,38 @@ void parallelCopy(unsigned char* to, const unsigned char* from, Index bytes, int
 {
   constexpr Index kPiece = Index(1) << 20;
   const Index pieces = (bytes + kPiece - 1) / kPiece;
-  detail::parallelFor(pieces, static_cast<int>(pieces), threads, [&](std::int64_t begin, std::int64_t end) {
-    const Index lo = begin * kPiece, hi = gpu::lower(bytes, end * kPiece);
-    std::memcpy(to + lo, from + lo, static_cast<std::size_t>(hi - lo));
-  });
+  detail::parallelFor(pieces, static_cast<int>(pieces), threads,
+    [&](std::int64_t begin, std::int64_t end)
+    {
+      const Index lo = begin * kPiece, hi = gpu::lower(bytes, end * kPiece);
+      std::memcpy(to + lo, from + lo, static_cast<std::size_t>(hi - lo));
+    });
 }
 
 /// Rows [begin, end) of the region's block (a row: sx values along x; row r is block
 /// slice r / sy, row r % sy), gathered from the volume into `to`.
 template <class T>
-void gatherRows(const detail::TypedVolume<T>& volume, const Region& region, const gpu::RegionGeometry& g,
-  Index begin, Index end, T* to, int threads)
+void gatherRows(const detail::TypedVolume<T>& volume, const Region& region,
+  const gpu::RegionGeometry& g, Index begin, Index end, T* to, int threads)
 {
   const Index x0 = region.begin[0] - g.ox, y0 = region.begin[1] - g.oy, z0 = region.begin[2] - g.oz;
   const Index rows = end - begin;
-  detail::parallelFor(rows, static_cast<int>(gpu::lower<Index>(rows, 64)), threads, [&](std::int64_t lo, std::int64_t hi) {
-    for (Index k = lo; k < hi; ++k)
+  detail::parallelFor(rows, static_cast<int>(gpu::lower<Index>(rows, 64)), threads,
+    [&](std::int64_t lo, std::int64_t hi)
     {
-      const Index row = begin + k;
-      const Index z = z0 + row / g.sy, y = y0 + row % g.sy;
-      T* out = to + k * g.sx;
-      if (volume.stride == 1)
-        std::memcpy(out, volume.data + (z * volume.dims[1] + y) * volume.dims[0] + x0, g.sx * sizeof(T));
-      else
-        for (Index x = 0; x < g.sx; ++x)
-          out[x] = volume.value(x0 + x, y, z);
-    }
-  });
+      for (Index k = lo; k < hi; ++k)
+      {
+        const Index row = begin + k;
+        const Index z = z0 + row / g.sy, y = y0 + row % g.sy;
+        T* out = to + k * g.sx;
+        if (volume.stride == 1)
+          std::memcpy(
+            out, volume.data + (z * volume.dims[1] + y) * volume.dims[0] + x0, g.sx * sizeof(T));
+        else
+          for (Index x = 0; x < g.sx; ++x)
+            out[x] = volume.value(x0 + x, y, z);
+      }
+    });
 }
 
 /// A CUDA event, destroyed with the object.
@@ -195,7 +201,8 @@ public:
       const Index n = gpu::lower(per, units - u);
       const int slot = this->take();
       fill(u, u + n, this->Buffers[slot]);
-      this->send(slot, device + u * unitBytes, this->Buffers[slot], n * unitBytes, cudaMemcpyHostToDevice);
+      this->send(
+        slot, device + u * unitBytes, this->Buffers[slot], n * unitBytes, cudaMemcpyHostToDevice);
     }
   }
 
@@ -205,7 +212,8 @@ public:
   {
     const Index pieces = (bytes + kStagedPiece - 1) / kStagedPiece;
     Index copied = 0;
-    const auto copyOut = [&](Index piece) {
+    const auto copyOut = [&](Index piece)
+    {
       const int slot = static_cast<int>(piece % 2);
       this->wait(slot);
       const Index at = piece * kStagedPiece;
@@ -218,7 +226,8 @@ public:
       if (piece >= 2)
         copyOut(piece - 2);
       const Index at = piece * kStagedPiece;
-      this->send(slot, this->Buffers[slot], device + at, gpu::lower(kStagedPiece, bytes - at), cudaMemcpyDeviceToHost);
+      this->send(slot, this->Buffers[slot], device + at, gpu::lower(kStagedPiece, bytes - at),
+        cudaMemcpyDeviceToHost);
     }
     for (Index piece = copied; piece < pieces; ++piece)
       copyOut(piece);
@@ -306,15 +315,15 @@ TransferCache& currentTransferCache()
 /// The region's block, from the volume to `device`, through pinned pieces; returns when it
 /// is on the device.
 template <class T>
-void uploadBlock(const detail::TypedVolume<T>& volume, const Region& region, const gpu::RegionGeometry& g, T* device,
-  int threads)
+void uploadBlock(const detail::TypedVolume<T>& volume, const Region& region,
+  const gpu::RegionGeometry& g, T* device, int threads)
 {
   StagedCopy copy(currentTransferCache());
   PinnedPipe pipe = copy.upPipe();
-  pipe.up(reinterpret_cast<unsigned char*>(device), g.sy * g.sz, g.sx * static_cast<Index>(sizeof(T)),
-    [&](Index begin, Index end, unsigned char* to) {
-      gatherRows(volume, region, g, begin, end, reinterpret_cast<T*>(to), threads);
-    });
+  pipe.up(reinterpret_cast<unsigned char*>(device), g.sy * g.sz,
+    g.sx * static_cast<Index>(sizeof(T)),
+    [&](Index begin, Index end, unsigned char* to)
+    { gatherRows(volume, region, g, begin, end, reinterpret_cast<T*>(to), threads); });
   pipe.finish();
 }
 

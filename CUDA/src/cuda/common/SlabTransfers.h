@@ -60,9 +60,12 @@ struct DeviceOutputs
   /// The outputs as the kernel's writer takes them.
   gpu::FinalOutputs finalOutputs(const OutputArray (&outputs)[kFusedOutputs]) const
   {
-    return { reinterpret_cast<float*>(this->at(outputs, 0)), reinterpret_cast<float*>(this->at(outputs, 1)),
-      reinterpret_cast<double*>(this->at(outputs, 2)), reinterpret_cast<double*>(this->at(outputs, 3)),
-      reinterpret_cast<double*>(this->at(outputs, 4)), reinterpret_cast<double*>(this->at(outputs, 5)),
+    return { reinterpret_cast<float*>(this->at(outputs, 0)),
+      reinterpret_cast<float*>(this->at(outputs, 1)),
+      reinterpret_cast<double*>(this->at(outputs, 2)),
+      reinterpret_cast<double*>(this->at(outputs, 3)),
+      reinterpret_cast<double*>(this->at(outputs, 4)),
+      reinterpret_cast<double*>(this->at(outputs, 5)),
       reinterpret_cast<double*>(this->at(outputs, 6)) };
   }
 };
@@ -92,17 +95,20 @@ void launchSlab(const gpu::StatisticsWriter<T, Acc>& writer, const gpu::SlabStep
   check(cudaStreamWaitEvent(computeStream, e.uploaded.event, 0), "stream wait");
   check(cudaEventRecord(e.kernelStart.event, computeStream), "event record");
   if (withExtrema)
-    launchFusedBlocks(gpu::fusedStatisticsWithExtrema(writer, s.sliceBegin, s.sliceEnd, segment), computeStream);
+    launchFusedBlocks(
+      gpu::fusedStatisticsWithExtrema(writer, s.sliceBegin, s.sliceEnd, segment), computeStream);
   else
-    launchFusedBlocks(gpu::fusedStatistics(writer, s.sliceBegin, s.sliceEnd, segment), computeStream);
+    launchFusedBlocks(
+      gpu::fusedStatistics(writer, s.sliceBegin, s.sliceEnd, segment), computeStream);
   check(cudaGetLastError(), "fused statistics");
   check(cudaEventRecord(e.kernel.event, computeStream), "event record");
 }
 
 /// Slab s's outputs to the caller's arrays, on the download stream once its kernel is done
 /// (`kernelDone`): a slab is whole slices of `plane` voxels, one range of each output.
-inline void downloadSlab(PinnedPipe& down, cudaStream_t downStream, cudaEvent_t kernelDone, const gpu::SlabStep& s,
-  Index plane, const OutputArray (&outputs)[kFusedOutputs], const DeviceOutputs& device, int threads)
+inline void downloadSlab(PinnedPipe& down, cudaStream_t downStream, cudaEvent_t kernelDone,
+  const gpu::SlabStep& s, Index plane, const OutputArray (&outputs)[kFusedOutputs],
+  const DeviceOutputs& device, int threads)
 {
   check(cudaStreamWaitEvent(downStream, kernelDone, 0), "stream wait");
   for (int a = 0; a < kFusedOutputs; ++a)
@@ -139,14 +145,16 @@ inline void addFusedTiming(Timing& timing, const std::vector<std::unique_ptr<Sla
 /// chunk i (the slices slab i reads), launches slab i behind it, and brings slab i - 1's
 /// outputs down while slab i computes.
 template <class T, class Acc>
-void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, const gpu::RegionGeometry& g,
-  Acc shift, const gpu::EstimatorSetting& estimator, bool withExtrema, const OutputArray (&outputs)[kFusedOutputs],
-  const Execution& execution, Timing* timing, void (*afterFirstUpload)())
+void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region,
+  const gpu::RegionGeometry& g, Acc shift, const gpu::EstimatorSetting& estimator, bool withExtrema,
+  const OutputArray (&outputs)[kFusedOutputs], const Execution& execution, Timing* timing,
+  void (*afterFirstUpload)())
 {
   StagedCopy copy(currentTransferCache()); // the device's buffers, drained on every exit
   TransferCache& cache = copy.cache;
   PinnedPipe up = copy.upPipe(), down = copy.downPipe();
-  const cudaStream_t upStream = cache.streams[0], computeStream = cache.streams[1], downStream = cache.streams[2];
+  const cudaStream_t upStream = cache.streams[0], computeStream = cache.streams[1],
+                     downStream = cache.streams[2];
 
   const Index plane = g.rx * g.ry;
   const Index segment = gpu::segmentLength(g.radius[2]);
@@ -159,8 +167,10 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
   const Index rowBytes = g.sx * static_cast<Index>(sizeof(T));
 
   std::vector<std::unique_ptr<SlabEvents>> events;
-  const auto download = [&](std::size_t i) {
-    downloadSlab(down, downStream, events[i]->kernel.event, plan[i], plane, outputs, device, execution.threads);
+  const auto download = [&](std::size_t i)
+  {
+    downloadSlab(down, downStream, events[i]->kernel.event, plan[i], plane, outputs, device,
+      execution.threads);
   };
   for (std::size_t i = 0; i < plan.size(); ++i)
   {
@@ -168,9 +178,12 @@ void runFusedSlabs(const detail::TypedVolume<T>& volume, const Region& region, c
     events.emplace_back(new SlabEvents);
     SlabEvents& e = *events.back();
     const Index firstRow = s.chunkBegin * g.sy;
-    up.up(reinterpret_cast<unsigned char*>(input) + firstRow * rowBytes, (s.chunkEnd - s.chunkBegin) * g.sy, rowBytes,
-      [&](Index begin, Index end, unsigned char* to) {
-        gatherRows(volume, region, g, firstRow + begin, firstRow + end, reinterpret_cast<T*>(to), execution.threads);
+    up.up(reinterpret_cast<unsigned char*>(input) + firstRow * rowBytes,
+      (s.chunkEnd - s.chunkBegin) * g.sy, rowBytes,
+      [&](Index begin, Index end, unsigned char* to)
+      {
+        gatherRows(volume, region, g, firstRow + begin, firstRow + end, reinterpret_cast<T*>(to),
+          execution.threads);
       });
     check(cudaEventRecord(e.uploaded.event, upStream), "event record");
     if (i == 0 && afterFirstUpload)

@@ -1,6 +1,6 @@
-// Exact Box and Exact Sphere on the device (the references of Ruiz et al., docs/methods.md section 1-2):
-// one thread per region voxel counts the values at or below its query over the rows of
-// its clipped box or ellipsoid, as ExactReference.cxx does on the CPU, with the same rows
+// Exact Box and Exact Sphere on the device (the references of Ruiz et al., docs/methods.md section
+// 1-2): one thread per region voxel counts the values at or below its query over the rows of its
+// clipped box or ellipsoid, as ExactReference.cxx does on the CPU, with the same rows
 // (neighbourhoodRowHalfWidths) and the same division. Written once for the CUDA executor
 // and the host emulation of the tests, like Pipeline.h; no CUDA runtime calls here.
 //
@@ -23,13 +23,13 @@ namespace gpu
 template <class T>
 struct ExactCount
 {
-  const T* block;              // the uploaded block (RegionGeometry)
+  const T* block; // the uploaded block (RegionGeometry)
   RegionGeometry g;
-  const Index* halfWidths;     // per neighbourhood row (dz, dy): x half-width, -1 outside
-  bool iso;                    // the query: the iso value, else the voxel's own value
+  const Index* halfWidths; // per neighbourhood row (dz, dy): x half-width, -1 outside
+  bool iso;                // the query: the iso value, else the voxel's own value
   double isoValue;
-  Index zBegin, zCount;        // the region's slices of this launch
-  float* openness;             // region-sized, x fastest
+  Index zBegin, zCount; // the region's slices of this launch
+  float* openness;      // region-sized, x fastest
 
   VAO_HD Index threads() const { return g.rx * g.ry * zCount; }
 
@@ -58,7 +58,8 @@ struct ExactCount
         total += hi - lo + 1;
       }
     }
-    openness[(z * g.ry + y) * g.rx + x] = static_cast<float>(static_cast<double>(below) / static_cast<double>(total));
+    openness[(z * g.ry + y) * g.rx + x] =
+      static_cast<float>(static_cast<double>(below) / static_cast<double>(total));
   }
 };
 
@@ -66,24 +67,29 @@ struct ExactCount
 /// `rows` (neighbourhoodRowHalfWidths, on the host), in launches of whole slices and about
 /// `visitsPerLaunch` value visits; progress moves from `from` to `to` between them.
 template <class T, class Executor>
-void runExactPasses(Executor& ex, const T* block, const RegionGeometry& g, const std::vector<std::int64_t>& rows,
-  bool iso, double isoValue, float* openness, double from, double to, double visitsPerLaunch = 1 << 30)
+void runExactPasses(Executor& ex, const T* block, const RegionGeometry& g,
+  const std::vector<std::int64_t>& rows, bool iso, double isoValue, float* openness, double from,
+  double to, double visitsPerLaunch = 1 << 30)
 {
   const std::vector<Index> widths(rows.begin(), rows.end());
   Index neighbourhood = 0; // voxels of an unclipped neighbourhood
   for (const Index w : widths)
     neighbourhood += w >= 0 ? 2 * w + 1 : 0;
   const auto halfWidths = ex.upload(widths.data(), static_cast<Index>(widths.size()));
-  const double perSlice = static_cast<double>(g.rx * g.ry) * static_cast<double>(greater<Index>(neighbourhood, 1));
-  const Index depth = greater<Index>(1, lower<Index>(g.rz, static_cast<Index>(visitsPerLaunch / perSlice)));
+  const double perSlice =
+    static_cast<double>(g.rx * g.ry) * static_cast<double>(greater<Index>(neighbourhood, 1));
+  const Index depth =
+    greater<Index>(1, lower<Index>(g.rz, static_cast<Index>(visitsPerLaunch / perSlice)));
   for (Index z = 0; z < g.rz; z += depth)
   {
-    const ExactCount<T> kernel{ block, g, halfWidths.get(), iso, isoValue, z, lower<Index>(depth, g.rz - z), openness };
+    const ExactCount<T> kernel{ block, g, halfWidths.get(), iso, isoValue, z,
+      lower<Index>(depth, g.rz - z), openness };
     // Bytes: the slab's rows from memory once, the openness written once.
     const double bytes = static_cast<double>(kernel.threads()) * (sizeof(float) + sizeof(T));
     ex.launch(kernel, "exact count", bytes);
     ex.synchronize(); // progress and Abort follow the device, not the queue
-    ex.progress(from + (to - from) * static_cast<double>(z + kernel.zCount) / static_cast<double>(g.rz));
+    ex.progress(
+      from + (to - from) * static_cast<double>(z + kernel.zCount) / static_cast<double>(g.rz));
   }
 }
 

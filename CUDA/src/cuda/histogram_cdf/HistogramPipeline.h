@@ -66,7 +66,8 @@ struct HistogramQuerySource
   VAO_HD double at(Index index) const
   {
     const Index x = index % g.rx, y = (index / g.rx) % g.ry, z = index / (g.rx * g.ry);
-    return iso ? isoValue : static_cast<double>(input[((g.oz + z) * g.sy + g.oy + y) * g.sx + g.ox + x]);
+    return iso ? isoValue
+               : static_cast<double>(input[((g.oz + z) * g.sy + g.oy + y) * g.sx + g.ox + x]);
   }
 };
 
@@ -126,7 +127,8 @@ struct GatherKernel
   VAO_HD void operator()(Index thread) const
   {
     zRunningSums(sum1, sum2, g, segment, thread,
-      [&](Index index, Index z, Index x, Index y, int s1, int s2) { sink.write(index, z, x, y, s1, s2); });
+      [&](Index index, Index z, Index x, Index y, int s1, int s2)
+      { sink.write(index, z, x, y, s1, s2); });
   }
 };
 
@@ -163,54 +165,57 @@ struct HistogramOpennessKernel
 /// round is one fused pass of the indicators (FusedStatistics.h) where its tile fits a
 /// block, else x, y and z passes.
 template <class T, class Executor>
-void runHistogramPasses(Executor& ex, const T* input, const RegionGeometry& g, const double* hostThresholds,
-  int n, bool iso, double isoValue, float* openness)
+void runHistogramPasses(Executor& ex, const T* input, const RegionGeometry& g,
+  const double* hostThresholds, int n, bool iso, double isoValue, float* openness)
 {
   const bool fused = fusedPassFits<int, Bin>(g, false, ex.sharedLimit());
   auto thresholds = ex.template upload<double>(hostThresholds, n);
-  auto bins = ex.template allocate<Bin>(g.block()), transposed = ex.template allocate<Bin>(fused ? 0 : g.block());
+  auto bins = ex.template allocate<Bin>(g.block()),
+       transposed = ex.template allocate<Bin>(fused ? 0 : g.block());
   ex.launch(BinKernel<T>{ input, thresholds.get(), n, bins.get(), g.block() }, "bins",
     g.block() * (sizeof(T) + sizeof(Bin)));
   auto upper = ex.template allocate<int>(g.region()), below = ex.template allocate<int>(g.region()),
        atOrBelow = ex.template allocate<int>(g.region());
   const HistogramQuerySource<T> query{ input, g, iso, isoValue, thresholds.get(), n };
-  ex.launch(UpperKernel<T>{ query, upper.get(), below.get(), atOrBelow.get() },
-    "query bins", g.region() * (sizeof(T) + 3.0 * sizeof(int)));
+  ex.launch(UpperKernel<T>{ query, upper.get(), below.get(), atOrBelow.get() }, "query bins",
+    g.region() * (sizeof(T) + 3.0 * sizeof(int)));
 
   const Index afterX = fused ? 0 : g.afterX();
   auto a1 = ex.template allocate<int>(afterX), a2 = ex.template allocate<int>(afterX);
   auto b1 = ex.template allocate<int>(afterX), b2 = ex.template allocate<int>(afterX);
   if (!fused)
     ex.transpose(bins.get(), transposed.get(), g.sx, g.sy, g.sz, "transpose bins");
-  const AxisPass xPass{ g.sy * g.sz, g.sx, g.radius[0], g.ox, g.rx, LaneLayout{ g.sy, g.sx * g.sy, g.sy },
-    LaneLayout{ g.sy, g.rx * g.sy, g.sy } };
-  const AxisPass yPass{ g.rx * g.sz, g.sy, g.radius[1], g.oy, g.ry, LaneLayout{ g.rx, g.sy * g.rx, g.rx },
-    LaneLayout{ g.rx, g.ry * g.rx, g.rx } };
+  const AxisPass xPass{ g.sy * g.sz, g.sx, g.radius[0], g.ox, g.rx,
+    LaneLayout{ g.sy, g.sx * g.sy, g.sy }, LaneLayout{ g.sy, g.rx * g.sy, g.sy } };
+  const AxisPass yPass{ g.rx * g.sz, g.sy, g.radius[1], g.oy, g.ry,
+    LaneLayout{ g.rx, g.sy * g.rx, g.rx }, LaneLayout{ g.rx, g.ry * g.rx, g.rx } };
   for (int k = 0; k < n; k += 2)
   {
     const GatherSink sink{ upper.get(), below.get(), atOrBelow.get(), k };
     if (fused)
     {
-      const FusedBoxSums<IndicatorSource, GatherSink, int> counts{ { bins.get(), k }, sink, g, 0, g.rz,
-        segmentLength(g.radius[2]) };
-      ex.launchBlocks(counts, "indicators (fused)", g.block() * sizeof(Bin) + 3.0 * g.region() * sizeof(int));
+      const FusedBoxSums<IndicatorSource, GatherSink, int> counts{ { bins.get(), k }, sink, g, 0,
+        g.rz, segmentLength(g.radius[2]) };
+      ex.launchBlocks(
+        counts, "indicators (fused)", g.block() * sizeof(Bin) + 3.0 * g.region() * sizeof(int));
     }
     else
     {
-      const SumKernel<IndicatorSource, int> countsX{ { transposed.get(), k }, a1.get(), a2.get(), xPass,
-        segmentLength(xPass.r) };
+      const SumKernel<IndicatorSource, int> countsX{ { transposed.get(), k }, a1.get(), a2.get(),
+        xPass, segmentLength(xPass.r) };
       ex.launch(countsX, "indicators x", g.block() * sizeof(Bin) + 2.0 * g.afterX() * sizeof(int));
       ex.transpose(a1.get(), b1.get(), g.sy, g.rx, g.sz, "transpose counts");
       ex.transpose(a2.get(), b2.get(), g.sy, g.rx, g.sz, "transpose counts");
-      const MomentKernel<int, int, false> countsY{ { b1.get(), b2.get(), 0 }, a1.get(), a2.get(), yPass,
-        segmentLength(yPass.r) };
+      const MomentKernel<int, int, false> countsY{ { b1.get(), b2.get(), 0 }, a1.get(), a2.get(),
+        yPass, segmentLength(yPass.r) };
       ex.launch(countsY, "indicators y", 2.0 * (g.afterX() + g.afterY()) * sizeof(int));
-      ex.launch(GatherKernel{ a1.get(), a2.get(), sink, g, segmentLength(g.radius[2]) }, "indicators z",
-        2.0 * g.afterY() * sizeof(int) + 3.0 * g.region() * sizeof(int));
+      ex.launch(GatherKernel{ a1.get(), a2.get(), sink, g, segmentLength(g.radius[2]) },
+        "indicators z", 2.0 * g.afterY() * sizeof(int) + 3.0 * g.region() * sizeof(int));
     }
     ex.progress(0.1 + 0.8 * lower(1.0, (k + 2.0) / n));
   }
-  ex.launch(HistogramOpennessKernel<T>{ query, upper.get(), below.get(), atOrBelow.get(), openness },
+  ex.launch(
+    HistogramOpennessKernel<T>{ query, upper.get(), below.get(), atOrBelow.get(), openness },
     "openness", g.region() * (sizeof(T) + 3.0 * sizeof(int) + sizeof(float)));
 }
 

@@ -80,11 +80,15 @@ struct BlurLevelZ
     const Index x = t % nx, y = (t / nx) % ny, zo = t / (nx * ny);
     const double* w = wz + zo * kTaps;
     double d[kTaps], s[kTaps];
-    tapsAlong(zo, step, nz, [&](Index z, double& dk, double& sk) {
-      const Index i = (z * ny + y) * nx + x;
-      dk = static_cast<double>(mean[i]) - shift;
-      sk = static_cast<double>(variance[i]) + dk * dk;
-    }, d, s);
+    tapsAlong(
+      zo, step, nz,
+      [&](Index z, double& dk, double& sk)
+      {
+        const Index i = (z * ny + y) * nx + x;
+        dk = static_cast<double>(mean[i]) - shift;
+        sk = static_cast<double>(variance[i]) + dk * dk;
+      },
+      d, s);
     a[t] = blur::tapSum(w, d);
     b[t] = blur::tapSum(w, s);
   }
@@ -107,10 +111,14 @@ struct BlurY
     const Index x = t % nx, yo = (t / nx) % oy, zo = t / (nx * oy);
     const double* w = wy + yo * kTaps;
     double ta[kTaps], tb[kTaps];
-    tapsAlong(yo, step, ny, [&](Index y, double& u, double& v) {
-      u = a[(zo * ny + y) * nx + x];
-      v = b[(zo * ny + y) * nx + x];
-    }, ta, tb);
+    tapsAlong(
+      yo, step, ny,
+      [&](Index y, double& u, double& v)
+      {
+        u = a[(zo * ny + y) * nx + x];
+        v = b[(zo * ny + y) * nx + x];
+      },
+      ta, tb);
     oa[t] = blur::tapSum(w, ta);
     ob[t] = blur::tapSum(w, tb);
   }
@@ -135,10 +143,14 @@ struct BlurX
     const Index xo = t % ox, row = t / ox; // row: (yo, zo) of the (nx, oy, oz) arrays
     const double* w = wx + xo * kTaps;
     double ta[kTaps], tb[kTaps];
-    tapsAlong(xo, step, nx, [&](Index x, double& u, double& v) {
-      u = a[row * nx + x];
-      v = b[row * nx + x];
-    }, ta, tb);
+    tapsAlong(
+      xo, step, nx,
+      [&](Index x, double& u, double& v)
+      {
+        u = a[row * nx + x];
+        v = b[row * nx + x];
+      },
+      ta, tb);
     blur::levelMoments(blur::tapSum(w, ta), blur::tapSum(w, tb), shift, mean[t], variance[t]);
   }
 };
@@ -146,14 +158,16 @@ struct BlurX
 /// One level's three passes: `z` (BlurRawZ or BlurLevelZ, its a and b the z arrays) then
 /// y and x into mean and variance of `out` kept voxels. The y arrays hold (nx, oy, oz).
 template <class Executor, class ZPass>
-void runBlurLevel(Executor& ex, const ZPass& z, const Index in[3], const Index out[3], int step, const double* wy,
-  const double* wx, double shift, double* ya, double* yb, float* mean, float* variance)
+void runBlurLevel(Executor& ex, const ZPass& z, const Index in[3], const Index out[3], int step,
+  const double* wy, const double* wx, double shift, double* ya, double* yb, float* mean,
+  float* variance)
 {
   ex.launch(z, "pyramid z", static_cast<double>(z.threads()) * 16.0);
   const BlurY y{ z.a, z.b, in[0], in[1], out[1], out[2], step, wy, ya, yb };
   ex.launch(y, "pyramid y", static_cast<double>(y.threads()) * 16.0 * 2.0);
   const BlurX x{ ya, yb, in[0], out[0], out[1], out[2], step, wx, shift, mean, variance };
-  ex.launch(x, "pyramid x", static_cast<double>(x.threads()) * 8.0 + static_cast<double>(y.threads()) * 16.0);
+  ex.launch(x, "pyramid x",
+    static_cast<double>(x.threads()) * 8.0 + static_cast<double>(y.threads()) * 16.0);
 }
 
 /// Every level of the pyramid from the raw volume `v` (dims, x fastest) into `out`'s
@@ -161,8 +175,8 @@ void runBlurLevel(Executor& ex, const ZPass& z, const Index in[3], const Index o
 /// and clipped weights; the geometry is setLevelGeometry's): level 0 keeps every
 /// setup.firstStep-th voxel, the next ones every second, each built from the one before.
 template <class T, class Executor>
-void runPyramid(Executor& ex, const T* v, const Index3& dims, const detail::PyramidSetup& setup, int levels,
-  std::vector<MomentLevel>& out)
+void runPyramid(Executor& ex, const T* v, const Index3& dims, const detail::PyramidSetup& setup,
+  int levels, std::vector<MomentLevel>& out)
 {
   out.resize(static_cast<std::size_t>(levels));
   Index3 in = dims;
@@ -173,7 +187,8 @@ void runPyramid(Executor& ex, const T* v, const Index3& dims, const detail::Pyra
     const int step = l == 0 ? setup.firstStep : 2;
     const Index3 kept = detail::keptDims(in, step);
     const Index i[3] = { in[0], in[1], in[2] }, o[3] = { kept[0], kept[1], kept[2] };
-    const auto hx = detail::axisWeights(i[0], o[0], step), hy = detail::axisWeights(i[1], o[1], step),
+    const auto hx = detail::axisWeights(i[0], o[0], step),
+               hy = detail::axisWeights(i[1], o[1], step),
                hz = detail::axisWeights(i[2], o[2], step);
     const auto wx = ex.upload(hx.data(), static_cast<Index>(hx.size()));
     const auto wy = ex.upload(hy.data(), static_cast<Index>(hy.size()));
@@ -187,12 +202,13 @@ void runPyramid(Executor& ex, const T* v, const Index3& dims, const detail::Pyra
     auto variance = ex.template allocate<float>(count);
     const double shift = setup.shift;
     if (l == 0)
-      runBlurLevel(ex, BlurRawZ<T>{ v, i[0], i[1], i[2], o[2], step, wz.get(), shift, za.get(), zb.get() }, i, o,
+      runBlurLevel(ex,
+        BlurRawZ<T>{ v, i[0], i[1], i[2], o[2], step, wz.get(), shift, za.get(), zb.get() }, i, o,
         step, wy.get(), wx.get(), shift, ya.get(), yb.get(), mean.get(), variance.get());
     else
       runBlurLevel(ex,
-        BlurLevelZ{ sourceMean.get(), sourceVariance.get(), i[0], i[1], i[2], o[2], step, wz.get(), shift, za.get(),
-          zb.get() },
+        BlurLevelZ{ sourceMean.get(), sourceVariance.get(), i[0], i[1], i[2], o[2], step, wz.get(),
+          shift, za.get(), zb.get() },
         i, o, step, wy.get(), wx.get(), shift, ya.get(), yb.get(), mean.get(), variance.get());
     MomentLevel& level = out[static_cast<std::size_t>(l)];
     level.dims = kept;
