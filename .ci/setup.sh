@@ -75,6 +75,6 @@ case "$job" in
   build)
     ;;
   *)
-    echo "unknown job '$job' (demo, test, benchmark, build)" >&2
+    echo "unknown job '$job' (demo, test, benchmark, build, sanitize, fuzz, format)" >&2
     exit 2 ;;
 esac
