@@ -21,15 +21,15 @@ namespace
 {
 
 /// Straight lines between the nodes (midpoint 0.5, sharpness 0); outside them the end
-/// node's opacity when clamping, else 0. A value on the last node counts as beyond it, as
-/// VTK has it.
+/// node's opacity when clamping, else 0. A value on the first node counts as outside, one
+/// on the last as inside, as VTK 9.2 has it.
 double linearOpacity(const vao::OpacityFunction& f, double v)
 {
   const auto& n = f.nodes;
-  if (v < n.front().x || v >= n.back().x)
-    return f.clamping ? (v < n.front().x ? n.front().y : n.back().y) : 0.0;
+  if (v <= n.front().x || v > n.back().x)
+    return f.clamping ? (v <= n.front().x ? n.front().y : n.back().y) : 0.0;
   std::size_t k = 0;
-  while (!(v < n[k + 1].x))
+  while (v > n[k + 1].x)
     ++k;
   const double t = (v - n[k].x) / (n[k + 1].x - n[k].x);
   return (1 - t) * n[k].y + t * n[k + 1].y;

@@ -29,13 +29,14 @@ struct OpacityFunction
   bool logScale = false;
 };
 
-/// alpha(x) as vtkPiecewiseFunction::GetValue(x) gives it: the first node whose x is
-/// greater than the value and the one before it bound the segment (a value on the last
-/// node is beyond the nodes); within the segment the position is moved by the midpoint,
-/// then sharpness 0 interpolates linearly, sharpness 1 steps at the midpoint and values
-/// between bend a Hermite curve, clamped to the two nodes' opacities. NaN where the log
-/// scale meets a value or node at or below 0. The function must pass
-/// checkOpacityFunction (vao/Validation.h).
+/// alpha(x) as VTK 9.2's vtkPiecewiseFunction::GetValue(x) gives it: the first node at or
+/// beyond the value and the one before it bound the segment (a value on the first node
+/// counts as before the nodes, one on the last node as the end of the last segment);
+/// within the segment the position is moved by the midpoint, then sharpness below 0.01
+/// interpolates linearly, above 0.99 steps at the midpoint and values between bend a
+/// Hermite curve, clamped to the two nodes' opacities. NaN where the log scale meets a
+/// value or node at or below 0. The function must pass checkOpacityFunction
+/// (vao/Validation.h).
 double evaluateOpacity(const OpacityFunction& function, double x);
 
 } // namespace vao

@@ -133,10 +133,11 @@ Status validateRequest(const VolumeView& volume, const Region& region,
 
 /// The openness of the methods that do not come from the streamed moments: Histogram CDF
 /// (box histograms), Transfer Function (the box mean of the opacity) and the exact
-/// references. `q` is the smoothed query, or null.
+/// references. `q` is the smoothed query, or null. Transfer Function keeps the range of what
+/// it writes in `range` (when not null).
 Status separateOpenness(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, const double* q, float* openness,
-  const Execution& stage)
+  OutputRange* range, const Execution& stage)
 {
   if (parameters.method == Method::HistogramCdf)
   {
@@ -151,7 +152,7 @@ Status separateOpenness(const VolumeView& volume, const Region& region,
   if (parameters.method == Method::TransferFunction)
   {
     return detail::computeTransferFunctionOpenness(
-      volume, region, parameters.radius, parameters.opacity, openness, stage);
+      volume, region, parameters.radius, parameters.opacity, openness, range, stage);
   }
   return detail::computeExactOpenness(volume, region, parameters, q, openness, stage);
 }
@@ -189,7 +190,7 @@ Status ambientOcclusion(const VolumeView& volume, const Region& region,
   if (separate)
   {
     const Status openness = separateOpenness(volume, region, parameters, q, output.openness,
-      detail::stageExecution(execution, queryEnd, opennessEnd));
+      output.opennessRange, detail::stageExecution(execution, queryEnd, opennessEnd));
     if (!openness.ok)
       return openness;
   }

@@ -11,6 +11,7 @@
 #pragma once
 
 #include "VolumeAccess.h"
+#include "cpu/box_statistics/PlaneRowKernels.h"
 #include "cpu/box_statistics/RunningTotals.h"
 #include "cpu/common/Parallel.h"
 #include "cpu/simd/CpuDispatch.h"
@@ -19,6 +20,7 @@
 #include <cstdint>
 #include <limits>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace vao
@@ -58,107 +60,6 @@ struct BoxGeometry
   }
 };
 
-/// One row of the y pass: plane += run (when plane is not null), then the running column
-/// sums move on: run = (run + entering) - leaving, in that order (the rounding of double
-/// sums is that of the scalar code it replaced), in one loop that loads run once. The
-/// x-box rows entering and leaving may be narrower integers (int32 sums of squares,
-/// widened here). Compiled for AVX2 too (CpuDispatch.h).
-template <class Acc, class In = Acc, class Out = Acc>
-struct SlideColumns
-{
-  static VAO_ALWAYS_INLINE void run(Acc* __restrict plane, Acc* __restrict run,
-    const In* __restrict entering, const Out* __restrict leaving, std::int64_t n)
-  {
-    if (plane)
-      for (std::int64_t i = 0; i < n; ++i)
-      {
-        const Acc r = run[i];
-        plane[i] += r;
-        run[i] = (r + static_cast<Acc>(entering[i])) - static_cast<Acc>(leaving[i]);
-      }
-    else
-      for (std::int64_t i = 0; i < n; ++i)
-        run[i] = (run[i] + static_cast<Acc>(entering[i])) - static_cast<Acc>(leaving[i]);
-  }
-};
-
-/// Values whose squares, and the differences of two squares, fit in int32: 8-bit and int16
-/// (whose 32-bit products vectorise where 64-bit ones do not on AVX2).
-template <class T>
-constexpr bool kSquaresFitInt32 =
-  std::is_integral<T>::value && (sizeof(T) == 1 || (sizeof(T) == 2 && std::is_signed<T>::value));
-
-/// d1 = a - b (in Lin, modulo 2^32 for std::uint32_t) and, with Squares, d2 = a^2 - b^2,
-/// with a, b the values of rows `in` and `out` less the shift (0 for a missing row). d2 is
-/// in Sq: Acc, or for 8-bit and int16 values, whose squares' differences fit in int32,
-/// std::uint32_t holding those int32 bits, with *largest the greatest |d2| (exact in any
-/// order): boxRowDifference then sums them modulo 2^32 where no window's sum can leave
-/// int32's range. Compiled for AVX2 too.
-template <class T, class Acc, bool Squares = true, class Lin = Acc, class Sq = Acc>
-struct RowDifferences
-{
-  static VAO_ALWAYS_INLINE void run(const T* __restrict in, const T* __restrict out,
-    std::int64_t stride, std::int64_t n, Acc shift, Lin* __restrict d1, Sq* __restrict d2,
-    std::int32_t* largest = nullptr)
-  {
-    using Product = typename std::conditional<kSquaresFitInt32<T>, std::int32_t, Acc>::type;
-    constexpr bool narrowSquares = Squares && !std::is_same<Sq, Acc>::value;
-    static_assert(!narrowSquares || std::is_same<Product, std::int32_t>::value,
-      "32-bit squares of 8- and 16-bit values");
-    const auto s = static_cast<Product>(shift);
-    std::int32_t most = 0;
-    for (std::int64_t i = 0; i < n; ++i)
-    {
-      const Product a = in ? static_cast<Product>(in[i * stride]) - s : Product(0);
-      const Product b = out ? static_cast<Product>(out[i * stride]) - s : Product(0);
-      d1[i] = static_cast<Lin>(a - b);
-      if constexpr (Squares)
-      {
-        const Product d = a * a - b * b; // |d| <= 2^30 where narrowSquares
-        d2[i] = static_cast<Sq>(d);
-        if constexpr (narrowSquares)
-        {
-          const std::int32_t magnitude = d < 0 ? -d : d;
-          most = magnitude > most ? magnitude : most;
-        }
-      }
-    }
-    if constexpr (narrowSquares)
-      *largest = most;
-  }
-};
-
-/// A window's sum of squares from the difference of two prefix sums: as it is in Acc, or
-/// the bits of an int32 sum modulo 2^32 (WindowDifferences).
-template <class Acc, class Sq>
-VAO_ALWAYS_INLINE Acc squaresWindow(Sq difference)
-{
-  if constexpr (std::is_same<Sq, std::uint32_t>::value && !std::is_same<Acc, std::uint32_t>::value)
-    return static_cast<Acc>(static_cast<std::int32_t>(difference));
-  else
-    return difference;
-}
-
-/// box[i] = p[i + offset + width] - p[i + offset] for i in [begin, end), for both prefix
-/// rows (the first, in Lin, alone without Squares). The second's prefix sums are in Sq:
-/// Acc, or std::uint32_t modulo 2^32 where every window's sum fits in int32, whose
-/// differences are then those sums' bits. Compiled for AVX2 too.
-template <class Acc, bool Squares = true, class Lin = Acc, class Sq = Acc>
-struct WindowDifferences
-{
-  static VAO_ALWAYS_INLINE void run(const Lin* __restrict p1, const Sq* __restrict p2,
-    std::int64_t offset, std::int64_t width, Lin* __restrict box1, Acc* __restrict box2,
-    std::int64_t begin, std::int64_t end)
-  {
-    for (std::int64_t i = begin; i < end; ++i)
-    {
-      box1[i] = p1[i + offset + width] - p1[i + offset];
-      if constexpr (Squares)
-        box2[i] = squaresWindow<Acc>(p2[i + offset + width] - p2[i + offset]);
-    }
-  }
-};
-
 /// Whether the box sums of v (exact integer types) can run in 32 bits: every box sum of the
 /// region, whatever the values, lies within int32's range. The running sums then wrap
 /// modulo 2^32 (unsigned, so wrapping is defined) and each box sum comes out exact; half
@@ -177,10 +78,28 @@ bool linearSumsFit32(const BoxGeometry& geometry)
   return voxels * largest < 2147483648.0;
 }
 
+/// Where MomentPlanes reads a row's values: the volume itself. A source gives `Value`,
+/// `stride()` and row(y, z, x0, n, scratch): the values x0 ... x0 + n - 1 of row (y, z),
+/// stride() apart, which a source that derives them from the volume's (kScratch) writes
+/// into scratch, n values.
+template <class T>
+struct VolumeRows
+{
+  using Value = T;
+  static constexpr bool kScratch = false;
+  const TypedVolume<T>& volume;
+
+  std::int64_t stride() const { return this->volume.stride; }
+  const T* row(std::int64_t y, std::int64_t z, std::int64_t x0, std::int64_t, T*) const
+  {
+    return this->volume.row(y, z) + x0 * this->volume.stride;
+  }
+};
+
 /// Box sums of (v - shift) and, unless told not to (a consumer that needs the mean alone),
 /// of (v - shift)^2 for one slice of the region at a time; the sums of v in Lin
 /// (std::uint32_t where linearSumsFit32, else the accumulator).
-template <class T, class Lin = typename MomentTraits<T>::Accumulator>
+template <class T, class Lin = typename MomentTraits<T>::Accumulator, class Source = VolumeRows<T>>
 class MomentPlanes
 {
 public:
@@ -191,8 +110,8 @@ public:
   static constexpr bool kNarrowSquares =
     std::is_same<Lin, std::uint32_t>::value && kSquaresFitInt32<T>;
 
-  MomentPlanes(const TypedVolume<T>& volume, const BoxGeometry& geometry, Acc shift, bool squares)
-    : Volume(volume)
+  MomentPlanes(const Source& rows, const BoxGeometry& geometry, Acc shift, bool squares)
+    : Rows(rows)
     , Geo(geometry)
     , Shift(shift)
     , Squares(squares)
@@ -211,6 +130,8 @@ public:
     , Zeros(geometry.region.size[0], Acc(0))
     , ZerosLin(geometry.region.size[0], Lin(0))
     , ZerosNarrow(kNarrowSquares ? geometry.region.size[0] : 0, 0)
+    , Entering(Source::kScratch ? geometry.xs.size() : 0)
+    , Leaving(Source::kScratch ? geometry.xs.size() : 0)
   {
   }
 
@@ -334,14 +255,16 @@ private:
   void boxRowDifference(std::int64_t y, std::int64_t entering, std::int64_t leaving)
   {
     const std::int64_t span = this->Geo.xs.size();
-    const std::int64_t stride = this->Volume.stride;
+    const std::int64_t stride = this->Rows.stride();
     const std::int64_t r = this->Geo.radius.x;
     Lin* p1 = this->Row1.data();
     Acc* p2 = this->Row2.data();
     std::uint32_t* q2 = this->Row2Narrow.data();
+    const std::int64_t lo = this->Geo.xs.lo;
     const T* in =
-      entering >= 0 ? this->Volume.row(y, entering) + this->Geo.xs.lo * stride : nullptr;
-    const T* out = leaving >= 0 ? this->Volume.row(y, leaving) + this->Geo.xs.lo * stride : nullptr;
+      entering >= 0 ? this->Rows.row(y, entering, lo, span, this->Entering.data()) : nullptr;
+    const T* out =
+      leaving >= 0 ? this->Rows.row(y, leaving, lo, span, this->Leaving.data()) : nullptr;
     // The differences of the two rows (a vector loop), then their prefix sums:
     // p[i] = sum of the first i values.
     p1[0] = 0;
@@ -383,6 +306,13 @@ private:
     else if constexpr (std::is_same<Acc, std::int64_t>::value)
       runningTotals(p1, this->Squares ? p2 : nullptr, span + 1,
         this->Simd); // exact: any order of the additions
+    else if constexpr (std::is_same<Lin, std::int64_t>::value)
+    {
+      runningTotals(p1, nullptr, span + 1, this->Simd); // integer sums of v: exact
+      if (this->Squares)
+        for (std::int64_t i = 0; i < span; ++i)
+          p2[i + 1] += p2[i];
+    }
     else
       for (std::int64_t i = 0; i < span; ++i) // double sums: this order on every tier
       {
@@ -442,7 +372,7 @@ private:
       clamped(i);
   }
 
-  const TypedVolume<T>& Volume;
+  const Source& Rows;
   const BoxGeometry& Geo;
   Acc Shift;
   bool Squares; // the sums of squares are formed (else their rows are empty)
@@ -461,6 +391,7 @@ private:
   std::vector<Acc> Zeros;                // a row outside the volume
   std::vector<Lin> ZerosLin;             // the same for the sums of v
   std::vector<std::int32_t> ZerosNarrow; // and for the narrow squares
+  std::vector<T> Entering, Leaving;      // Source::kScratch: the rows it derived
   SimdTier Simd = cpuSimdTier();
 };
 
@@ -482,18 +413,20 @@ struct MomentSlice
 /// each thread takes a contiguous chunk of slices and a consumer of its own, made by
 /// makeConsumer(), whose buffers then serve the chunk's slices, not one slice each. The
 /// sums of v are in Lin (std::uint32_t only where linearSumsFit32), the sums of squares
-/// formed only if `squares`. Returns false when cancelled.
-template <class T, class Lin, class MakeConsumer>
-bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
-  const MomentScale& scale, bool squares, const Execution& execution, MakeConsumer&& makeConsumer)
+/// formed only if `squares`. The values are read from `rows` (VolumeRows: the volume's).
+/// Returns false when cancelled.
+template <class Lin, class Source, class MakeConsumer>
+bool streamMomentsOf(const Source& rows, const BoxGeometry& geometry, const MomentScale& scale,
+  bool squares, const Execution& execution, MakeConsumer&& makeConsumer)
 {
+  using T = typename Source::Value;
   const auto shift = static_cast<typename MomentTraits<T>::Accumulator>(scale.shift);
   const int threads = resolveThreadCount(execution.threads);
   const std::int64_t nz = geometry.region.size[2];
   return parallelFor(nz, threads, threads, execution,
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
     {
-      MomentPlanes<T, Lin> planes(volume, geometry, shift, squares);
+      MomentPlanes<T, Lin, Source> planes(rows, geometry, shift, squares);
       auto consume = makeConsumer();
       for (std::int64_t k = begin; k < end; ++k)
       {
@@ -515,6 +448,15 @@ bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
         }
       }
     });
+}
+
+/// streamMomentsOf the volume's own values.
+template <class T, class Lin, class MakeConsumer>
+bool streamMoments(const TypedVolume<T>& volume, const BoxGeometry& geometry,
+  const MomentScale& scale, bool squares, const Execution& execution, MakeConsumer&& makeConsumer)
+{
+  return streamMomentsOf<Lin>(VolumeRows<T>{ volume }, geometry, scale, squares, execution,
+    std::forward<MakeConsumer>(makeConsumer));
 }
 
 } // namespace detail

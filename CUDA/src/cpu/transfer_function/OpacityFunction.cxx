@@ -27,15 +27,19 @@ double segmentPosition(const OpacityFunction& f, double x, double x1, double x2)
 }
 
 /// The opacity between two nodes at `scale`, VTK's curve: the midpoint moves the position,
-/// then linear (sharpness < 0.01), a step (above 0.99) or the sharpened Hermite curve. A
-/// sharpness above 0.99 ends up in the Hermite branch in VTK as well, where (1 - sharpness)
-/// nearly zeroes the tangents: the result is the curve's, which is what GetValue returns.
+/// then a step at the moved midpoint (sharpness above 0.99), a straight line (below 0.01)
+/// or the Hermite curve sharpened by raising the position to the power 1 + 10 sharpness,
+/// clamped to the two nodes' opacities.
 double segmentOpacity(const OpacityNode& a, const OpacityNode& b, double scale)
 {
   const double midpoint = std::min(std::max(a.midpoint, kMidpointMargin), 1.0 - kMidpointMargin);
   scale =
     scale < midpoint ? 0.5 * scale / midpoint : 0.5 + 0.5 * (scale - midpoint) / (1.0 - midpoint);
   const double sharpness = a.sharpness;
+  if (sharpness > 0.99)
+  {
+    return scale < 0.5 ? a.y : b.y;
+  }
   if (sharpness < 0.01)
   {
     return (1 - scale) * a.y + scale * b.y;
@@ -71,8 +75,10 @@ double evaluateOpacity(const OpacityFunction& f, double x)
   {
     return 0.0;
   }
-  const auto upper = std::upper_bound(nodes.begin(), nodes.end(), x,
-    [](double value, const OpacityNode& node) { return value < node.x; });
+  // The segment is the first node at or beyond x and the one before it: a value on the
+  // first node counts as before the nodes (0 without clamping), one on the last as its end.
+  const auto upper = std::lower_bound(nodes.begin(), nodes.end(), x,
+    [](const OpacityNode& node, double value) { return node.x < value; });
   if (upper == nodes.end())
   {
     return f.clamping ? nodes.back().y : 0.0;
