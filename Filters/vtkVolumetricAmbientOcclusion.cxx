@@ -37,7 +37,7 @@ namespace
 {
 
 const char* const MethodNames[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box",
-  "Exact Sphere", "Histogram CDF" };
+  "Exact Sphere", "Histogram CDF", "Transfer Function" };
 const char* const QueryModeNames[] = { "Voxel Value", "Iso Value", "Smoothed Voxel Value" };
 
 vao::Method KernelMethod(int method)
@@ -54,6 +54,8 @@ vao::Method KernelMethod(int method)
       return vao::Method::ExactSphere;
     case vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF:
       return vao::Method::HistogramCdf;
+    case vtkVolumetricAmbientOcclusion::TRANSFER_FUNCTION:
+      return vao::Method::TransferFunction;
     case vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF:
     default: // CheckParameters rejects any other value
       return vao::Method::GaussianCdf;
@@ -152,7 +154,7 @@ vtkMultiProcessController* vtkVolumetricAmbientOcclusion::GetController() const
 void vtkVolumetricAmbientOcclusion::ComputeReach(const double spacing[3], int reach[3]) const
 {
   this->ComputeVoxelRadius(spacing, reach);
-  if (this->QueryMode == SMOOTHED_VALUE)
+  if (this->QueryMode == SMOOTHED_VALUE && this->Method != TRANSFER_FUNCTION)
   {
     const int window = vao::querySmoothingHalfWidth(this->QuerySmoothing);
     for (int a = 0; a < 3; ++a)
@@ -170,6 +172,11 @@ vao::AmbientOcclusionParameters vtkVolumetricAmbientOcclusion::Parameters(const 
   parameters.isoValue = this->IsoValue;
   parameters.erfMode = KernelErfMode(this->ErfApproximation);
   parameters.querySmoothing = this->QuerySmoothing;
+  if (this->Method == TRANSFER_FUNCTION)
+  {
+    parameters.queryMode = vao::QueryMode::VoxelValue; // the opacity has no query
+    parameters.opacity = this->OpacityNodes();
+  }
   return parameters;
 }
 
@@ -393,8 +400,13 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
     vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads);
   execution.device = this->Device;
   vao::Status status;
-  // The device runs every method, with the voxel's value or an iso value as the query.
-  bool onDevice = this->ChooseCuda(parameters.queryMode != vao::QueryMode::SmoothedValue,
+  // The device runs every method but Transfer Function, with the voxel's value or an iso
+  // value as the query.
+  const char* cpuOnly = parameters.method == vao::Method::TransferFunction
+    ? "The Transfer Function method runs"
+    : parameters.queryMode == vao::QueryMode::SmoothedValue ? "The smoothed query runs"
+                                                            : nullptr;
+  bool onDevice = this->ChooseCuda(cpuOnly,
     !vao::isSeparableMethod(parameters.method) && parameters.method != vao::Method::HistogramCdf,
     region.voxelCount());
   if (onDevice)
@@ -420,7 +432,7 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
 
 //------------------------------------------------------------------------------
 bool vtkVolumetricAmbientOcclusion::ChooseCuda(
-  bool onDeviceQuery, bool exactMethod, long long voxels)
+  const char* cpuOnly, bool exactMethod, long long voxels)
 {
   if (this->Backend == BACKEND_CPU)
   {
@@ -431,11 +443,11 @@ bool vtkVolumetricAmbientOcclusion::ChooseCuda(
   {
     // Below about a million voxels the CPU finishes before the transfers would, except
     // for the exact references, whose O(R^3) counts pay for them at any size.
-    return device.available && onDeviceQuery && (exactMethod || voxels >= AutoCudaMinimumVoxels);
+    return device.available && !cpuOnly && (exactMethod || voxels >= AutoCudaMinimumVoxels);
   }
-  if (!onDeviceQuery)
+  if (cpuOnly)
   {
-    vtkWarningMacro(<< "The smoothed query runs on the CPU only; computing on the CPU.");
+    vtkWarningMacro(<< cpuOnly << " on the CPU only; computing on the CPU.");
     return false;
   }
   if (!device.available)
@@ -451,7 +463,7 @@ bool vtkVolumetricAmbientOcclusion::ChooseCuda(
 void vtkVolumetricAmbientOcclusion::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  const bool knownMethod = this->Method >= CDF_RECONSTRUCTION && this->Method <= HISTOGRAM_CDF;
+  const bool knownMethod = this->Method >= CDF_RECONSTRUCTION && this->Method <= TRANSFER_FUNCTION;
   const bool knownQuery = this->QueryMode >= VOXEL_VALUE && this->QueryMode <= SMOOTHED_VALUE;
   os << indent << "Method: " << (knownMethod ? MethodNames[this->Method] : "(invalid)") << "\n";
   os << indent << "NumberOfBins: " << this->NumberOfBins << "\n";

@@ -55,10 +55,12 @@ class vtkDataArray;
 class vtkDoubleArray;
 class vtkImageData;
 class vtkMultiProcessController;
+class vtkPiecewiseFunction;
 namespace vao
 {
 struct AmbientOcclusionOutput;
 struct AmbientOcclusionParameters;
+struct OpacityFunction;
 struct Region;
 struct Status;
 struct ValueScan;
@@ -79,7 +81,8 @@ public:
     CHEBYSHEV = 2,
     EXACT_BOX = 3,
     EXACT_SPHERE = 4,
-    HISTOGRAM_CDF = 5
+    HISTOGRAM_CDF = 5,
+    TRANSFER_FUNCTION = 6
   };
   enum RadiusUnitsType
   {
@@ -109,6 +112,18 @@ public:
   vtkSetMacro(Method, int);
   vtkGetMacro(Method, int);
   ///@}
+
+  ///@{
+  /// TRANSFER_FUNCTION: the opacity whose box mean occludes (openness = 1 - the mean
+  /// opacity of the box), evaluated as vtkPiecewiseFunction::GetValue does. In ParaView,
+  /// the opacity transfer function of an array (GetOpacityTransferFunction): the filter's
+  /// modification time includes the function's, so editing it re-executes the filter.
+  void SetOpacityFunction(vtkPiecewiseFunction* opacity);
+  vtkPiecewiseFunction* GetOpacityFunction() const;
+  ///@}
+
+  /// Includes the opacity function's modification time.
+  vtkMTimeType GetMTime() override;
 
   ///@{
   /// Radius of the box (the paper's kernel radius), in voxels or world units (default 10).
@@ -241,6 +256,7 @@ protected:
   int NumberOfBins = 64;
   vtkSmartPointer<vtkMultiProcessController> Controller;
   vtkSmartPointer<vtkDataArray> HistogramThresholds;
+  vtkSmartPointer<vtkPiecewiseFunction> OpacityFunction;
   int ErfApproximation = ERF_EXACT;
   vtkTypeBool ComputeVariance = false;
   int Component = -1;
@@ -290,9 +306,12 @@ private:
   /// The radius in voxels for the input's spacing; false when it is 0 on every axis or
   /// covers the whole extent on every axis.
   bool CheckVoxelRadius(vtkImageData* input, const int whole[6], int radius[3]);
-  /// Whether to run on the device: the query is one it computes, the method is an exact
-  /// reference (worth the transfers at any size), the extent's voxels.
-  bool ChooseCuda(bool onDeviceQuery, bool exactMethod, long long voxels);
+  /// Whether to run on the device: what runs on the CPU only (nullptr: nothing; else it
+  /// names it, for the warning), the method is an exact reference (worth the transfers at
+  /// any size), the extent's voxels.
+  bool ChooseCuda(const char* cpuOnly, bool exactMethod, long long voxels);
+  /// The opacity function's nodes for the kernel (TRANSFER_FUNCTION; empty without one).
+  vao::OpacityFunction OpacityNodes() const;
   /// Runs the kernel on the chosen backend; a device failure falls back to the CPU.
   vao::Status Compute(const vao::VolumeView& volume, const vao::Region& region,
     const vao::AmbientOcclusionParameters& parameters, const vao::AmbientOcclusionOutput& arrays);

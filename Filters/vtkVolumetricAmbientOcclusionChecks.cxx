@@ -10,6 +10,7 @@
 #include "vao/Validation.h"
 
 #include "vtkImageData.h"
+#include "vtkPiecewiseFunction.h"
 
 #include <cmath>
 #include <sstream>
@@ -20,15 +21,24 @@ bool vtkVolumetricAmbientOcclusion::CheckParameters()
   // The VTK side: enums, names, the radius before it becomes voxels. The kernel's own
   // checks (finiteness) keep its wording, with the property's name.
   std::ostringstream why;
+  const vao::Status opacity = this->Method == TRANSFER_FUNCTION && this->OpacityFunction
+    ? vao::checkOpacityFunction(this->OpacityNodes())
+    : vao::Status::success();
   const vao::Status iso = this->QueryMode == ISO_VALUE
     ? vao::checkFiniteParameter(this->IsoValue, "IsoValue")
     : vao::Status::success();
   if (!std::isfinite(this->Radius) || this->Radius < 0.0)
     why << "Radius must be a finite, non-negative number (got " << this->Radius << ").";
-  else if (this->Method < CDF_RECONSTRUCTION || this->Method > HISTOGRAM_CDF)
+  else if (this->Method < CDF_RECONSTRUCTION || this->Method > TRANSFER_FUNCTION)
     why << "Unknown Method " << this->Method
         << " (0 CDF Reconstruction, 1 Gaussian CDF, 2 Chebyshev, 3 Exact Box, 4 Exact Sphere, 5 "
-           "Histogram CDF).";
+           "Histogram CDF, 6 Transfer Function).";
+  else if (this->Method == TRANSFER_FUNCTION && !this->OpacityFunction)
+    why << "Method Transfer Function needs an opacity function (OpacityFunction): in ParaView "
+           "the opacity transfer function of an array (GetOpacityTransferFunction), in VTK a "
+           "vtkPiecewiseFunction.";
+  else if (!opacity.ok)
+    why << "OpacityFunction: " << opacity.message << ".";
   else if (this->Method == HISTOGRAM_CDF && !vao::checkHistogramBins(this->NumberOfBins).empty())
     why << vao::checkHistogramBins(this->NumberOfBins) << ".";
   else if (this->RadiusUnits != VOXELS && this->RadiusUnits != WORLD)
