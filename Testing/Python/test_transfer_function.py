@@ -1,0 +1,103 @@
+"""pvpython: Volumetric AO's Transfer Function method follows the opacity transfer function
+the Color Map Editor edits. The filter takes GetOpacityTransferFunction(array) itself, so
+that editing its points (a point moved, a midpoint or sharpness changed) re-executes the
+filter with the new opacity, and an update with nothing changed does not. Ambient Occlusion
+Shading takes the same functions (the view's colour and opacity) and follows their edits.
+
+Each result is compared with a box mean of the opacity written here with numpy (cumulative
+sums, the box clipped to the volume) from vtkPiecewiseFunction.GetValue itself.
+
+Usage: pvpython test_transfer_function.py PLUGIN
+Prints "FAILED: ..." and exits non-zero on a failure."""
+import os
+import sys
+
+import numpy as np
+from paraview.simple import *  # noqa: F401,F403 (and the plugin's proxies, loaded below)
+from paraview import servermanager
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from vao_test_utils import check, finish  # noqa: E402
+
+LoadPlugin(sys.argv[1], ns=globals())
+RADIUS = 4
+
+
+def fetch(proxy, name):
+    data = servermanager.Fetch(proxy)
+    dims = data.GetDimensions()
+    return vtk_to_numpy(data.GetPointData().GetArray(name)).reshape(dims[2], dims[1], dims[0], -1).squeeze()
+
+
+def box_mean(values, r):
+    """The mean over the box of half-width r clipped to the volume, by cumulative sums."""
+    out = values.astype(np.float64)
+    for axis in range(3):
+        n = out.shape[axis]
+        padded = np.concatenate([np.zeros_like(np.take(out, [0], axis=axis)), np.cumsum(out, axis=axis)], axis=axis)
+        hi = np.minimum(np.arange(n) + r + 1, n)
+        lo = np.maximum(np.arange(n) - r, 0)
+        out = (np.take(padded, hi, axis=axis) - np.take(padded, lo, axis=axis))
+        shape = [1, 1, 1]
+        shape[axis] = n
+        out = out / (hi - lo).reshape(shape)
+    return out
+
+
+def reference(density, function):
+    values, inverse = np.unique(density, return_inverse=True)
+    alpha = np.array([function.GetValue(float(v)) for v in values])[inverse].reshape(density.shape)
+    return 1.0 - box_mean(alpha, RADIUS)
+
+
+head = AmbientOcclusionHeadPhantom(Dimensions=[48, 48, 48])
+opacity = GetOpacityTransferFunction("Density")
+# Soft tissue shown, bone (above 300 HU) transparent; ParaView's points are
+# (value, opacity, midpoint, sharpness).
+opacity.Points = [-1000.0, 0.0, 0.5, 0.0, -200.0, 0.3, 0.4, 0.6, 250.0, 0.3, 0.5, 0.0, 300.0, 0.0, 0.5, 0.0]
+ao = VolumetricAmbientOcclusion(Input=head, Method="Transfer Function", Radius=RADIUS, OpacityFunction=opacity)
+ao.Scalars = ["POINTS", "Density"]
+runs = []
+ao.GetClientSideObject().AddObserver("StartEvent", lambda caller, event: runs.append(1))
+function = opacity.GetClientSideObject()
+
+ao.UpdatePipeline()
+density = fetch(head, "Density")
+first = fetch(ao, "AmbientOcclusion")
+error = np.abs(first - reference(density, function)).max()
+check(error <= 1e-6, "Transfer Function equals the box mean of GetValue (max difference %.3g)" % error)
+check(len(runs) == 1, "the filter ran once (%d)" % len(runs))
+ao.UpdatePipeline()
+check(len(runs) == 1, "an update with nothing changed does not re-execute (%d runs)" % len(runs))
+
+# The Color Map Editor's edits: a point moved, then a midpoint and sharpness changed.
+for step, points in enumerate([
+        [-1000.0, 0.0, 0.5, 0.0, -100.0, 0.8, 0.5, 0.0, 250.0, 0.3, 0.5, 0.0, 300.0, 0.0, 0.5, 0.0],
+        [-1000.0, 0.0, 0.5, 0.0, -100.0, 0.8, 0.2, 0.9, 250.0, 0.3, 0.5, 0.0, 300.0, 0.0, 0.5, 0.0]]):
+    before = fetch(ao, "AmbientOcclusion")
+    opacity.Points = points
+    ao.UpdatePipeline()
+    check(len(runs) == 2 + step, "edit %d re-executed the filter (%d runs)" % (step + 1, len(runs)))
+    after = fetch(ao, "AmbientOcclusion")
+    error = np.abs(after - reference(density, function)).max()
+    check(error <= 1e-6 and np.abs(after - before).max() > 1e-3,
+          "edit %d: the AO changed (by up to %.3g) to the new reference (max difference %.3g)"
+          % (step + 1, np.abs(after - before).max(), error))
+
+# Shading with the view's functions: the alpha follows the opacity as it is edited.
+colors = GetColorTransferFunction("Density")
+shaded = AmbientOcclusionShading(Input=ao, ColorTransferFunction=colors, OpacityTransferFunction=opacity)
+shaded.Scalars = ["POINTS", "Density"]
+shaded.UpdatePipeline()
+alpha = fetch(shaded, "ShadedRGBA")[..., 3]
+bone = density > 300
+check(bone.any() and (alpha[bone] == 0).all() and alpha[(density > -150) & (density < 200)].max() > 0,
+      "ShadedRGBA's alpha is the opacity function's: bone transparent, soft tissue shown")
+opacity.Points = [-1000.0, 0.0, 0.5, 0.0, 300.0, 0.0, 0.5, 0.0, 400.0, 1.0, 0.5, 0.0]  # bone shown instead
+shaded.UpdatePipeline()
+alpha = fetch(shaded, "ShadedRGBA")[..., 3]
+check(alpha[density > 400].min() > 0 and (alpha[density < 300] == 0).all(),
+      "editing the opacity function re-shades (bone shown, soft tissue transparent)")
+
+finish("transfer-function AO follows the opacity transfer function")
