@@ -13,13 +13,18 @@ from paraview.simple import *  # noqa: F401,F403
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from vao_test_utils import XML_OPTIONS, extent_logger  # noqa: E402
 
-plugin, source, target = sys.argv[1:4]
+plugin, input_path, target = sys.argv[1:4]
 LoadPlugin(plugin, remote=True, ns=globals())
-if source.endswith(".pvti"):
-    reader = XMLPartitionedImageDataReader(FileName=[source])  # .pvti
-else:
-    reader = XMLImageDataReader(FileName=[source])
-reader.PointArrayStatus = ["MetaImage"]
+
+
+def open_reader():
+    reader = XMLPartitionedImageDataReader(FileName=[input_path]) if input_path.endswith(".pvti") else \
+        XMLImageDataReader(FileName=[input_path])
+    reader.PointArrayStatus = ["MetaImage"]
+    return reader
+
+
+reader = open_reader()
 current = extent_logger(reader, target + ".local")
 # Local filters: each rank needs its piece grown by the radius (10 + 5 + 7 + 2 = 24 voxels
 # for the chain).
@@ -56,3 +61,13 @@ smoothed = VolumetricAmbientOcclusion(Input=histogram, Method="Histogram CDF", R
                                       OutputArrayName="HistogramSmoothed")
 smoothed.Scalars = ["POINTS", "MetaImage"]
 SaveData(target[:-len(".pvti")] + "_histogram.pvti", proxy=smoothed, **XML_OPTIONS)
+
+# Transfer Function AO: the opacity transfer function is the one ParaView keeps for the
+# array (as the GUI's Color Map Editor edits it); each rank needs its piece grown by R
+# (a reader of its own: the shared one keeps the largest extent any branch asked of it).
+opacity = GetOpacityTransferFunction("MetaImage")
+opacity.Points = [-1000.0, 0.0, 0.5, 0.0, -200.0, 0.2, 0.4, 0.6, 400.0, 0.6, 0.5, 0.0, 1500.0, 1.0, 0.5, 0.0]
+transfer = VolumetricAmbientOcclusion(Input=extent_logger(open_reader(), target + ".tf"), Method="Transfer Function",
+                                      Radius=6, OpacityFunction=opacity, OutputArrayName="TransferFunction")
+transfer.Scalars = ["POINTS", "MetaImage"]
+SaveData(target[:-len(".pvti")] + "_tf.pvti", proxy=transfer, **XML_OPTIONS)

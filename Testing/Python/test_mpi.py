@@ -65,8 +65,10 @@ serial_target = run(1)
 serial = read_image(serial_target)
 reference = {name: array_of(serial, name) for name in names}
 serial_histogram = read_image(serial_target[:-len(".pvti")] + "_histogram.pvti")
-for name in ("Histogram", "HistogramSmoothed"):
-    reference[name] = array_of(serial_histogram, name)
+serial_tf = read_image(serial_target[:-len(".pvti")] + "_tf.pvti")
+for data, name in ((serial_histogram, "Histogram"), (serial_histogram, "HistogramSmoothed"),
+                   (serial_tf, "TransferFunction")):
+    reference[name] = array_of(data, name)
     check(reference[name].size == 128 * 128 * 136 and reference[name].std() > 0.05, "serial %s is a real field" % name)
 for name in names:
     values = reference[name]
@@ -92,7 +94,7 @@ for input_path in (source, partitioned):
         extents = [tuple(int(v) for v in p.get("Extent").split()) for p in pieces]
         check(len(extents) == ranks, "%s np %d wrote %d pieces %s" % (kind, ranks, len(extents), extents))
         received = {(label, rank): logged_extent("%s.%s" % (target, label), rank)
-                    for label in ("local", "sweeping", "piece", "histogram") for rank in range(ranks)}
+                    for label in ("local", "sweeping", "piece", "histogram", "tf") for rank in range(ranks)}
         for rank, piece in enumerate(extents):
             slab = received.get(("sweeping", rank))
             thickness = max(slab[2 * a + 1] - slab[2 * a] + 1 for a in range(3) if slab[2 * a:2 * a + 2] !=
@@ -127,6 +129,17 @@ for input_path in (source, partitioned):
             difference = np.abs(array_of(histogram_run, name) - reference[name]).max()
             check(difference == 0.0, "%s np %d: %s (thresholds reduced over the ranks) equals serial "
                   "(max difference %.3g)" % (kind, ranks, name, difference))
+        tf_target = target[:-len(".pvti")] + "_tf.pvti"
+        tf_pieces = [tuple(int(v) for v in p.get("Extent").split())
+                     for p in ET.parse(tf_target).getroot().findall(".//Piece")]
+        for rank, piece in enumerate(tf_pieces):
+            asked = received.get(("tf", rank))
+            check(asked is not None and asked != WHOLE and inside(asked, grown(piece, 6)),
+                  "%s np %d rank %d: Transfer Function AO of the piece %s received %s (the piece grown by R = 6)"
+                  % (kind, ranks, rank, piece, asked))
+        difference = np.abs(array_of(read_image(tf_target), "TransferFunction") - reference["TransferFunction"]).max()
+        check(difference == 0.0, "%s np %d: Transfer Function AO equals serial (max difference %.3g)"
+              % (kind, ranks, difference))
         difference = np.abs(array_of(read_image(direct_target), "Direct") - reference["GaussianCDF"]).max()
         check(difference == 0.0, "%s np %d: Volumetric AO of the pieces equals serial (max difference %.3g)"
               % (kind, ranks, difference))
