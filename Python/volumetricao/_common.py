@@ -13,7 +13,7 @@ from vtkmodules.util.misc import calldata_type
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtkmodules.util.vtkConstants import VTK_STRING
 from vtkmodules.vtkCommonCore import vtkCommand
-from vtkmodules.vtkCommonDataModel import vtkDataObject, vtkImageData
+from vtkmodules.vtkCommonDataModel import vtkDataObject, vtkImageData, vtkPiecewiseFunction
 from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm, vtkAlgorithmOutput
 
 
@@ -76,6 +76,42 @@ def number(value, name):
         return float(value)
     except (TypeError, ValueError):
         raise TypeError("%s must be a number, got %r" % (name, value)) from None
+
+
+def opacity_function(opacity, name="opacity"):
+    """A vtkPiecewiseFunction from one, from a ParaView opacity transfer function
+    (``GetOpacityTransferFunction(array)``: its object is used, so later edits count), or
+    from points: an (N, 2) array of (value, opacity), an (N, 4) array of (value, opacity,
+    midpoint, sharpness), or a flat list in ParaView's ``Points`` order (value, opacity,
+    midpoint, sharpness, ...). Points make a clamped function, as VTK's default."""
+    if isinstance(opacity, vtkPiecewiseFunction):
+        return opacity
+    if hasattr(opacity, "GetClientSideObject"):
+        function = opacity.GetClientSideObject()
+        if isinstance(function, vtkPiecewiseFunction):
+            return function
+        raise TypeError("%s: %r is not an opacity (piecewise) transfer function" % (name, opacity))
+    try:
+        points = np.asarray(opacity, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError("%s: a vtkPiecewiseFunction or (value, opacity) points, got %r" % (name, opacity)) from None
+    if points.ndim == 1 and points.size % 4 == 0 and points.size > 0:
+        points = points.reshape(-1, 4)
+    if points.ndim != 2 or points.shape[1] not in (2, 4) or points.shape[0] == 0:
+        raise ValueError("%s: (N, 2) points (value, opacity) or (N, 4) (value, opacity, midpoint, sharpness), "
+                         "got shape %s" % (name, points.shape))
+    if not np.isfinite(points).all():
+        raise ValueError("%s: the points must be finite (no NaN or infinity)" % name)
+    if ((points[:, 1] < 0) | (points[:, 1] > 1)).any():
+        raise ValueError("%s: opacities must lie in [0, 1]" % name)
+    function = vtkPiecewiseFunction()
+    function.AllowDuplicateScalarsOn()
+    for row in points:
+        if points.shape[1] == 4:
+            function.AddPoint(row[0], row[1], row[2], row[3])
+        else:
+            function.AddPoint(row[0], row[1])
+    return function
 
 
 def three(value, name):

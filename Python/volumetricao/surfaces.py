@@ -138,7 +138,8 @@ def shade(values, ao=None, *, variance=None, shadow=None, sampling=None, color_p
         (default the values' range). opacity_ramp: (low, high), the opacity rising from 0
         to 1 (default the upper half of the range). variance_max <= 0: (range / 20)^2.
     color_transfer_function, opacity_transfer_function: a vtkScalarsToColors and a
-        vtkPiecewiseFunction instead of the preset and the ramp.
+        vtkPiecewiseFunction (or opacity points, as ambient_occlusion's ``opacity`` takes
+        them) instead of the preset and the ramp.
     backend: "auto" or "cpu" ("cuda" warns and runs on the CPU); threads, progress,
         return_info: as for ambient_occlusion.
 
@@ -207,7 +208,8 @@ def shade(values, ao=None, *, variance=None, shadow=None, sampling=None, color_p
     if color_transfer_function is not None:
         shading.SetColorTransferFunction(color_transfer_function)
     if opacity_transfer_function is not None:
-        shading.SetOpacityTransferFunction(opacity_transfer_function)
+        shading.SetOpacityTransferFunction(
+            _common.opacity_function(opacity_transfer_function, "opacity_transfer_function"))
     shading.SetNumberOfThreads(_common.check_threads(threads))
     output = _common.run(shading, progress, cuda_asked=backend_key == "cuda", label="shade")
     (colours,) = _common.point_arrays(output, [output_name], shape, "vtkAmbientOcclusionShading")

@@ -19,6 +19,7 @@ _METHODS = {
     "chebyshev": vtkVolumetricAmbientOcclusion.CHEBYSHEV,
     "exact box": vtkVolumetricAmbientOcclusion.EXACT_BOX,
     "exact sphere": vtkVolumetricAmbientOcclusion.EXACT_SPHERE,
+    "transfer function": vtkVolumetricAmbientOcclusion.TRANSFER_FUNCTION,
 }
 _ERF = {"exact": vtkVolumetricAmbientOcclusion.ERF_EXACT, "winitzki": vtkVolumetricAmbientOcclusion.ERF_WINITZKI}
 _BACKEND = {"auto": vtkVolumetricAmbientOcclusion.BACKEND_AUTO, "cpu": vtkVolumetricAmbientOcclusion.BACKEND_CPU,
@@ -47,7 +48,7 @@ def _volume(array, sampling, spacing, origin):
 def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", world_radius=False,
                       iso_value=None, query_smoothing=None, number_of_bins=64, variance=False, threads=0,
                       origin=None, *, sampling=None, component=None, scalars=None, erf="exact", backend="auto",
-                      device=-1, progress=False, return_info=False):
+                      device=-1, opacity=None, progress=False, return_info=False):
     """Per-voxel ambient occlusion (openness in [0, 1], 1 = open) of a volume: the
     Volumetric Ambient Occlusion filter (``vtkVolumetricAmbientOcclusion``).
 
@@ -59,7 +60,11 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
     radius: half-width of the box, in voxels (in the units of ``sampling`` with
         ``world_radius=True``).
     method: "Histogram CDF" (default, nearly exact), "Gaussian CDF", "CDF Reconstruction",
-        "Chebyshev", "Exact Box", "Exact Sphere" (case and underscores do not matter).
+        "Chebyshev", "Exact Box", "Exact Sphere" (case and underscores do not matter), or
+        "Transfer Function": 1 - the box's mean opacity, with ``opacity``.
+    opacity: the opacity transfer function of method="transfer function": a
+        vtkPiecewiseFunction, ParaView's ``GetOpacityTransferFunction(array)``, or points
+        ((N, 2) value and opacity, (N, 4) with midpoint and sharpness, as VTK takes them).
     iso_value: compare with this value instead of each voxel's own.
     query_smoothing: compare with the voxel's value smoothed by a Gaussian of this sigma
         (voxels) instead (ignored with iso_value).
@@ -92,8 +97,20 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
     Traceback (most recent call last):
         ...
     ValueError: Radius 0 rounds to 0 voxels on every axis: ... Use at least one voxel.
+
+    The openness of what a volume rendering shows, with bone (above 0.7) transparent:
+
+    >>> shown = volumetricao.ambient_occlusion(volume, radius=3, method="transfer function",
+    ...                                        opacity=[(-1, 0), (0, 0.8), (0.7, 0.8), (0.71, 0)])
+    >>> bool(((shown >= 0) & (shown <= 1)).all())
+    True
     """
     chosen = _common.choice(method, _METHODS, "method")
+    if chosen == vtkVolumetricAmbientOcclusion.TRANSFER_FUNCTION and opacity is None:
+        raise ValueError('method="transfer function" needs opacity: points (value, opacity) or a vtkPiecewiseFunction')
+    if chosen != vtkVolumetricAmbientOcclusion.TRANSFER_FUNCTION and opacity is not None:
+        raise ValueError('opacity is used by method="transfer function" only')
+    function = None if opacity is None else _common.opacity_function(opacity)
     erf_key = _common.choice(erf, _ERF, "erf")
     backend_key = _common.check_backend(backend)
     volume = _volume(array, sampling, spacing, origin)
@@ -103,6 +120,8 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
     _common.choose_scalars(ao, scalars)
     _common.set_component(ao, component)
     ao.SetMethod(chosen)
+    if function is not None:
+        ao.SetOpacityFunction(function)
     ao.SetRadius(_common.number(radius, "radius"))
     ao.SetRadiusUnits(vtkVolumetricAmbientOcclusion.WORLD if world_radius else vtkVolumetricAmbientOcclusion.VOXELS)
     ao.SetNumberOfBins(int(number_of_bins))

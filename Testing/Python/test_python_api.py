@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 import volumetricao  # noqa: E402
 from volumetricao import VolumetricAOWarning  # noqa: E402
 from vtkmodules.util.numpy_support import numpy_to_vtk  # noqa: E402
-from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData  # noqa: E402
+from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPiecewiseFunction, vtkPolyData  # noqa: E402
 from vtkmodules.vtkImagingCore import vtkImageCast  # noqa: E402
 
 from vao_test_utils import check, finish, same  # noqa: E402
@@ -97,6 +97,26 @@ for what, other, native, level in [(">i2 (big-endian)", int16.astype(">i2"), int
           and (distance < 0).any() and (distance > 0).any(),
           "%s: equals the native array's AO and sweeping" % what)
 
+
+# method="transfer function": 1 - the mean opacity over the box clipped to the volume. The
+# reference: np.interp is VTK's clamped linear interpolation for default midpoints and
+# sharpness; the box mean by brute force.
+points = [(-200, 0.0), (100, 0.9), (400, 0.2), (600, 0.0)]
+alpha = np.interp(int16.astype(np.float64), *zip(*points))
+expected = np.empty_like(alpha)
+for z, y, x in np.ndindex(*alpha.shape):
+    expected[z, y, x] = 1 - alpha[max(z - 2, 0):z + 3, max(y - 2, 0):y + 3, max(x - 2, 0):x + 3].mean()
+shown = volumetricao.ambient_occlusion(int16, radius=2, method="Transfer_Function", opacity=points)
+check(shown.dtype == np.float32 and np.abs(shown - expected).max() <= 1e-6,
+      "transfer function from (N, 2) points equals 1 - the box mean of the opacity (max difference %.3g)"
+      % np.abs(shown - expected).max())
+function = vtkPiecewiseFunction()
+for value, opacity in points:
+    function.AddPoint(value, opacity, 0.5, 0.0)
+flat = [v for value, opacity in points for v in (value, opacity, 0.5, 0.0)]
+check(same(volumetricao.ambient_occlusion(int16, radius=2, method="transfer function", opacity=function), shown)
+      and same(volumetricao.ambient_occlusion(int16, radius=2, method="transfer function", opacity=flat), shown),
+      "a vtkPiecewiseFunction and ParaView's flat Points give the same transfer-function AO")
 # Exceptions: the filter's sentence, no decoration.
 vertices = np.array([[5.0, 5.0, 5.0]])
 errors = [
@@ -124,6 +144,18 @@ errors = [
     ("threads 1.5", lambda: volumetricao.ambient_occlusion(int16, threads=1.5), TypeError, "integer"),
     ("a string volume", lambda: volumetricao.ambient_occlusion("head.mha"), TypeError, "numpy array"),
     ("a surface as the volume", lambda: volumetricao.ambient_occlusion(vtkPolyData()), TypeError, "image data"),
+    ("method='transfer function' without opacity",
+     lambda: volumetricao.ambient_occlusion(int16, method="transfer function"), ValueError, "needs opacity"),
+    ("opacity with another method", lambda: volumetricao.ambient_occlusion(int16, opacity=[(0, 1)]), ValueError,
+     "opacity is used by"),
+    ("opacity points (N, 3)", lambda: volumetricao.ambient_occlusion(int16, method="transfer function",
+                                                                   opacity=np.ones((2, 3))), ValueError, "(N, 2)"),
+    ("an opacity of 1.5", lambda: volumetricao.ambient_occlusion(int16, method="transfer function",
+                                                                opacity=[(0, 0), (10, 1.5)]), ValueError, "[0, 1]"),
+    ("a NaN opacity point", lambda: volumetricao.ambient_occlusion(int16, method="transfer function",
+                                                                  opacity=[(np.nan, 0)]), ValueError, "finite"),
+    ("an empty vtkPiecewiseFunction", lambda: volumetricao.ambient_occlusion(
+        int16, method="transfer function", opacity=vtkPiecewiseFunction()), ValueError, "no points"),
     ("sampling with a vtkImageData", lambda: volumetricao.ambient_occlusion(image, sampling=1.0), TypeError,
      "own spacing"),
 ]
