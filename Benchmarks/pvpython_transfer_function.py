@@ -1,0 +1,62 @@
+"""Transfer Function AO against the Gaussian CDF, in one pvpython process, and the time to
+follow an edit of the opacity transfer function:
+
+- Volumetric AO, R = 10, on the generated 256x256x415 int16 phantom: the Gaussian CDF and
+  the Transfer Function method run one after the other in each round (this machine's
+  speed drifts within minutes; a round mostly does not), 5 rounds, the median ratio;
+- a 128^3 phantom, R = 10: the opacity's points edited (as the Color Map Editor does), then
+  UpdatePipeline; the time of that update, which re-executes the filter only.
+
+    pvpython Benchmarks/pvpython_transfer_function.py "$(cat build/VolumetricAOPluginPath.txt)"
+"""
+import sys
+import time
+
+from paraview.simple import *  # noqa: F401,F403
+
+LoadPlugin(sys.argv[1], ns=globals())
+ROUNDS = 5
+
+
+def seconds(update):
+    start = time.perf_counter()
+    update()
+    return time.perf_counter() - start
+
+
+def median(values):
+    return sorted(values)[len(values) // 2]
+
+
+# A CT preset with the bone transparent: air 0, soft tissue shown, bone (above 300 HU) 0.
+TISSUE = [-1000.0, 0.0, 0.5, 0.0, -200.0, 0.3, 0.4, 0.6, 250.0, 0.3, 0.5, 0.0, 300.0, 0.0, 0.5, 0.0]
+body = AmbientOcclusionHeadPhantom(Dimensions=[256, 256, 415])
+body.UpdatePipeline()
+opacity = GetOpacityTransferFunction("Density")
+opacity.Points = TISSUE
+times = {"Gaussian CDF": [], "Transfer Function": []}
+ratios = []
+for repeat in range(ROUNDS):
+    for method in times:
+        extra = {"OpacityFunction": opacity} if method == "Transfer Function" else {}
+        proxy = VolumetricAmbientOcclusion(Input=body, Method=method, Radius=10, **extra)
+        times[method].append(seconds(proxy.UpdatePipeline))
+        Delete(proxy)
+    ratios.append(times["Transfer Function"][-1] / times["Gaussian CDF"][-1])
+print("256x256x415 int16, R = 10, %d rounds: Gaussian CDF median %.0f ms, Transfer Function median %.0f ms"
+      % (ROUNDS, median(times["Gaussian CDF"]) * 1e3, median(times["Transfer Function"]) * 1e3))
+print("  Transfer Function / Gaussian CDF, round by round: median %.2fx (%.2f-%.2f)"
+      % (median(ratios), min(ratios), max(ratios)))
+Delete(body)
+
+small = AmbientOcclusionHeadPhantom(Dimensions=[128, 128, 128])
+ao = VolumetricAmbientOcclusion(Input=small, Method="Transfer Function", Radius=10, OpacityFunction=opacity)
+ao.UpdatePipeline()
+edits = []
+for repeat in range(10):
+    points = list(TISSUE)
+    points[5] = 0.2 + 0.05 * (repeat % 5)  # the soft tissue's opacity, as a drag in the editor
+    opacity.Points = points
+    edits.append(seconds(ao.UpdatePipeline))
+print("128^3 int16, R = 10, an opacity edit then UpdatePipeline (10 edits): median %.1f ms, best %.1f ms"
+      % (median(edits) * 1e3, min(edits) * 1e3))
