@@ -38,7 +38,7 @@ ao = VolumetricAmbientOcclusion(Input=wavelet)
 
 # Properties: names, defaults, enumeration texts, documentation.
 expected_enums = {
-    "Method": METHODS,
+    "Method": METHODS + ["Transfer Function"],  # the last needs an opacity function
     "RadiusUnits": ["Voxels", "World"],
     "QueryMode": ["Voxel Value", "Iso Value", "Smoothed Voxel Value"],
     "ErfApproximation": ["Exact", "Winitzki"],
