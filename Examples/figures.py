@@ -6,7 +6,7 @@ under Xvfb, package xvfb):
     xvfb-run -a pvpython --force-offscreen-rendering Examples/figures.py PLUGIN OUTDIR [CT.mha] [--quick]
 
 For the generated head phantom (128^3; 64^3 with --quick) and, when CT.mha is given, for
-that CT head (int16 Hounsfield units), it writes five PNGs per data set, each a row of
+that CT head (int16 Hounsfield units), it writes six PNGs per data set, each a row of
 panels seen from the front (the face looks towards -y, LPS; view up +z):
 
     ruiz_ambient_lighting_<data>.png    volume rendering: no AO, Chebyshev, CDF Reconstruction,
@@ -16,6 +16,9 @@ panels seen from the front (the face looks towards -y, LPS; view up +z):
     accuracy_exact_gaussian_histogram_<data>.png
                                         the same light from Exact Box, Gaussian CDF and
                                         Histogram CDF (R = 10): the paper's estimator against ours
+    transfer_function_<data>.png        soft tissue shown, bone transparent: ambient light from
+                                        the data's order (Histogram CDF) and from the opacity
+                                        the rendering uses (Transfer Function), R = 10
     singh_sweeping_<data>.png           the skin coloured by occlusion sweeping: skylight, the
                                         upper four octants (overcast), one octant (a shadow)
     penner_bone_<data>.png              the bone: diffuse light only, isosurface AO, AO x shadow
@@ -199,6 +202,34 @@ def accuracy(source, array, tag, spacing):
     combine(panels, os.path.join(out_dir, "accuracy_exact_gaussian_histogram_%s.png" % tag))
 
 
+# Soft tissue shown, bone (above 300 HU) transparent: ParaView's opacity points
+# (value, opacity, midpoint, sharpness).
+TISSUE_OPACITY = [-1000.0, 0.0, 0.5, 0.0, -500.0, 0.0, 0.5, 0.0, -200.0, 0.4, 0.5, 0.0, 250.0, 0.4, 0.5, 0.0,
+                  300.0, 0.0, 0.5, 0.0, 3000.0, 0.0, 0.5, 0.0]
+
+
+def transfer_function(source, array, tag, spacing):
+    """The same soft-tissue rendering lit by the data-order AO and by the transfer-function AO:
+    the first darkens the tissue next to the transparent bone, the second does not."""
+    bounds = bounds_of(source)
+    tissue = GetOpacityTransferFunction(array)
+    tissue.Points = TISSUE_OPACITY
+    panels = []
+    for i, method in enumerate(["Histogram CDF", "Transfer Function"]):
+        t0 = time.time()
+        ao = VolumetricAmbientOcclusion(Input=source, Method=method, Radius=10)
+        ao.Scalars = ["POINTS", array]
+        if method == "Transfer Function":
+            ao.OpacityFunction = tissue
+        shaded = AmbientOcclusionShading(Input=ao, OpacityTransferFunction=tissue, ColorPreset="Bone",
+                                         ScalarRange=[-400.0, 400.0])
+        shaded.Scalars = ["POINTS", array]
+        text = "AO by value (Histogram CDF)" if i == 0 else "AO by opacity (Transfer Function)"
+        panels.append(render_rgba(shaded, text, os.path.join(out_dir, "_panel%d.png" % i), bounds, spacing))
+        print("  transfer function %-20s %.1f s" % (method, time.time() - t0))
+    combine(panels, os.path.join(out_dir, "transfer_function_%s.png" % tag))
+
+
 def ruiz(source, array, tag, spacing):
     """Volume rendering lit by AO alone (Ruiz et al. Eq. 5): RGBA from Ambient Occlusion Shading."""
     bounds = bounds_of(source)
@@ -324,6 +355,7 @@ def figures(source, array, tag):
                                                         extent[5] - extent[4] + 1, spacing))
     ruiz(source, array, tag, spacing)
     accuracy(source, array, tag, spacing)
+    transfer_function(source, array, tag, spacing)
     singh(source, array, tag, spacing)
     penner(source, array, tag)
     print("%s: %.1f s" % (tag, time.time() - t0))
