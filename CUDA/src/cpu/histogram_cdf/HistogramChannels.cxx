@@ -6,10 +6,13 @@
 // (TileSize x TileSize output columns, a z-range each), which keeps a tile's state in the
 // L2 cache and the extra memory far below the input's size:
 //  - Window: the counts of the 2 Rz + 1 slices around z, per pixel of the tile grown by
-//    the radius. Moving to the next slice adds one voxel's bin and removes one: O(1), and
-//    nothing where both fall in the same bin.
-//  - Rows: the window summed along x (a running vector per row), then a running vector per
-//    column along y gives the 3-D box histogram of each output voxel.
+//    the radius, in 8-bit lanes where 2 Rz + 1 fits. Moving to the next slice adds one
+//    voxel's bin and removes one: O(1), and nothing where both fall in the same bin. Each
+//    voxel's bin is found once per tile, when its slice enters, and kept in a ring of the
+//    2 Rz + 2 slices' bins for the slice leaving and for the query.
+//  - Rows: the window summed along x (a running vector per row), kept in a ring of the
+//    2 Ry + 2 rows a y window and its next entering row span; a running vector per column
+//    along y then gives the 3-D box histogram of each output voxel.
 // The query q then needs F just below and at the bin of q: a masked sum of the histogram's
 // lanes. Counts never exceed the box's voxel count; lanes are 16 bits when that fits and
 // the intermediate sums may wrap (unsigned arithmetic is modular, and the final counts are
@@ -42,12 +45,32 @@ int laneCount(int bins)
   return (bins + kLaneMultiple - 1) / kLaneMultiple * kLaneMultiple;
 }
 
+/// Whether the window's counts (at most 2 Rz + 1 per pixel) fit 8-bit lanes.
+bool narrowWindow(const Radius& r)
+{
+  return 2 * std::int64_t(r.z) + 1 <= 0xFF;
+}
+
+/// Rows of x sums a tile keeps: those of a y window and its next entering row.
+std::int64_t ringRows(const Radius& r)
+{
+  return 2 * std::int64_t(r.y) + 2;
+}
+
+/// Slices whose bins a tile keeps: those of a z window and its next entering slice.
+std::int64_t ringSlices(const Radius& r)
+{
+  return 2 * std::int64_t(r.z) + 2;
+}
+
 /// Bytes of one worker's state for tiles of `tile` columns: the window counts of the tile
-/// grown by the radius, and the rows summed along x.
+/// grown by the radius, and the ring of rows summed along x.
 std::int64_t tileStateBytes(std::int64_t tile, const Radius& r, int lanes, int laneBytes)
 {
   const std::int64_t span = tile + 2 * std::max(r.x, r.y);
-  return (span * span + span * tile) * lanes * laneBytes;
+  const int windowBytes = narrowWindow(r) ? 1 : laneBytes;
+  return (span * span * windowBytes + std::min(ringRows(r), span) * tile * laneBytes) * lanes +
+    ringSlices(r) * span * span * std::int64_t(sizeof(std::uint16_t));
 }
 
 /// The tile's side: 64 (larger tiles leave the L2 cache, smaller ones recount more of
@@ -69,11 +92,11 @@ std::int64_t tileSize(
 /// pixel `first`, `count` of them, half-width r. Each output is the previous one plus the
 /// pixel entering the window minus the one leaving it (`zeros` stands for a pixel outside
 /// the row): three loads and one store per vector of lanes.
-template <class L>
+template <class L, class W>
 struct RowSums
 {
-  static VAO_ALWAYS_INLINE void run(const L* __restrict src, std::int64_t width, std::int64_t first,
-    std::int64_t count, std::int64_t r, int lanes, const L* __restrict zeros, L* __restrict dst)
+  static VAO_ALWAYS_INLINE void run(const W* __restrict src, std::int64_t width, std::int64_t first,
+    std::int64_t count, std::int64_t r, int lanes, const W* __restrict zeros, L* __restrict dst)
   {
     for (int c = 0; c < lanes; ++c)
       dst[c] = 0;
@@ -81,19 +104,19 @@ struct RowSums
     const std::int64_t hi = std::min<std::int64_t>(width - 1, first + r);
     for (std::int64_t x = lo; x <= hi; ++x)
     {
-      const L* __restrict s = src + x * lanes;
+      const W* __restrict s = src + x * lanes;
       for (int c = 0; c < lanes; ++c)
-        dst[c] = static_cast<L>(dst[c] + s[c]);
+        dst[c] = static_cast<L>(dst[c] + L(s[c]));
     }
     for (std::int64_t i = 1; i < count; ++i)
     {
       const std::int64_t entering = first + i + r, leaving = first + i - r - 1;
-      const L* __restrict in = entering < width ? src + entering * lanes : zeros;
-      const L* __restrict out = leaving >= 0 ? src + leaving * lanes : zeros;
+      const W* __restrict in = entering < width ? src + entering * lanes : zeros;
+      const W* __restrict out = leaving >= 0 ? src + leaving * lanes : zeros;
       const L* __restrict previous = dst + (i - 1) * lanes;
       L* __restrict d = dst + i * lanes;
       for (int c = 0; c < lanes; ++c)
-        d[c] = static_cast<L>(previous[c] + in[c] - out[c]);
+        d[c] = static_cast<L>(previous[c] + L(in[c]) - L(out[c]));
     }
   }
 };
@@ -151,6 +174,23 @@ public:
     }
   }
 
+  /// The bins of n values `stride` apart.
+  void row(const T* in, std::int64_t stride, std::int64_t n, std::uint16_t* out) const
+  {
+    if constexpr (kTable)
+    {
+      const std::uint16_t* table =
+        this->Table.data() - std::int64_t(std::numeric_limits<T>::lowest());
+      for (std::int64_t i = 0; i < n; ++i)
+        out[i] = table[in[i * stride]];
+    }
+    else
+    {
+      for (std::int64_t i = 0; i < n; ++i)
+        out[i] = static_cast<std::uint16_t>((*this)(in[i * stride]));
+    }
+  }
+
   int operator()(T v) const
   {
     if constexpr (kTable)
@@ -182,8 +222,9 @@ struct HistogramJob
   SimdTier simd;
 };
 
-/// One tile's state, reused for the tiles of one worker.
-template <class T, class L>
+/// One tile's state, reused for the tiles of one worker: counts in lanes of L, the window's
+/// in W (8-bit where they fit).
+template <class T, class L, class W>
 class TileHistograms
 {
 public:
@@ -196,10 +237,15 @@ public:
   {
     const std::int64_t tile = job.tile;
     const std::int64_t span = tile + 2 * std::max(job.radius.x, job.radius.y);
+    this->RingRows = std::min(ringRows(job.radius), span);
+    this->RingSlices = ringSlices(job.radius);
+    this->SlicePixels = span * span;
+    this->SliceBins.resize(static_cast<std::size_t>(this->RingSlices * this->SlicePixels));
     this->Window.resize(static_cast<std::size_t>(span * span * this->Lanes));
-    this->Rows.resize(static_cast<std::size_t>(span * tile * this->Lanes));
+    this->Rows.resize(static_cast<std::size_t>(this->RingRows * tile * this->Lanes));
     this->Run.resize(static_cast<std::size_t>(tile * this->Lanes));
     this->Zeros.assign(static_cast<std::size_t>(tile * this->Lanes), L(0));
+    this->WindowZeros.assign(static_cast<std::size_t>(this->Lanes), W(0));
     this->Upper.resize(tile);
     this->Below.resize(tile);
     this->Query.resize(tile);
@@ -222,7 +268,7 @@ public:
     this->HY0 = std::max<std::int64_t>(0, y0 - r.y);
     this->HY1 = std::min<std::int64_t>(dims[1], y0 + ny + r.y);
     const std::int64_t pixels = (this->HX1 - this->HX0) * (this->HY1 - this->HY0);
-    std::fill(this->Window.begin(), this->Window.begin() + pixels * this->Lanes, L(0));
+    std::fill(this->Window.begin(), this->Window.begin() + pixels * this->Lanes, W(0));
     for (std::int64_t s = std::max<std::int64_t>(0, z0 - r.z);
          s <= std::min<std::int64_t>(dims[2] - 1, z0 + r.z); ++s)
     {
@@ -242,6 +288,24 @@ public:
 private:
   const L* zeros() const { return this->Zeros.data(); }
 
+  /// Row y's x sums (outputs X0 ... X0 + NX - 1 of window row y), in the ring.
+  L* rowSums(std::int64_t y)
+  {
+    return &this->Rows[((y - this->HY0) % this->RingRows) * this->NX * this->Lanes];
+  }
+
+  /// Sums window row y along x into its ring slot.
+  const L* sumRow(std::int64_t y)
+  {
+    const std::int64_t width = this->HX1 - this->HX0;
+    L* dst = this->rowSums(y);
+    runRows<RowSums<L, W>>(this->Job.simd,
+      static_cast<const W*>(&this->Window[(y - this->HY0) * width * this->Lanes]), width,
+      this->X0 - this->HX0, this->NX, std::int64_t(this->Job.radius.x), this->Lanes,
+      static_cast<const W*>(this->WindowZeros.data()), dst);
+    return dst;
+  }
+
   /// Adds the bins of slice `entering` to the window and removes those of `leaving` (-1:
   /// none), in one pass that leaves a pixel alone when both voxels fall in the same bin
   /// (most of a smooth volume).
@@ -249,53 +313,59 @@ private:
   {
     const std::int64_t width = this->HX1 - this->HX0;
     const std::int64_t stride = this->Volume.stride;
+    const int bins = this->Bins;
     for (std::int64_t y = this->HY0; y < this->HY1; ++y)
     {
-      const T* in = entering >= 0 ? this->Volume.row(y, entering) : nullptr;
-      const T* out = leaving >= 0 ? this->Volume.row(y, leaving) : nullptr;
-      L* w = &this->Window[(y - this->HY0) * width * this->Lanes];
-      for (std::int64_t x = this->HX0; x < this->HX1; ++x)
+      std::uint16_t* in = nullptr;
+      if (entering >= 0)
+      {
+        in = this->binsOf(entering, y);
+        this->Bin.row(this->Volume.row(y, entering) + this->HX0 * stride, stride, width, in);
+      }
+      const std::uint16_t* out = leaving >= 0 ? this->binsOf(leaving, y) : nullptr;
+      W* w = &this->Window[(y - this->HY0) * width * this->Lanes];
+      for (std::int64_t x = 0; x < width; ++x)
       {
         // A missing slice's voxel is in no bin (index Bins), as a value above every threshold.
-        const int added = in ? this->Bin(in[x * stride]) : this->Bins;
-        const int removed = out ? this->Bin(out[x * stride]) : this->Bins;
+        const int added = in ? in[x] : bins;
+        const int removed = out ? out[x] : bins;
         if (added == removed)
           continue;
-        L* pixel = w + (x - this->HX0) * this->Lanes;
-        if (added < this->Bins)
-          pixel[added] = static_cast<L>(pixel[added] + 1);
-        if (removed < this->Bins)
-          pixel[removed] = static_cast<L>(pixel[removed] - 1);
+        W* pixel = w + x * this->Lanes;
+        if (added < bins)
+          pixel[added] = static_cast<W>(pixel[added] + 1);
+        if (removed < bins)
+          pixel[removed] = static_cast<W>(pixel[removed] - 1);
       }
     }
   }
 
+  /// The bins of row y of slice s (from HX0), in the ring: written when the slice enters,
+  /// read while it is in the z window and when it leaves.
+  std::uint16_t* binsOf(std::int64_t s, std::int64_t y)
+  {
+    return &this->SliceBins[(s % this->RingSlices) * this->SlicePixels +
+      (y - this->HY0) * (this->HX1 - this->HX0)];
+  }
+
   /// The openness of output rows [y0, y0 + ny) of slice z from the window (the counts of
-  /// the slices around z), in three steps: every window row summed along x (RowSums), the
-  /// run along y started on the rows around y0, then per output row the query's bin, the
-  /// masked prefix of the run (the count below that bin) and the openness, before the run
-  /// slides one row down. The run holds one row of histograms, not a plane of them.
+  /// the slices around z): the run along y started on the window rows around y0 summed
+  /// along x (RowSums), then per output row the query's bin, the masked prefix of the run
+  /// (the count below that bin) and the openness, before the run slides one row down by
+  /// the next entering row's x sums. The run holds one row of histograms, not a plane.
   void outputSlice(std::int64_t y0, std::int64_t ny, std::int64_t z)
   {
     const Radius& r = this->Job.radius;
     const Index3& dims = this->Volume.dims;
     const Region& region = this->Job.region;
-    const std::int64_t width = this->HX1 - this->HX0;
     const std::int64_t nx = this->NX;
     const std::int64_t rowValues = nx * this->Lanes;
-    for (std::int64_t y = this->HY0; y < this->HY1; ++y)
-    {
-      runRows<RowSums<L>>(this->Job.simd,
-        static_cast<const L*>(&this->Window[(y - this->HY0) * width * this->Lanes]), width,
-        this->X0 - this->HX0, nx, std::int64_t(r.x), this->Lanes, this->zeros(),
-        &this->Rows[(y - this->HY0) * rowValues]);
-    }
     std::fill(this->Run.begin(), this->Run.end(), L(0));
     for (std::int64_t y = std::max<std::int64_t>(0, y0 - r.y);
          y <= std::min<std::int64_t>(dims[1] - 1, y0 + r.y); ++y)
     {
-      runRows<SlideRun<L>>(this->Job.simd, this->Run.data(),
-        static_cast<const L*>(&this->Rows[(y - this->HY0) * rowValues]), this->zeros(), rowValues);
+      runRows<SlideRun<L>>(
+        this->Job.simd, this->Run.data(), this->sumRow(y), this->zeros(), rowValues);
     }
     const double* t = this->Job.thresholds.data();
     const HistogramQuery& query = this->Job.query;
@@ -303,6 +373,7 @@ private:
     for (std::int64_t y = y0; y < y0 + ny; ++y)
     {
       const T* row = this->Volume.row(y, z);
+      const std::uint16_t* bins = this->binsOf(z, y);
       const std::int64_t out =
         ((z - region.begin[2]) * region.size[1] + (y - region.begin[1])) * region.size[0] +
         (this->X0 - region.begin[0]);
@@ -315,8 +386,8 @@ private:
         else if (query.isoValue)
           q = *query.isoValue;
         this->Query[i] = q;
-        this->Upper[i] =
-          query.values || query.isoValue ? thresholdIndex(q, t, this->Bins) : this->Bin(v);
+        this->Upper[i] = query.values || query.isoValue ? thresholdIndex(q, t, this->Bins)
+                                                        : bins[this->X0 + i - this->HX0];
       }
       runRows<MaskedPrefix<L>>(this->Job.simd, static_cast<const L*>(this->Run.data()),
         static_cast<const int*>(this->Upper.data()), nx, this->Lanes,
@@ -335,13 +406,10 @@ private:
       if (y + 1 < y0 + ny)
       {
         const std::int64_t entering = y + r.y + 1, leaving = y - r.y;
-        runRows<SlideRun<L>>(this->Job.simd, this->Run.data(),
-          entering < dims[1]
-            ? static_cast<const L*>(&this->Rows[(entering - this->HY0) * rowValues])
-            : this->zeros(),
-          leaving >= 0 ? static_cast<const L*>(&this->Rows[(leaving - this->HY0) * rowValues])
-                       : this->zeros(),
-          rowValues);
+        // The leaving row is still in the ring: it holds 2 Ry + 2 rows.
+        const L* in = entering < dims[1] ? this->sumRow(entering) : this->zeros();
+        const L* out = leaving >= 0 ? static_cast<const L*>(this->rowSums(leaving)) : this->zeros();
+        runRows<SlideRun<L>>(this->Job.simd, this->Run.data(), in, out, rowValues);
       }
     }
   }
@@ -350,16 +418,20 @@ private:
   const HistogramJob& Job;
   const BinOf<T>& Bin;
   int Bins, Lanes;
+  std::int64_t RingRows = 0, RingSlices = 0, SlicePixels = 0;
   std::int64_t X0 = 0, NX = 0, HX0 = 0, HX1 = 0, HY0 = 0, HY1 = 0;
-  std::vector<L> Window, Rows, Run;
-  std::vector<L> Zeros; // a row of pixels outside the volume
-  std::vector<L> Masks; // row u: all ones in the lanes below u
+  std::vector<W> Window;
+  std::vector<L> Rows, Run;
+  std::vector<L> Zeros;                 // a row of pixels outside the volume
+  std::vector<W> WindowZeros;           // one window pixel outside the volume
+  std::vector<std::uint16_t> SliceBins; // the ring of the slices' bins (binsOf)
+  std::vector<L> Masks;                 // row u: all ones in the lanes below u
   std::vector<int> Upper;
   std::vector<std::uint32_t> Below;
   std::vector<double> Query;
 };
 
-template <class T, class L>
+template <class T, class L, class W>
 bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const Execution& execution)
 {
   const BinOf<T> bin(job.thresholds);
@@ -376,7 +448,7 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
     execution,
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
     {
-      TileHistograms<T, L> state(volume, job, bin);
+      TileHistograms<T, L, W> state(volume, job, bin);
       for (std::int64_t u = begin; u < end && !progress.stopped(); ++u)
       {
         const std::int64_t part = u % zParts, t = u / zParts;
@@ -414,8 +486,12 @@ bool computeHistogramOpenness(const VolumeView& view, const Region& region, cons
         tileSize(inputBytes, radius, lanes, laneBytes, resolveThreadCount(execution.threads)),
         region, radius, thresholds, query, openness, cpuSimdTierUpTo(SimdTier::Avx2)
       }; // AVX-512 loses here
-      return laneBytes == 2 ? computeTiles<T, std::uint16_t>(volume, job, execution)
-                            : computeTiles<T, std::uint32_t>(volume, job, execution);
+      if (narrowWindow(radius))
+        return laneBytes == 2
+          ? computeTiles<T, std::uint16_t, std::uint8_t>(volume, job, execution)
+          : computeTiles<T, std::uint32_t, std::uint8_t>(volume, job, execution);
+      return laneBytes == 2 ? computeTiles<T, std::uint16_t, std::uint16_t>(volume, job, execution)
+                            : computeTiles<T, std::uint32_t, std::uint32_t>(volume, job, execution);
     });
 }
 
