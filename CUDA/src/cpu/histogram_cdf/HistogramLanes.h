@@ -1,0 +1,217 @@
+// The lane loops of Histogram CDF on the CPU (HistogramChannels.cxx) and the bins of
+// values. A pixel's histogram is a vector of `lanes` small unsigned counts held
+// cumulatively: lane c counts the voxels of bin c or below, so that adding a voxel adds a
+// row of a mask table and the count below a bin is one lane. The loops are structs whose
+// run() runRows compiles for AVX2 as well (CpuDispatch.h); `Fixed` is the lane count when
+// it is known at compile time (the default 64 bins), 0 when it is read at run time.
+#pragma once
+
+#include "cpu/simd/CpuDispatch.h"
+
+#include "vao/Estimators.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <type_traits>
+#include <vector>
+
+namespace vao
+{
+namespace detail
+{
+
+/// The z window moves one slice at one row of pixels: each pixel adds the cumulative mask
+/// of the entering voxel's bin and subtracts the leaving one's (`in` or `out` null: a
+/// slice outside the volume, as the empty bin `bins`). Pixels whose two voxels share a
+/// bin, most of a smooth volume, are left alone. Counts wrap modulo the lanes' width,
+/// which holds the window's 2 Rz + 1.
+template <class W, int Fixed>
+struct MoveRow
+{
+  static VAO_ALWAYS_INLINE void run(const std::uint16_t* __restrict in,
+    const std::uint16_t* __restrict out, std::int64_t width, W* __restrict window,
+    const W* __restrict cumulativeMasks, int runtimeLanes, int bins)
+  {
+    const int lanes = Fixed ? Fixed : runtimeLanes;
+    for (std::int64_t x = 0; x < width; ++x)
+    {
+      const int added = in ? in[x] : bins;
+      const int removed = out ? out[x] : bins;
+      if (added == removed)
+        continue;
+      const W* __restrict plus = cumulativeMasks + std::int64_t(added) * lanes;
+      const W* __restrict minus = cumulativeMasks + std::int64_t(removed) * lanes;
+      W* __restrict pixel = window + x * lanes;
+      for (int c = 0; c < lanes; ++c)
+        pixel[c] = static_cast<W>(pixel[c] + plus[c] - minus[c]);
+    }
+  }
+};
+
+/// columns += entering - leaving over n lanes: the y window's sums move one row down.
+template <class L, class W>
+struct SlideRows
+{
+  static VAO_ALWAYS_INLINE void run(L* __restrict columns, const W* __restrict entering,
+    const W* __restrict leaving, std::int64_t n)
+  {
+    for (std::int64_t c = 0; c < n; ++c)
+      columns[c] = static_cast<L>(columns[c] + L(entering[c]) - L(leaving[c]));
+  }
+};
+
+/// The x window over one row of `columns` (width pixels, each the y and z window's
+/// cumulative counts), for the outputs from pixel `first`, `count` of them, half-width r:
+/// a running histogram plus the pixel entering minus the one leaving, stored per output in
+/// `histograms`. Output i then takes from its histogram the count below its bin upper[i]
+/// and the count in that bin: below[i] = h[u - 1] (0 for u = 0), at[i] = h[u] - below[i]
+/// (0 for u = bins). (Read once the row is stored: a lane read back from the vector just
+/// stored would wait for the store.)
+template <class L, int Fixed>
+struct RowQuery
+{
+  static VAO_ALWAYS_INLINE void run(const L* __restrict columns, std::int64_t width,
+    std::int64_t first, std::int64_t count, std::int64_t r, int runtimeLanes,
+    const int* __restrict upper, int bins, L* __restrict histograms,
+    std::uint32_t* __restrict below, std::uint32_t* __restrict at)
+  {
+    const int lanes = Fixed ? Fixed : runtimeLanes;
+    L* __restrict h = histograms;
+    for (int c = 0; c < lanes; ++c)
+      h[c] = 0;
+    const std::int64_t lo = first - r > 0 ? first - r : 0;
+    const std::int64_t hi = first + r < width - 1 ? first + r : width - 1;
+    for (std::int64_t x = lo; x <= hi; ++x)
+      for (int c = 0; c < lanes; ++c)
+        h[c] = static_cast<L>(h[c] + columns[x * lanes + c]);
+    for (std::int64_t i = 1; i < count; ++i)
+    {
+      const std::int64_t entering = first + i + r, leaving = first + i - r - 1;
+      const L* __restrict previous = histograms + (i - 1) * lanes;
+      L* __restrict next = histograms + i * lanes;
+      const L* __restrict in = entering < width ? columns + entering * lanes : nullptr;
+      const L* __restrict out = leaving >= 0 ? columns + leaving * lanes : nullptr;
+      if (in && out)
+        for (int c = 0; c < lanes; ++c)
+          next[c] = static_cast<L>(previous[c] + in[c] - out[c]);
+      else if (in)
+        for (int c = 0; c < lanes; ++c)
+          next[c] = static_cast<L>(previous[c] + in[c]);
+      else if (out)
+        for (int c = 0; c < lanes; ++c)
+          next[c] = static_cast<L>(previous[c] - out[c]);
+      else
+        for (int c = 0; c < lanes; ++c)
+          next[c] = previous[c];
+    }
+    for (std::int64_t i = 0; i < count; ++i)
+    {
+      const L* __restrict hist = histograms + i * lanes;
+      const int u = upper[i];
+      const std::uint32_t under = u > 0 ? hist[u - 1] : 0;
+      below[i] = under;
+      at[i] = u < bins ? static_cast<std::uint32_t>(static_cast<L>(hist[u] - under)) : 0;
+    }
+  }
+};
+
+/// The openness of `count` output voxels from their queries q, bins upper, box counts and
+/// the counts below and in their bins: opennessHistogramCdfAt's formula with its branches
+/// as selections, so that the row is a vector loop (three divisions per voxel).
+/// `lowerEnd[u]` and `upperEnd[u]` are t_(u-1) and t_u for u in [0, n] (the nearest
+/// threshold where one is missing). Compiled without fused multiply-adds, as the formula.
+struct CdfOpenness
+{
+  static VAO_ALWAYS_INLINE void run(const double* __restrict q, const int* __restrict upper,
+    const double* __restrict boxCounts, const std::uint32_t* __restrict below,
+    const std::uint32_t* __restrict at, const double* __restrict lowerEnd,
+    const double* __restrict upperEnd, double first, double last, int n, std::int64_t count,
+    float* __restrict openness)
+  {
+    for (std::int64_t i = 0; i < count; ++i)
+    {
+      const int u = upper[i];
+      const double under = static_cast<double>(below[i]);
+      const double fUpper = (under + static_cast<double>(at[i])) / boxCounts[i];
+      const double fLower = under / boxCounts[i];
+      const double tLower = lowerEnd[u], tUpper = upperEnd[u];
+      const double a = (q[i] - tLower) / (tUpper - tLower);
+      const double line = fLower + a * (fUpper - fLower);
+      const double low = line < 0.0 ? 0.0 : line; // clamp01, as selections
+      const double between = low > 1.0 ? 1.0 : low;
+      const double f = q[i] == tUpper ? fUpper : between;
+      const bool top = (u >= n - 1) & (q[i] >= last);
+      const double o = top ? 1.0 : f;
+      openness[i] = static_cast<float>(q[i] < first ? 0.0 : o);
+    }
+  }
+};
+
+/// Bin of a value: a table over the whole type for 8- and 16-bit integers, else a search
+/// that gives thresholdIndex's answer without a branch per step (the thresholds padded
+/// with infinity to a power of two: random values would mispredict half the steps).
+template <class T>
+class BinOf
+{
+public:
+  BinOf(const std::vector<double>& thresholds)
+    : Thresholds(thresholds)
+  {
+    std::size_t padded = 1;
+    while (padded < thresholds.size())
+      padded *= 2;
+    this->Padded.assign(padded, std::numeric_limits<double>::infinity());
+    std::copy(thresholds.begin(), thresholds.end(), this->Padded.begin());
+    if (kTable)
+    {
+      const double lowest = static_cast<double>(std::numeric_limits<T>::lowest());
+      this->Table.resize(std::size_t(1) << (8 * sizeof(T)));
+      for (std::size_t i = 0; i < this->Table.size(); ++i)
+      {
+        this->Table[i] = static_cast<std::uint16_t>(thresholdIndex(
+          lowest + static_cast<double>(i), thresholds.data(), static_cast<int>(thresholds.size())));
+      }
+    }
+  }
+
+  /// The bins of n values `stride` apart.
+  void row(const T* in, std::int64_t stride, std::int64_t n, std::uint16_t* out) const
+  {
+    if constexpr (kTable)
+    {
+      const std::uint16_t* table =
+        this->Table.data() - std::int64_t(std::numeric_limits<T>::lowest());
+      for (std::int64_t i = 0; i < n; ++i)
+        out[i] = table[in[i * stride]];
+    }
+    else
+    {
+      for (std::int64_t i = 0; i < n; ++i)
+        out[i] = static_cast<std::uint16_t>(this->search(static_cast<double>(in[i * stride])));
+    }
+  }
+
+  /// thresholdIndex(q): the number of thresholds below q (q not NaN).
+  int search(double q) const
+  {
+    const double* first = this->Padded.data();
+    std::size_t count = this->Padded.size();
+    while (count > 1)
+    {
+      const std::size_t half = count / 2;
+      first = first[half] < q ? first + half : first;
+      count -= half;
+    }
+    return static_cast<int>(first - this->Padded.data()) + (*first < q ? 1 : 0);
+  }
+
+private:
+  static constexpr bool kTable = std::is_integral<T>::value && sizeof(T) <= 2;
+  const std::vector<double>& Thresholds;
+  std::vector<double> Padded;
+  std::vector<std::uint16_t> Table;
+};
+
+} // namespace detail
+} // namespace vao
