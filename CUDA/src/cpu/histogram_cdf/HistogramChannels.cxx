@@ -248,21 +248,19 @@ private:
   void queryBins(std::int64_t y, std::int64_t z)
   {
     const HistogramQuery& query = this->Job.query;
-    const T* row = this->Volume.row(y, z);
-    const std::uint16_t* bins = this->binsOf(z, y) + (this->X0 - this->HX0);
+    if (!query.values && !query.isoValue) // the voxels' own values, and the bins kept
+    {
+      runRows<VoxelQueries<T>>(this->Job.simd,
+        this->Volume.row(y, z) + this->X0 * this->Volume.stride, this->Volume.stride,
+        static_cast<const std::uint16_t*>(this->binsOf(z, y) + (this->X0 - this->HX0)), this->NX,
+        this->Query.data(), this->Upper.data());
+      return;
+    }
     const std::int64_t out = this->outputIndex(y, z);
     for (std::int64_t i = 0; i < this->NX; ++i)
     {
-      if (query.values || query.isoValue)
-      {
-        this->Query[i] = query.values ? query.values[out + i] : *query.isoValue;
-        this->Upper[i] = this->Bin.search(this->Query[i]);
-      }
-      else
-      {
-        this->Query[i] = static_cast<double>(row[(this->X0 + i) * this->Volume.stride]);
-        this->Upper[i] = bins[i];
-      }
+      this->Query[i] = query.values ? query.values[out + i] : *query.isoValue;
+      this->Upper[i] = this->Bin.search(this->Query[i]);
     }
   }
 

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <type_traits>
 #include <vector>
@@ -23,9 +24,9 @@ namespace detail
 
 /// The z window moves one slice at one row of pixels: each pixel adds the cumulative mask
 /// of the entering voxel's bin and subtracts the leaving one's (`in` or `out` null: a
-/// slice outside the volume, as the empty bin `bins`). Pixels whose two voxels share a
-/// bin, most of a smooth volume, are left alone. Counts wrap modulo the lanes' width,
-/// which holds the window's 2 Rz + 1.
+/// slice outside the volume, as the empty bin `bins`). A pixel whose two voxels share a
+/// bin adds and subtracts the same row: no branch, which noisy data would mispredict.
+/// Counts wrap modulo the lanes' width, which holds the window's 2 Rz + 1.
 template <class W, int Fixed>
 struct MoveRow
 {
@@ -38,8 +39,6 @@ struct MoveRow
     {
       const int added = in ? in[x] : bins;
       const int removed = out ? out[x] : bins;
-      if (added == removed)
-        continue;
       const W* __restrict plus = cumulativeMasks + std::int64_t(added) * lanes;
       const W* __restrict minus = cumulativeMasks + std::int64_t(removed) * lanes;
       W* __restrict pixel = window + x * lanes;
@@ -73,37 +72,35 @@ struct RowQuery
 {
   static VAO_ALWAYS_INLINE void run(const L* __restrict columns, std::int64_t width,
     std::int64_t first, std::int64_t count, std::int64_t r, int runtimeLanes,
-    const int* __restrict upper, int bins, L* __restrict histograms,
-    std::uint32_t* __restrict below, std::uint32_t* __restrict at)
+    const int* __restrict upper, int bins, L* histograms, std::uint32_t* __restrict below,
+    std::uint32_t* __restrict at)
   {
     const int lanes = Fixed ? Fixed : runtimeLanes;
-    L* __restrict h = histograms;
-    for (int c = 0; c < lanes; ++c)
-      h[c] = 0;
     const std::int64_t lo = first - r > 0 ? first - r : 0;
     const std::int64_t hi = first + r < width - 1 ? first + r : width - 1;
-    for (std::int64_t x = lo; x <= hi; ++x)
-      for (int c = 0; c < lanes; ++c)
-        h[c] = static_cast<L>(h[c] + columns[x * lanes + c]);
-    for (std::int64_t i = 1; i < count; ++i)
+    if constexpr (Fixed > 0)
+      runningRegisters(columns, width, first, count, r, lo, hi, histograms);
+    else
     {
-      const std::int64_t entering = first + i + r, leaving = first + i - r - 1;
-      const L* __restrict previous = histograms + (i - 1) * lanes;
-      L* __restrict next = histograms + i * lanes;
-      const L* __restrict in = entering < width ? columns + entering * lanes : nullptr;
-      const L* __restrict out = leaving >= 0 ? columns + leaving * lanes : nullptr;
-      if (in && out)
+      // Each output starts from the one stored before it.
+      for (int c = 0; c < lanes; ++c)
+        histograms[c] = 0;
+      for (std::int64_t x = lo; x <= hi; ++x)
         for (int c = 0; c < lanes; ++c)
-          next[c] = static_cast<L>(previous[c] + in[c] - out[c]);
-      else if (in)
+          histograms[c] = static_cast<L>(histograms[c] + columns[x * lanes + c]);
+      for (std::int64_t i = 1; i < count; ++i)
+      {
+        const std::int64_t entering = first + i + r, leaving = first + i - r - 1;
+        L* next = histograms + i * lanes;
         for (int c = 0; c < lanes; ++c)
-          next[c] = static_cast<L>(previous[c] + in[c]);
-      else if (out)
-        for (int c = 0; c < lanes; ++c)
-          next[c] = static_cast<L>(previous[c] - out[c]);
-      else
-        for (int c = 0; c < lanes; ++c)
-          next[c] = previous[c];
+          next[c] = histograms[(i - 1) * lanes + c];
+        if (entering < width)
+          for (int c = 0; c < lanes; ++c)
+            next[c] = static_cast<L>(next[c] + columns[entering * lanes + c]);
+        if (leaving >= 0)
+          for (int c = 0; c < lanes; ++c)
+            next[c] = static_cast<L>(next[c] - columns[leaving * lanes + c]);
+      }
     }
     for (std::int64_t i = 0; i < count; ++i)
     {
@@ -112,6 +109,65 @@ struct RowQuery
       const std::uint32_t under = u > 0 ? hist[u - 1] : 0;
       below[i] = under;
       at[i] = u < bins ? static_cast<std::uint32_t>(static_cast<L>(hist[u] - under)) : 0;
+    }
+  }
+
+  /// The running histogram of a known lane count in vector registers (GCC's and Clang's
+  /// vector types, 64 bytes each), stored per output: a value read back from memory would
+  /// wait for its own store on every output.
+  static VAO_ALWAYS_INLINE void runningRegisters(const L* __restrict columns, std::int64_t width,
+    std::int64_t first, std::int64_t count, std::int64_t r, std::int64_t lo, std::int64_t hi,
+    L* __restrict histograms)
+  {
+    typedef L Vector __attribute__((vector_size(64)));
+    constexpr int kPerVector = 64 / sizeof(L);
+    constexpr int kVectors = Fixed / kPerVector;
+    static_assert(Fixed % kPerVector == 0, "whole vectors of lanes");
+    Vector h[kVectors] = {};
+    Vector v;
+    for (std::int64_t x = lo; x <= hi; ++x)
+      for (int k = 0; k < kVectors; ++k)
+      {
+        std::memcpy(&v, columns + x * Fixed + k * kPerVector, sizeof(v));
+        h[k] += v;
+      }
+    for (std::int64_t i = 0; i < count; ++i)
+    {
+      if (i > 0)
+      {
+        const std::int64_t entering = first + i + r, leaving = first + i - r - 1;
+        if (entering < width)
+          for (int k = 0; k < kVectors; ++k)
+          {
+            std::memcpy(&v, columns + entering * Fixed + k * kPerVector, sizeof(v));
+            h[k] += v;
+          }
+        if (leaving >= 0)
+          for (int k = 0; k < kVectors; ++k)
+          {
+            std::memcpy(&v, columns + leaving * Fixed + k * kPerVector, sizeof(v));
+            h[k] -= v;
+          }
+      }
+      for (int k = 0; k < kVectors; ++k)
+        std::memcpy(histograms + i * Fixed + k * kPerVector, &h[k], sizeof(Vector));
+    }
+  }
+};
+
+/// q[i] = the value of voxel i of a row, upper[i] = its bin (kept from when its slice
+/// entered the window).
+template <class T>
+struct VoxelQueries
+{
+  static VAO_ALWAYS_INLINE void run(const T* __restrict values, std::int64_t stride,
+    const std::uint16_t* __restrict bins, std::int64_t count, double* __restrict q,
+    int* __restrict upper)
+  {
+    for (std::int64_t i = 0; i < count; ++i)
+    {
+      q[i] = static_cast<double>(values[i * stride]);
+      upper[i] = bins[i];
     }
   }
 };
