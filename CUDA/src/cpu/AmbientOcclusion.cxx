@@ -145,7 +145,7 @@ Status separateOpenness(const VolumeView& volume, const Region& region,
     source.values = q;
     source.isoValue = parameters.queryMode == QueryMode::IsoValue ? &parameters.isoValue : nullptr;
     if (!detail::computeHistogramOpenness(
-          volume, region, parameters.radius, parameters.thresholds, source, openness, stage))
+          volume, region, parameters.radius, parameters.thresholds, source, openness, range, stage))
       return Status::cancelled();
     return Status::success();
   }

@@ -24,6 +24,7 @@
 #include "cpu/histogram_cdf/HistogramLanes.h"
 
 #include "VolumeAccess.h"
+#include "cpu/common/ConcurrentRange.h"
 #include "cpu/common/Parallel.h"
 #include "cpu/simd/CpuDispatch.h"
 
@@ -95,6 +96,7 @@ struct HistogramJob
   const HistogramQuery& query;
   float* openness;
   SimdTier simd;
+  ConcurrentRange* range; // keeps the range of what is written, or null
 };
 
 /// One tile's state, reused for the tiles of one worker: counts in lanes of L, the window's
@@ -282,6 +284,8 @@ private:
       static_cast<const double*>(this->LowerEnd.data()),
       static_cast<const double*>(this->UpperEnd.data()), t.front(), t.back(), this->Bins, this->NX,
       this->Job.openness + this->outputIndex(y, z));
+    if (this->Job.range)
+      this->Job.range->add(this->Job.openness + this->outputIndex(y, z), this->NX);
   }
 
   /// Index in the output of voxel (X0, y, z).
@@ -347,8 +351,9 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
 
 bool computeHistogramOpenness(const VolumeView& view, const Region& region, const Radius& radius,
   const std::vector<double>& thresholds, const HistogramQuery& query, float* openness,
-  const Execution& execution)
+  OutputRange* range, const Execution& execution)
 {
+  ConcurrentRange seen;
   // The largest box: its count must fit the lanes.
   std::int64_t largest = 1;
   const int r[3] = { radius.x, radius.y, radius.z };
@@ -356,7 +361,7 @@ bool computeHistogramOpenness(const VolumeView& view, const Region& region, cons
     largest *= std::min<std::int64_t>(2 * std::int64_t(r[a]) + 1, view.dims[a]);
   const int laneBytes = largest <= 0xFFFF ? 2 : 4;
   const int lanes = laneCount(static_cast<int>(thresholds.size()));
-  return dispatchScalarType(view.type,
+  const bool done = dispatchScalarType(view.type,
     [&](auto tag)
     {
       using T = decltype(tag);
@@ -364,7 +369,8 @@ bool computeHistogramOpenness(const VolumeView& view, const Region& region, cons
       const std::int64_t inputBytes = view.voxelCount() * static_cast<std::int64_t>(sizeof(T));
       const HistogramJob job{ tileSize(inputBytes, radius, lanes, laneBytes,
                                 resolveThreadCount(execution.threads)),
-        region, radius, thresholds, query, openness, cpuSimdTierUpTo(SimdTier::Avx512) };
+        region, radius, thresholds, query, openness, cpuSimdTierUpTo(SimdTier::Avx512),
+        range ? &seen : nullptr };
       // The default 64 bins in 16-bit lanes: loops of a known length.
       if (narrowWindow(radius) && laneBytes == 2 && lanes == 64)
         return computeTiles<T, std::uint16_t, std::uint8_t, 64>(volume, job, execution);
@@ -376,6 +382,9 @@ bool computeHistogramOpenness(const VolumeView& view, const Region& region, cons
         ? computeTiles<T, std::uint16_t, std::uint16_t, 0>(volume, job, execution)
         : computeTiles<T, std::uint32_t, std::uint32_t, 0>(volume, job, execution);
     });
+  if (done && range)
+    *range = seen.result();
+  return done;
 }
 
 } // namespace detail

@@ -19,10 +19,11 @@ struct HistogramQuery
 };
 
 /// Histogram CDF openness of the region's voxels for the ascending thresholds (at most
-/// kMaximumHistogramBins of them). Returns false when cancelled.
+/// kMaximumHistogramBins of them), and their range into `range` unless it is null.
+/// Returns false when cancelled.
 bool computeHistogramOpenness(const VolumeView& volume, const Region& region, const Radius& radius,
   const std::vector<double>& thresholds, const HistogramQuery& query, float* openness,
-  const Execution& execution);
+  OutputRange* range, const Execution& execution);
 
 } // namespace detail
 } // namespace vao

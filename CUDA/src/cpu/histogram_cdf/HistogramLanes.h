@@ -164,11 +164,18 @@ struct VoxelQueries
     const std::uint16_t* __restrict bins, std::int64_t count, double* __restrict q,
     int* __restrict upper)
   {
-    for (std::int64_t i = 0; i < count; ++i)
-    {
-      q[i] = static_cast<double>(values[i * stride]);
-      upper[i] = bins[i];
-    }
+    if (stride == 1)
+      for (std::int64_t i = 0; i < count; ++i)
+      {
+        q[i] = static_cast<double>(values[i]);
+        upper[i] = bins[i];
+      }
+    else
+      for (std::int64_t i = 0; i < count; ++i)
+      {
+        q[i] = static_cast<double>(values[i * stride]);
+        upper[i] = bins[i];
+      }
   }
 };
 
