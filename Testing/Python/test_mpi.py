@@ -108,35 +108,28 @@ for input_path in (source, partitioned):
             check(local is not None and local != WHOLE and inside(local, grown(slab, RADII)),
                   "%s np %d rank %d: the local filters received %s, not the whole volume, within the "
                   "extent they produce %s grown by %d" % (kind, ranks, rank, local, slab, RADII))
-        direct_target = target[:-len(".pvti")] + "_direct.pvti"
-        direct_pieces = [tuple(int(v) for v in p.get("Extent").split())
-                         for p in ET.parse(direct_target).getroot().findall(".//Piece")]
-        for rank, piece in enumerate(direct_pieces):
-            asked = received.get(("piece", rank))
-            check(asked is not None and asked != WHOLE and inside(asked, grown(piece, 10)),
-                  "%s np %d rank %d: Volumetric AO of the piece %s received %s (the piece grown by R = 10)"
-                  % (kind, ranks, rank, piece, asked))
-        histogram_target = target[:-len(".pvti")] + "_histogram.pvti"
-        histogram_pieces = [tuple(int(v) for v in p.get("Extent").split())
-                            for p in ET.parse(histogram_target).getroot().findall(".//Piece")]
-        for rank, piece in enumerate(histogram_pieces):
-            asked = received.get(("histogram", rank))
-            check(asked is not None and asked != WHOLE and inside(asked, grown(piece, 11)),
-                  "%s np %d rank %d: Histogram CDF of the piece %s received %s (the piece grown by 5 + 6)"
-                  % (kind, ranks, rank, piece, asked))
+
+        def pieces_received(suffix, label, reach, what):
+            """Checks that each rank's branch `label` read its written piece grown by
+            `reach`, not the whole volume; returns the branch's output file."""
+            path = target[:-len(".pvti")] + suffix
+            pieces = [tuple(int(v) for v in p.get("Extent").split())
+                      for p in ET.parse(path).getroot().findall(".//Piece")]
+            for rank, piece in enumerate(pieces):
+                asked = received.get((label, rank))
+                check(asked is not None and asked != WHOLE and inside(asked, grown(piece, reach)),
+                      "%s np %d rank %d: %s of the piece %s received %s (the piece grown by %d)"
+                      % (kind, ranks, rank, what, piece, asked, reach))
+            return path
+
+        direct_target = pieces_received("_direct.pvti", "piece", 10, "Volumetric AO")
+        histogram_target = pieces_received("_histogram.pvti", "histogram", 11, "Histogram CDF (R = 5 + 6)")
         histogram_run = read_image(histogram_target)
         for name in ("Histogram", "HistogramSmoothed"):
             difference = np.abs(array_of(histogram_run, name) - reference[name]).max()
             check(difference == 0.0, "%s np %d: %s (thresholds reduced over the ranks) equals serial "
                   "(max difference %.3g)" % (kind, ranks, name, difference))
-        tf_target = target[:-len(".pvti")] + "_tf.pvti"
-        tf_pieces = [tuple(int(v) for v in p.get("Extent").split())
-                     for p in ET.parse(tf_target).getroot().findall(".//Piece")]
-        for rank, piece in enumerate(tf_pieces):
-            asked = received.get(("tf", rank))
-            check(asked is not None and asked != WHOLE and inside(asked, grown(piece, 6)),
-                  "%s np %d rank %d: Transfer Function AO of the piece %s received %s (the piece grown by R = 6)"
-                  % (kind, ranks, rank, piece, asked))
+        tf_target = pieces_received("_tf.pvti", "tf", 6, "Transfer Function AO")
         difference = np.abs(array_of(read_image(tf_target), "TransferFunction") - reference["TransferFunction"]).max()
         check(difference == 0.0, "%s np %d: Transfer Function AO equals serial (max difference %.3g)"
               % (kind, ranks, difference))
