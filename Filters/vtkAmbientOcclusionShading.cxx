@@ -2,6 +2,7 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionMemory.h"
+#include "vtkAmbientOcclusionOpacity.h"
 #include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkAmbientOcclusionCollectives.h"
@@ -104,6 +105,9 @@ std::string vtkAmbientOcclusionShading::CheckInput(
 {
   std::ostringstream why;
   vtkDataArray* ao = pd->GetArray(this->AmbientOcclusionArrayName.c_str());
+  const std::string opacity = this->Opacity
+    ? vtkAmbientOcclusionOpacity::Check(this->Opacity, "OpacityTransferFunction")
+    : std::string();
   if (!std::isfinite(this->AmbientIntensity) || this->AmbientIntensity < 0.0)
     why << "AmbientIntensity must be a finite, non-negative number (got " << this->AmbientIntensity
         << ").";
@@ -134,6 +138,8 @@ std::string vtkAmbientOcclusionShading::CheckInput(
     why << "OpacityRamp must be finite (got " << this->OpacityRamp[0] << ", "
         << this->OpacityRamp[1]
         << "); an empty ramp such as (1, 0) means the upper half of the range.";
+  else if (!opacity.empty())
+    why << opacity;
   if (!why.str().empty())
     return why.str();
   // The arrays the colours come from, read a value a point: one short of the points would

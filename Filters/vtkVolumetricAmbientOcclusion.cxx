@@ -4,6 +4,7 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionOpacity.h"
 #include "vtkAmbientOcclusionRanges.h"
 #include "vtkAmbientOcclusionThresholds.h"
 
@@ -22,6 +23,7 @@
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
+#include "vtkPiecewiseFunction.h"
 #include "vtkPointData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
@@ -175,7 +177,7 @@ vao::AmbientOcclusionParameters vtkVolumetricAmbientOcclusion::Parameters(const 
   if (this->Method == TRANSFER_FUNCTION)
   {
     parameters.queryMode = vao::QueryMode::VoxelValue; // the opacity has no query
-    parameters.opacity = this->OpacityNodes();
+    parameters.opacity = vtkAmbientOcclusionOpacity::Nodes(this->OpacityFunction);
   }
   return parameters;
 }

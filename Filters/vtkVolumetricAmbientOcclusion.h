@@ -60,7 +60,6 @@ namespace vao
 {
 struct AmbientOcclusionOutput;
 struct AmbientOcclusionParameters;
-struct OpacityFunction;
 struct Region;
 struct Status;
 struct ValueScan;
@@ -310,8 +309,6 @@ private:
   /// names it, for the warning), the method is an exact reference (worth the transfers at
   /// any size), the extent's voxels.
   bool ChooseCuda(const char* cpuOnly, bool exactMethod, long long voxels);
-  /// The opacity function's nodes for the kernel (TRANSFER_FUNCTION; empty without one).
-  vao::OpacityFunction OpacityNodes() const;
   /// Runs the kernel on the chosen backend; a device failure falls back to the CPU.
   vao::Status Compute(const vao::VolumeView& volume, const vao::Region& region,
     const vao::AmbientOcclusionParameters& parameters, const vao::AmbientOcclusionOutput& arrays);

@@ -4,6 +4,7 @@
 #include "vtkVolumetricAmbientOcclusion.h"
 
 #include "vtkAmbientOcclusionArrayInput.h"
+#include "vtkAmbientOcclusionOpacity.h"
 
 #include "vao/AmbientOcclusion.h"
 #include "vao/HistogramCdf.h"
@@ -21,9 +22,9 @@ bool vtkVolumetricAmbientOcclusion::CheckParameters()
   // The VTK side: enums, names, the radius before it becomes voxels. The kernel's own
   // checks (finiteness) keep its wording, with the property's name.
   std::ostringstream why;
-  const vao::Status opacity = this->Method == TRANSFER_FUNCTION && this->OpacityFunction
-    ? vao::checkOpacityFunction(this->OpacityNodes())
-    : vao::Status::success();
+  const std::string opacity = this->Method == TRANSFER_FUNCTION && this->OpacityFunction
+    ? vtkAmbientOcclusionOpacity::Check(this->OpacityFunction, "OpacityFunction")
+    : std::string();
   const vao::Status iso = this->QueryMode == ISO_VALUE
     ? vao::checkFiniteParameter(this->IsoValue, "IsoValue")
     : vao::Status::success();
@@ -37,8 +38,8 @@ bool vtkVolumetricAmbientOcclusion::CheckParameters()
     why << "Method Transfer Function needs an opacity function (OpacityFunction): in ParaView "
            "the opacity transfer function of an array (GetOpacityTransferFunction), in VTK a "
            "vtkPiecewiseFunction.";
-  else if (!opacity.ok)
-    why << "OpacityFunction: " << opacity.message << ".";
+  else if (!opacity.empty())
+    why << opacity;
   else if (this->Method == HISTOGRAM_CDF && !vao::checkHistogramBins(this->NumberOfBins).empty())
     why << vao::checkHistogramBins(this->NumberOfBins) << ".";
   else if (this->RadiusUnits != VOXELS && this->RadiusUnits != WORLD)

@@ -100,10 +100,9 @@ def opacity_function(opacity, name="opacity"):
     if points.ndim != 2 or points.shape[1] not in (2, 4) or points.shape[0] == 0:
         raise ValueError("%s: (N, 2) points (value, opacity) or (N, 4) (value, opacity, midpoint, sharpness), "
                          "got shape %s" % (name, points.shape))
+    # Before VTK sorts them: the filters check the rest of the function (its opacities).
     if not np.isfinite(points).all():
         raise ValueError("%s: the points must be finite (no NaN or infinity)" % name)
-    if ((points[:, 1] < 0) | (points[:, 1] > 1)).any():
-        raise ValueError("%s: opacities must lie in [0, 1]" % name)
     function = vtkPiecewiseFunction()
     function.AllowDuplicateScalarsOn()
     for row in points:

@@ -180,6 +180,30 @@ TEST(AmbientOcclusionShadingFilter, RejectsBadInputWithAClearError)
   check(
     SmallVolume(), [](vtkAmbientOcclusionShading* s) { s->SetNumberOfThreads(-2); },
     "NumberOfThreads");
+  // An opacity transfer function (ParaView's, from the view) is checked as Volumetric AO
+  // checks its own: an opacity outside [0, 1], a NaN point, no point at all.
+  const auto withOpacity = [](double x, double y)
+  {
+    return [x, y](vtkAmbientOcclusionShading* s)
+    {
+      vtkNew<vtkPiecewiseFunction> opacity;
+      opacity->AddPoint(-1000, 0.0);
+      opacity->AddPoint(x, y);
+      s->SetOpacityTransferFunction(opacity);
+    };
+  };
+  check(SmallVolume(), withOpacity(500, 1.5),
+    "OpacityTransferFunction: opacity point 1 has opacity 1.5");
+  check(
+    SmallVolume(), withOpacity(500, nan), "OpacityTransferFunction: opacity point 1 is not finite");
+  check(
+    SmallVolume(),
+    [](vtkAmbientOcclusionShading* s)
+    {
+      vtkNew<vtkPiecewiseFunction> empty;
+      s->SetOpacityTransferFunction(empty);
+    },
+    "OpacityTransferFunction: the opacity function has no points");
   // Arrays with fewer or more values than the points (read past their end before).
   const vtkIdType points = SmallVolume()->GetNumberOfPoints();
   for (const char* name : { "Density", "AmbientOcclusion", "Variance" })
