@@ -4,8 +4,9 @@ that editing its points (a point moved, a midpoint or sharpness changed) re-exec
 filter with the new opacity, and an update with nothing changed does not. Ambient Occlusion
 Shading takes the same functions (the view's colour and opacity) and follows their edits.
 
-Each result is compared with a box mean of the opacity written here with numpy (cumulative
-sums, the box clipped to the volume) from vtkPiecewiseFunction.GetValue itself.
+Each result is compared with the tests' own reference (vao_test_utils.opacity_openness): a
+numpy box mean (cumulative sums, the box clipped to the volume) of the opacity from
+vtkPiecewiseFunction.GetValue itself.
 
 Usage: pvpython test_transfer_function.py PLUGIN
 Prints "FAILED: ..." and exits non-zero on a failure."""
@@ -18,7 +19,7 @@ from paraview import servermanager
 from vtkmodules.util.numpy_support import vtk_to_numpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from vao_test_utils import check, finish  # noqa: E402
+from vao_test_utils import check, finish, opacity_openness  # noqa: E402
 
 LoadPlugin(sys.argv[1], ns=globals())
 RADIUS = 4
@@ -30,25 +31,8 @@ def fetch(proxy, name):
     return vtk_to_numpy(data.GetPointData().GetArray(name)).reshape(dims[2], dims[1], dims[0], -1).squeeze()
 
 
-def box_mean(values, r):
-    """The mean over the box of half-width r clipped to the volume, by cumulative sums."""
-    out = values.astype(np.float64)
-    for axis in range(3):
-        n = out.shape[axis]
-        padded = np.concatenate([np.zeros_like(np.take(out, [0], axis=axis)), np.cumsum(out, axis=axis)], axis=axis)
-        hi = np.minimum(np.arange(n) + r + 1, n)
-        lo = np.maximum(np.arange(n) - r, 0)
-        out = (np.take(padded, hi, axis=axis) - np.take(padded, lo, axis=axis))
-        shape = [1, 1, 1]
-        shape[axis] = n
-        out = out / (hi - lo).reshape(shape)
-    return out
-
-
 def reference(density, function):
-    values, inverse = np.unique(density, return_inverse=True)
-    alpha = np.array([function.GetValue(float(v)) for v in values])[inverse].reshape(density.shape)
-    return 1.0 - box_mean(alpha, RADIUS)
+    return opacity_openness(density, function, (RADIUS,) * 3)
 
 
 head = AmbientOcclusionHeadPhantom(Dimensions=[48, 48, 48])

@@ -1,7 +1,7 @@
 """Transfer Function AO on the shipped scans (and VAO_EXTRA_DATA_DIR's, when given) against
-a reference written here: the opacity of every voxel from vtkPiecewiseFunction.GetValue
-itself (once per distinct value), its box mean in float64 by cumulative sums with the box
-clipped to the volume. Random functions of 3-7 points inside and outside the scan's range
+the tests' own reference (vao_test_utils.opacity_openness): the opacity of every voxel from
+vtkPiecewiseFunction.GetValue itself (once per distinct value), its box mean in float64 by
+cumulative sums with the box clipped to the volume. Random functions of 3-7 points inside and outside the scan's range
 (midpoints, sharpness, clamping on and off), voxel and anisotropic world radii, the 8/16-bit
 path (a table) and the float path (the CT in other units). Every voxel within 1e-5.
 Prints "FAILED: ..." and exits non-zero on a failure.
@@ -18,7 +18,7 @@ from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction  # noqa: E402
 from vtkmodules.vtkIOImage import vtkMetaImageReader, vtkNrrdReader  # noqa: E402
 from vtkmodules.vtkIOXML import vtkXMLImageDataReader  # noqa: E402
 
-from vao_test_utils import check, finish  # noqa: E402
+from vao_test_utils import check, finish, opacity_openness  # noqa: E402
 
 SCANS = ["ct_head_phantom/ct_head_phantom_128x128x136_int16.mha", "lidc2_ct_chest/LIDC2_256x256x133_uint8.mha",
          "headsq/headsq_64x64x93_int16.vti", "head_mr_small/HeadMRVolume.mhd",
@@ -48,25 +48,6 @@ def random_function(rng, lo, hi):
     return function
 
 
-def box_mean(values, radii):
-    out = values.astype(np.float64)
-    for axis, r in enumerate(radii):
-        n = out.shape[axis]
-        zero = np.zeros_like(np.take(out, [0], axis=axis))
-        sums = np.concatenate([zero, np.cumsum(out, axis=axis)], axis=axis)
-        hi, lo = np.minimum(np.arange(n) + r + 1, n), np.maximum(np.arange(n) - r, 0)
-        shape = [1, 1, 1]
-        shape[axis] = n
-        out = (np.take(sums, hi, axis=axis) - np.take(sums, lo, axis=axis)) / (hi - lo).reshape(shape)
-    return out
-
-
-def reference(values, function, radii):
-    distinct, inverse = np.unique(values, return_inverse=True)
-    alpha = np.array([function.GetValue(float(v)) for v in distinct])[inverse].reshape(values.shape)
-    return 1.0 - box_mean(alpha, radii)
-
-
 rng = np.random.default_rng(46)
 folders = sys.argv[2:]
 tested = 0
@@ -90,7 +71,7 @@ for name in SCANS:
             radii = (2, 4, 8)
         else:
             radii = (options["radius"],) * 3
-        expected = reference(data, function, radii)
+        expected = opacity_openness(data, function, radii)
         error = np.abs(got.astype(np.float64) - expected).max()
         check(error <= 1e-5 and expected.std() > 1e-3,
               "%s %s (%d points, clamping %d, radii %s): max |O_tf - reference| %.2g, the reference's "

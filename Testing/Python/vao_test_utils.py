@@ -101,3 +101,29 @@ def logged_extent(prefix, rank):
     """The extent extent_logger wrote for `rank`, as a tuple."""
     with open("%s.%d" % (prefix, rank)) as log:
         return tuple(int(v) for v in log.read().split())
+
+
+def box_mean(values, radii):
+    """The mean of `values` ([z, y, x]) over the box of half-widths `radii` (z, y, x) around
+    each voxel, clipped to the volume: float64 cumulative sums, one axis at a time."""
+    import numpy as np
+    out = values.astype(np.float64)
+    for axis, r in enumerate(radii):
+        n = out.shape[axis]
+        zero = np.zeros_like(np.take(out, [0], axis=axis))
+        sums = np.concatenate([zero, np.cumsum(out, axis=axis)], axis=axis)
+        hi, lo = np.minimum(np.arange(n) + r + 1, n), np.maximum(np.arange(n) - r, 0)
+        shape = [1, 1, 1]
+        shape[axis] = n
+        out = (np.take(sums, hi, axis=axis) - np.take(sums, lo, axis=axis)) / (hi - lo).reshape(shape)
+    return out
+
+
+def opacity_openness(values, function, radii):
+    """The Transfer Function method's reference: 1 - box_mean of the opacity that
+    vtkPiecewiseFunction.GetValue itself gives each voxel (once per distinct value)."""
+    import numpy as np
+    distinct, inverse = np.unique(values, return_inverse=True)
+    alpha = np.array([function.GetValue(float(v)) for v in distinct])[inverse].reshape(values.shape)
+    return 1.0 - box_mean(alpha, radii)
+
