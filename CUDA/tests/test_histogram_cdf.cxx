@@ -3,12 +3,16 @@
 #include "ReferenceFormulas.h"
 #include "TestVolumes.h"
 
+#include "cpu/histogram_cdf/HistogramBins.h"
+
 #include "vao/HistogramCdf.h"
 #include "vao/Validation.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
+#include <random>
 #include <set>
 
 using namespace vaotest;
@@ -313,4 +317,114 @@ TEST(HistogramCdf, ExtremeMagnitudesKeepTheirCells)
   EXPECT_EQ(t.front(), -1.7e308);
   EXPECT_EQ(t.back(), 1.7e308);
   expectMatchesDefinition(v, dims, { 1, 1, 1 }, t);
+}
+
+namespace
+{
+
+/// The bins BinOf gives a row of `values` (all its lengths up to one more than two
+/// vectors, so every remainder) against a count of the thresholds below each value.
+template <class T>
+void expectRowBinsCountThresholds(
+  const std::vector<T>& values, const std::vector<double>& thresholds)
+{
+  using vao::detail::SimdTier;
+  for (SimdTier tier : { SimdTier::Baseline, vao::detail::cpuSimdTier() })
+  {
+    const vao::detail::BinOf<T> bin(thresholds, tier, 1);
+    for (std::size_t n : { values.size(), std::size_t(1), std::size_t(33), std::size_t(65) })
+    {
+      n = std::min(n, values.size());
+      std::vector<std::uint16_t> got(n, 0xFFFF);
+      bin.row(values.data(), 1, static_cast<std::int64_t>(n), got.data());
+      int failures = 0;
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        int below = 0;
+        for (const double t : thresholds)
+          below += t < static_cast<double>(values[i]) ? 1 : 0;
+        if (got[i] != below && failures++ < 4)
+          ADD_FAILURE() << "value " << +values[i] << ": bin " << got[i] << ", " << below
+                        << " thresholds below it (tier " << int(tier) << ")";
+      }
+    }
+  }
+}
+
+/// Every value of an 8- or 16-bit type's range near its ends and around the thresholds,
+/// and random ones; for floats, random values and the thresholds' neighbours.
+template <class T>
+std::vector<T> probeValues(const std::vector<double>& thresholds, unsigned seed)
+{
+  std::mt19937 rng(seed);
+  std::vector<T> values;
+  const double lo = static_cast<double>(std::numeric_limits<T>::lowest());
+  const double hi = static_cast<double>(std::numeric_limits<T>::max());
+  for (double t : thresholds)
+    for (double d : { -1.0, -0.5, 0.0, 0.5, 1.0 })
+      if (t + d >= lo && t + d <= hi)
+      {
+        values.push_back(static_cast<T>(t + d));
+        if (std::is_floating_point<T>::value)
+        {
+          values.push_back(std::nextafter(static_cast<T>(t), std::numeric_limits<T>::infinity()));
+          values.push_back(std::nextafter(static_cast<T>(t), -std::numeric_limits<T>::infinity()));
+        }
+      }
+  for (double end : { lo, hi })
+    values.push_back(static_cast<T>(end));
+  std::uniform_real_distribution<double> any(
+    std::is_floating_point<T>::value ? -1e6 : lo, std::is_floating_point<T>::value ? 1e6 : hi);
+  while (values.size() < 700)
+    values.push_back(static_cast<T>(any(rng)));
+  return values;
+}
+
+template <class T>
+void expectBinsOfType(unsigned seed)
+{
+  const double lo = static_cast<double>(std::numeric_limits<T>::lowest());
+  const double hi = static_cast<double>(std::numeric_limits<T>::max());
+  std::mt19937 rng(seed);
+  std::vector<std::vector<double>> sets;
+  // 64 thresholds within the type's range, at integers and between them.
+  std::vector<double> inside;
+  std::uniform_real_distribution<double> within(std::max(lo, -1e5), std::min(hi, 1e5));
+  for (int k = 0; k < 64; ++k)
+    inside.push_back(k % 3 ? std::floor(within(rng)) : within(rng));
+  sets.push_back(inside);
+  // Beyond the type's ends (given thresholds may be anywhere): some below every value,
+  // some above, 64 in between.
+  std::vector<double> beyond = inside;
+  for (double t : { lo - 1e9, lo - 0.5, hi + 0.5, hi + 3e9, 1e300, -1e300 })
+    beyond.push_back(t);
+  sets.push_back(beyond);
+  // Few, and more than the vector search holds (65 in range): the other paths.
+  sets.push_back({ std::floor((lo + hi) / 2) });
+  std::vector<double> many = inside;
+  many.push_back(std::min(hi - 1, 1e5 + 1));
+  sets.push_back(many);
+  for (auto& t : sets)
+  {
+    std::sort(t.begin(), t.end());
+    t.erase(std::unique(t.begin(), t.end()), t.end());
+    expectRowBinsCountThresholds(probeValues<T>(t, seed + 1), t);
+  }
+}
+
+} // namespace
+
+TEST(HistogramCdf, RowBinsCountTheThresholdsBelowEveryValue)
+{
+  expectBinsOfType<std::uint8_t>(1);
+  expectBinsOfType<std::int8_t>(2);
+  expectBinsOfType<std::int16_t>(3);
+  expectBinsOfType<std::uint16_t>(4);
+  expectBinsOfType<float>(5);
+  expectBinsOfType<double>(6);
+  // Thresholds between floats: each is above its nearest float or below it.
+  std::vector<double> between;
+  for (int k = 0; k < 64; ++k)
+    between.push_back(0.1 * k + 1e-12 * (k % 2 ? 1 : -1));
+  expectRowBinsCountThresholds(probeValues<float>(between, 7), between);
 }

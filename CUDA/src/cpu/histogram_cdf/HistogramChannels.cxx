@@ -21,6 +21,7 @@
 // below 2^16), else 32 bits.
 #include "cpu/histogram_cdf/HistogramChannels.h"
 
+#include "cpu/histogram_cdf/HistogramBins.h"
 #include "cpu/histogram_cdf/HistogramLanes.h"
 
 #include "VolumeAccess.h"
@@ -318,7 +319,7 @@ private:
 template <class T, class L, class W, int Fixed>
 bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const Execution& execution)
 {
-  const BinOf<T> bin(job.thresholds);
+  const BinOf<T> bin(job.thresholds, job.simd, volume.stride);
   const Region& region = job.region;
   const std::int64_t tile = job.tile;
   const std::int64_t tilesX = (region.size[0] + tile - 1) / tile;

@@ -1,7 +1,7 @@
-// The lane loops of Histogram CDF on the CPU (HistogramChannels.cxx) and the bins of
-// values. A pixel's histogram is a vector of `lanes` small unsigned counts held
-// cumulatively: lane c counts the voxels of bin c or below, so that adding a voxel adds a
-// row of a mask table and the count below a bin is one lane. The loops are structs whose
+// The lane loops of Histogram CDF on the CPU (HistogramChannels.cxx). A pixel's histogram
+// is a vector of `lanes` small unsigned counts held cumulatively: lane c counts the voxels
+// of bin c or below, so that adding a voxel adds a row of a mask table and the count below
+// a bin is one lane. The loops are structs whose
 // run() runRows compiles for AVX2 as well (CpuDispatch.h); `Fixed` is the lane count when
 // it is known at compile time (the default 64 bins), 0 when it is read at run time.
 #pragma once
@@ -209,71 +209,6 @@ struct CdfOpenness
       openness[i] = static_cast<float>(q[i] < first ? 0.0 : o);
     }
   }
-};
-
-/// Bin of a value: a table over the whole type for 8- and 16-bit integers, else a search
-/// that gives thresholdIndex's answer without a branch per step (the thresholds padded
-/// with infinity to a power of two: random values would mispredict half the steps).
-template <class T>
-class BinOf
-{
-public:
-  BinOf(const std::vector<double>& thresholds)
-    : Thresholds(thresholds)
-  {
-    std::size_t padded = 1;
-    while (padded < thresholds.size())
-      padded *= 2;
-    this->Padded.assign(padded, std::numeric_limits<double>::infinity());
-    std::copy(thresholds.begin(), thresholds.end(), this->Padded.begin());
-    if (kTable)
-    {
-      const double lowest = static_cast<double>(std::numeric_limits<T>::lowest());
-      this->Table.resize(std::size_t(1) << (8 * sizeof(T)));
-      for (std::size_t i = 0; i < this->Table.size(); ++i)
-      {
-        this->Table[i] = static_cast<std::uint16_t>(thresholdIndex(
-          lowest + static_cast<double>(i), thresholds.data(), static_cast<int>(thresholds.size())));
-      }
-    }
-  }
-
-  /// The bins of n values `stride` apart.
-  void row(const T* in, std::int64_t stride, std::int64_t n, std::uint16_t* out) const
-  {
-    if constexpr (kTable)
-    {
-      const std::uint16_t* table =
-        this->Table.data() - std::int64_t(std::numeric_limits<T>::lowest());
-      for (std::int64_t i = 0; i < n; ++i)
-        out[i] = table[in[i * stride]];
-    }
-    else
-    {
-      for (std::int64_t i = 0; i < n; ++i)
-        out[i] = static_cast<std::uint16_t>(this->search(static_cast<double>(in[i * stride])));
-    }
-  }
-
-  /// thresholdIndex(q): the number of thresholds below q (q not NaN).
-  int search(double q) const
-  {
-    const double* first = this->Padded.data();
-    std::size_t count = this->Padded.size();
-    while (count > 1)
-    {
-      const std::size_t half = count / 2;
-      first = first[half] < q ? first + half : first;
-      count -= half;
-    }
-    return static_cast<int>(first - this->Padded.data()) + (*first < q ? 1 : 0);
-  }
-
-private:
-  static constexpr bool kTable = std::is_integral<T>::value && sizeof(T) <= 2;
-  const std::vector<double>& Thresholds;
-  std::vector<double> Padded;
-  std::vector<std::uint16_t> Table;
 };
 
 } // namespace detail

@@ -88,6 +88,12 @@ __attribute__((target("avx2,fma"))) void runAvx2(Args... args)
   __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma,prefer-vector-width=512")))
 #endif
 
+// Hand-written AVX-512 code (intrinsics): its entry points and the helpers they inline.
+#define VAO_AVX512_INLINE                                                                          \
+  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"))) inline
+#define VAO_AVX512_HELPER                                                                          \
+  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"), always_inline)) inline
+
 template <class Kernel, class... Args>
 VAO_AVX512_TARGET void runAvx512(Args... args)
 {

@@ -34,11 +34,6 @@ extern "C" __attribute__((target("avx512f"))) __m512d _ZGVeN8v_exp(__m512d);
 extern "C" __attribute__((target("avx512f"))) __m512d _ZGVeN8v_log(__m512d);
 #endif
 
-#define VAO_AVX512_HELPER                                                                          \
-  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"), always_inline)) inline
-#define VAO_AVX512_INLINE                                                                          \
-  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"))) inline
-
 namespace vao
 {
 namespace detail
