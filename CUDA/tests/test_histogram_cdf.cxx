@@ -323,7 +323,8 @@ namespace
 {
 
 /// The bins BinOf gives a row of `values` (all its lengths up to one more than two
-/// vectors, so every remainder) against a count of the thresholds below each value.
+/// vectors, so every remainder), in 16 and 8 bits, against a count of the thresholds
+/// below each value.
 template <class T>
 void expectRowBinsCountThresholds(
   const std::vector<T>& values, const std::vector<double>& thresholds)
@@ -331,12 +332,15 @@ void expectRowBinsCountThresholds(
   using vao::detail::SimdTier;
   for (SimdTier tier : { SimdTier::Baseline, vao::detail::cpuSimdTier() })
   {
-    const vao::detail::BinOf<T> bin(thresholds, tier, 1);
+    const vao::detail::BinOf<T> bin(thresholds, tier);
     for (std::size_t n : { values.size(), std::size_t(1), std::size_t(33), std::size_t(65) })
     {
       n = std::min(n, values.size());
       std::vector<std::uint16_t> got(n, 0xFFFF);
       bin.row(values.data(), 1, static_cast<std::int64_t>(n), got.data());
+      std::vector<std::uint8_t> narrow(n, 0xFF); // as the ring of the default 64 bins holds them
+      bin.row(values.data(), 1, static_cast<std::int64_t>(n), narrow.data());
+      EXPECT_TRUE(std::equal(got.begin(), got.end(), narrow.begin())) << "8-bit bins";
       int failures = 0;
       for (std::size_t i = 0; i < n; ++i)
       {

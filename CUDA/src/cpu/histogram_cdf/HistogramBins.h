@@ -1,5 +1,5 @@
 // The bins of values in Histogram CDF on the CPU: thresholdIndex (the number of thresholds
-// below a value) for whole rows of voxels, the query's bin for one value.
+// below a value) for whole rows of voxels, and for one query value.
 #pragma once
 
 #include "cpu/simd/CpuDispatch.h"
@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <type_traits>
 #include <vector>
@@ -23,80 +22,47 @@ namespace vao
 namespace detail
 {
 
-/// Thresholds as keys a vector search compares values with: 16-bit integers for 8- and
-/// 16-bit data, floats for float data, 64 of them in ascending order (padded with a key
-/// no value is above). A value v of the data is above threshold t exactly when its key
-/// is above t's key, so that the count of keys below v is thresholdIndex(v) less `offset`
-/// (the thresholds below every value of the type).
-template <class Key>
-struct SearchKeys
+/// The thresholds as the float keys a vector search compares float values with: the
+/// largest float not above each threshold, 64 in ascending order (padded with +infinity).
+/// A float v is above threshold t exactly when it is above t's key, so the count of keys
+/// below v is thresholdIndex(v).
+struct FloatKeys
 {
   static constexpr int kKeys = 64;
-  Key keys[kKeys];
-  int offset = 0;
+  float keys[kKeys];
 
-  /// thresholdIndex of a value of key k, one key at a time (a row's last values).
-  int count(Key k) const
+  /// Keys for at most 64 thresholds; false for more.
+  bool place(const std::vector<double>& thresholds)
   {
-    int below = this->offset;
-    for (const Key key : this->keys)
-      below += key < k ? 1 : 0;
+    if (thresholds.size() > std::size_t(kKeys))
+      return false;
+    std::fill(this->keys, this->keys + kKeys, std::numeric_limits<float>::infinity());
+    const double largest = std::numeric_limits<float>::max();
+    for (std::size_t k = 0; k < thresholds.size(); ++k)
+    {
+      // Beyond the floats: above or below every float value (no out-of-range conversion).
+      const double t = thresholds[k];
+      float key = t > largest ? std::numeric_limits<float>::max()
+        : t < -largest        ? -std::numeric_limits<float>::infinity()
+                              : static_cast<float>(t);
+      if (static_cast<double>(key) > t)
+        key = std::nextafter(key, -std::numeric_limits<float>::infinity());
+      this->keys[k] = key;
+    }
+    return true;
+  }
+
+  /// thresholdIndex of one float (a row's last values).
+  int count(float v) const
+  {
+    int below = 0;
+    for (const float key : this->keys)
+      below += key < v ? 1 : 0;
     return below;
   }
 };
 
-/// The 16-bit key of an 8- or 16-bit integer: its value, less 2^15 for unsigned 16 bits
-/// (the order kept in signed comparisons).
-template <class T>
-std::int16_t keyOf(T v)
-{
-  if constexpr (std::is_same<T, std::uint16_t>::value)
-    return static_cast<std::int16_t>(static_cast<std::int32_t>(v) - 32768);
-  else
-    return static_cast<std::int16_t>(v);
-}
-
 #if VAO_HAVE_AVX2_TARGET
-/// The bins of a row of n values by a branch-free binary search of a whole vector of
-/// values at once, its probes looked up in the 64 keys held in registers (a permutation
-/// across two or four vectors): seven steps for 32 16-bit or 16 float values, where a
-/// table or a scalar search take a dependent load per value.
-template <class T>
-VAO_AVX512_TARGET void searchRowAvx512(const T* __restrict in, std::int64_t n,
-  const SearchKeys<std::int16_t>& search, std::uint16_t* __restrict out)
-{
-  const __m512i low = _mm512_loadu_si512(search.keys), high = _mm512_loadu_si512(search.keys + 32);
-  std::int64_t i = 0;
-  for (; i + 32 <= n; i += 32)
-  {
-    __m512i v;
-    if constexpr (sizeof(T) == 1)
-    {
-      const __m256i bytes = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i));
-      v = std::is_signed<T>::value ? _mm512_cvtepi8_epi16(bytes) : _mm512_cvtepu8_epi16(bytes);
-    }
-    else
-    {
-      v = _mm512_loadu_si512(in + i);
-      if (!std::is_signed<T>::value)
-        v = _mm512_xor_si512(v, _mm512_set1_epi16(-32768));
-    }
-    __m512i pos = _mm512_setzero_si512();
-    for (int step = 32; step >= 1; step /= 2)
-    {
-      const __m512i probe =
-        _mm512_permutex2var_epi16(low, _mm512_add_epi16(pos, _mm512_set1_epi16(step - 1)), high);
-      pos =
-        _mm512_mask_add_epi16(pos, _mm512_cmplt_epi16_mask(probe, v), pos, _mm512_set1_epi16(step));
-    }
-    const __m512i last = _mm512_permutex2var_epi16(low, pos, high);
-    pos = _mm512_mask_add_epi16(pos, _mm512_cmplt_epi16_mask(last, v), pos, _mm512_set1_epi16(1));
-    _mm512_storeu_si512(out + i, _mm512_add_epi16(pos, _mm512_set1_epi16(search.offset)));
-  }
-  for (; i < n; ++i)
-    out[i] = static_cast<std::uint16_t>(search.count(keyOf(in[i])));
-}
-
 /// The float keys at indices `at` (0 to 63), from four vectors of 16.
 VAO_AVX512_HELPER __m512 probeKeys(const __m512* table, __m512i at)
 {
@@ -105,10 +71,13 @@ VAO_AVX512_HELPER __m512 probeKeys(const __m512* table, __m512i at)
   return _mm512_mask_blend_ps(_mm512_test_epi32_mask(at, _mm512_set1_epi32(32)), low, high);
 }
 
-/// The same for floats: 16 values at once over keys in four vectors.
-template <class T>
-VAO_AVX512_TARGET void searchRowAvx512(const T* __restrict in, std::int64_t n,
-  const SearchKeys<float>& search, std::uint16_t* __restrict out)
+/// The bins of a row of n floats, stored as O (8 or 16 bits), by a branch-free binary
+/// search of 16 values at once, its probes looked up in the 64 keys held in four
+/// registers: seven steps of a permutation and a comparison per vector, where a scalar
+/// search takes six dependent loads per value.
+template <class O>
+VAO_AVX512_TARGET void searchRowAvx512(
+  const float* __restrict in, std::int64_t n, const FloatKeys& search, O* __restrict out)
 {
   __m512 table[4];
   for (int k = 0; k < 4; ++k)
@@ -126,32 +95,36 @@ VAO_AVX512_TARGET void searchRowAvx512(const T* __restrict in, std::int64_t n,
     }
     pos = _mm512_mask_add_epi32(
       pos, _mm512_cmp_ps_mask(probeKeys(table, pos), v, _CMP_LT_OQ), pos, _mm512_set1_epi32(1));
-    pos = _mm512_add_epi32(pos, _mm512_set1_epi32(search.offset));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i), _mm512_cvtepi32_epi16(pos));
+    if constexpr (sizeof(O) == 1)
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i), _mm512_cvtepi32_epi8(pos));
+    else
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i), _mm512_cvtepi32_epi16(pos));
   }
   for (; i < n; ++i)
-    out[i] = static_cast<std::uint16_t>(search.count(in[i]));
+    out[i] = static_cast<O>(search.count(in[i]));
 }
 #endif
 
-/// Bin of a value (thresholdIndex): for rows of 8-bit, 16-bit and float voxels with at
-/// most 64 thresholds in their type's range, searchRowAvx512; else a table over the
-/// whole type for 8- and 16-bit integers, and a search that gives thresholdIndex's answer
-/// without a branch per step (the thresholds padded with infinity to a power of two:
-/// random values would mispredict half the steps).
+/// Bin of a value (thresholdIndex): a table over the whole type for 8- and 16-bit
+/// integers (its part in use stays in the L1 cache on the data measured); for rows of
+/// floats with at most 64 thresholds on AVX-512, searchRowAvx512; else a search that
+/// gives thresholdIndex's answer without a branch per step (the thresholds padded with
+/// infinity to a power of two: random values would mispredict half the steps).
 template <class T>
 class BinOf
 {
 public:
-  BinOf(const std::vector<double>& thresholds, SimdTier simd, std::int64_t stride)
+  BinOf(const std::vector<double>& thresholds, SimdTier simd)
   {
     std::size_t padded = 1;
     while (padded < thresholds.size())
       padded *= 2;
     this->Padded.assign(padded, std::numeric_limits<double>::infinity());
     std::copy(thresholds.begin(), thresholds.end(), this->Padded.begin());
-    this->Vector = VAO_HAVE_AVX2_TARGET && simd == SimdTier::Avx512 && this->placeKeys(thresholds);
-    if (kTable && !(this->Vector && stride == 1))
+    if constexpr (std::is_same<T, float>::value)
+      this->Vector =
+        VAO_HAVE_AVX2_TARGET && simd == SimdTier::Avx512 && this->Keys.place(thresholds);
+    if constexpr (kTable)
     {
       const double lowest = static_cast<double>(std::numeric_limits<T>::lowest());
       this->Table.resize(std::size_t(1) << (8 * sizeof(T)));
@@ -163,11 +136,12 @@ public:
     }
   }
 
-  /// The bins of n values `stride` apart.
-  void row(const T* in, std::int64_t stride, std::int64_t n, std::uint16_t* out) const
+  /// The bins of n values `stride` apart, as O (8 bits where the bins fit).
+  template <class O>
+  void row(const T* in, std::int64_t stride, std::int64_t n, O* out) const
   {
 #if VAO_HAVE_AVX2_TARGET
-    if constexpr (kKeyed)
+    if constexpr (std::is_same<T, float>::value)
       if (this->Vector && stride == 1)
       {
         searchRowAvx512(in, n, this->Keys, out);
@@ -179,12 +153,12 @@ public:
       const std::uint16_t* table =
         this->Table.data() - std::int64_t(std::numeric_limits<T>::lowest());
       for (std::int64_t i = 0; i < n; ++i)
-        out[i] = table[in[i * stride]];
+        out[i] = static_cast<O>(table[in[i * stride]]);
     }
     else
     {
       for (std::int64_t i = 0; i < n; ++i)
-        out[i] = static_cast<std::uint16_t>(this->search(static_cast<double>(in[i * stride])));
+        out[i] = static_cast<O>(this->search(static_cast<double>(in[i * stride])));
     }
   }
 
@@ -204,52 +178,8 @@ public:
 
 private:
   static constexpr bool kTable = std::is_integral<T>::value && sizeof(T) <= 2;
-  static constexpr bool kKeyed = kTable || std::is_same<T, float>::value;
-  typedef typename std::conditional<kTable, std::int16_t, float>::type Key;
-
-  /// The keys of searchRowAvx512, when the thresholds allow them: those in the type's range
-  /// number at most 64. For integers, t < v exactly when floor(t) < v; for floats, when
-  /// the largest float not above t is below v.
-  bool placeKeys(const std::vector<double>& thresholds)
-  {
-    if constexpr (!kKeyed)
-      return false;
-    else
-    {
-      int count = 0;
-      for (const double t : thresholds)
-      {
-        Key key;
-        if constexpr (kTable)
-        {
-          if (t < static_cast<double>(std::numeric_limits<T>::lowest()))
-          {
-            ++this->Keys.offset;
-            continue;
-          }
-          if (t >= static_cast<double>(std::numeric_limits<T>::max()))
-            break;
-          key = keyOf(static_cast<T>(std::floor(t)));
-        }
-        else
-        {
-          key = static_cast<float>(t);
-          if (static_cast<double>(key) > t)
-            key = std::nextafter(key, -std::numeric_limits<float>::infinity());
-        }
-        if (count == SearchKeys<Key>::kKeys)
-          return false;
-        this->Keys.keys[count++] = key;
-      }
-      std::fill(this->Keys.keys + count, this->Keys.keys + SearchKeys<Key>::kKeys,
-        std::numeric_limits<Key>::has_infinity ? std::numeric_limits<Key>::infinity()
-                                               : std::numeric_limits<Key>::max());
-      return true;
-    }
-  }
-
   bool Vector = false;
-  SearchKeys<Key> Keys;
+  FloatKeys Keys;
   std::vector<double> Padded;
   std::vector<std::uint16_t> Table;
 };

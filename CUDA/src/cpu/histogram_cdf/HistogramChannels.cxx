@@ -63,6 +63,13 @@ std::int64_t ringSlices(const Radius& r)
   return 2 * std::int64_t(r.z) + 2;
 }
 
+/// Bytes of a voxel's bin in the ring: 8 bits for the default 64 bins (the loops of a known
+/// lane count), else 16.
+int binBytes(int lanes)
+{
+  return lanes == 64 ? 1 : 2;
+}
+
 /// Bytes of one worker's state for tiles of `tile` columns: the window counts of the tile
 /// grown by the radius, one row of column sums, and the ring of the slices' bins.
 std::int64_t tileStateBytes(std::int64_t tile, const Radius& r, int lanes, int laneBytes)
@@ -70,7 +77,7 @@ std::int64_t tileStateBytes(std::int64_t tile, const Radius& r, int lanes, int l
   const std::int64_t span = tile + 2 * std::max(r.x, r.y);
   const int windowBytes = narrowWindow(r) ? 1 : laneBytes;
   return (span * span * windowBytes + span * laneBytes) * lanes +
-    ringSlices(r) * span * span * std::int64_t(sizeof(std::uint16_t));
+    ringSlices(r) * span * span * binBytes(lanes);
 }
 
 /// The tile's side: 64 (larger tiles leave the L2 cache, smaller ones recount more of
@@ -105,6 +112,9 @@ struct HistogramJob
 template <class T, class L, class W, int Fixed>
 class TileHistograms
 {
+  /// A voxel's bin in the ring (binBytes).
+  using B = typename std::conditional<Fixed == 64, std::uint8_t, std::uint16_t>::type;
+
 public:
   TileHistograms(const TypedVolume<T>& volume, const HistogramJob& job, const BinOf<T>& bin)
     : Volume(volume)
@@ -187,7 +197,7 @@ private:
 
   /// The bins of row y of slice s (from HX0), in the ring: written when the slice enters,
   /// read while it is in the z window and when it leaves.
-  std::uint16_t* binsOf(std::int64_t s, std::int64_t y)
+  B* binsOf(std::int64_t s, std::int64_t y)
   {
     return &this->SliceBins[(s % this->RingSlices) * this->SlicePixels +
       (y - this->HY0) * this->width()];
@@ -201,14 +211,14 @@ private:
     const std::int64_t stride = this->Volume.stride;
     for (std::int64_t y = this->HY0; y < this->HY1; ++y)
     {
-      std::uint16_t* in = nullptr;
+      B* in = nullptr;
       if (entering >= 0)
       {
         in = this->binsOf(entering, y);
         this->Bin.row(this->Volume.row(y, entering) + this->HX0 * stride, stride, width, in);
       }
-      const std::uint16_t* out = leaving >= 0 ? this->binsOf(leaving, y) : nullptr;
-      runRows<MoveRow<W, Fixed>>(this->Job.simd, static_cast<const std::uint16_t*>(in), out, width,
+      const B* out = leaving >= 0 ? this->binsOf(leaving, y) : nullptr;
+      runRows<MoveRow<W, Fixed, B>>(this->Job.simd, static_cast<const B*>(in), out, width,
         &this->Window[(y - this->HY0) * width * this->Lanes],
         static_cast<const W*>(this->Masks.data()), this->Lanes, this->Bins);
     }
@@ -253,9 +263,9 @@ private:
     const HistogramQuery& query = this->Job.query;
     if (!query.values && !query.isoValue) // the voxels' own values, and the bins kept
     {
-      runRows<VoxelQueries<T>>(this->Job.simd,
+      runRows<VoxelQueries<T, B>>(this->Job.simd,
         this->Volume.row(y, z) + this->X0 * this->Volume.stride, this->Volume.stride,
-        static_cast<const std::uint16_t*>(this->binsOf(z, y) + (this->X0 - this->HX0)), this->NX,
+        static_cast<const B*>(this->binsOf(z, y) + (this->X0 - this->HX0)), this->NX,
         this->Query.data(), this->Upper.data());
       return;
     }
@@ -304,11 +314,11 @@ private:
   std::int64_t RingSlices = 0, SlicePixels = 0;
   std::int64_t X0 = 0, NX = 0, HX0 = 0, HX1 = 0, HY0 = 0, HY1 = 0;
   std::vector<W> Window;
-  std::vector<L> Columns;               // one row of the y window's sums of the window
-  std::vector<W> WindowZeros;           // a window row outside the volume
-  std::vector<std::uint16_t> SliceBins; // the ring of the slices' bins (binsOf)
-  std::vector<W> Masks;                 // row b: ones in the lanes from b (cumulative counts)
-  std::vector<L> Histograms;            // RowQuery's box histograms of one output row
+  std::vector<L> Columns;     // one row of the y window's sums of the window
+  std::vector<W> WindowZeros; // a window row outside the volume
+  std::vector<B> SliceBins;   // the ring of the slices' bins (binsOf)
+  std::vector<W> Masks;       // row b: ones in the lanes from b (cumulative counts)
+  std::vector<L> Histograms;  // RowQuery's box histograms of one output row
   std::vector<int> Upper;
   std::vector<std::uint32_t> Below, At;
   std::vector<double> Query;
@@ -319,7 +329,7 @@ private:
 template <class T, class L, class W, int Fixed>
 bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const Execution& execution)
 {
-  const BinOf<T> bin(job.thresholds, job.simd, volume.stride);
+  const BinOf<T> bin(job.thresholds, job.simd);
   const Region& region = job.region;
   const std::int64_t tile = job.tile;
   const std::int64_t tilesX = (region.size[0] + tile - 1) / tile;

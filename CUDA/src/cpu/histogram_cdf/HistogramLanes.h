@@ -27,12 +27,12 @@ namespace detail
 /// slice outside the volume, as the empty bin `bins`). A pixel whose two voxels share a
 /// bin adds and subtracts the same row: no branch, which noisy data would mispredict.
 /// Counts wrap modulo the lanes' width, which holds the window's 2 Rz + 1.
-template <class W, int Fixed>
+template <class W, int Fixed, class B>
 struct MoveRow
 {
-  static VAO_ALWAYS_INLINE void run(const std::uint16_t* __restrict in,
-    const std::uint16_t* __restrict out, std::int64_t width, W* __restrict window,
-    const W* __restrict cumulativeMasks, int runtimeLanes, int bins)
+  static VAO_ALWAYS_INLINE void run(const B* __restrict in, const B* __restrict out,
+    std::int64_t width, W* __restrict window, const W* __restrict cumulativeMasks, int runtimeLanes,
+    int bins)
   {
     const int lanes = Fixed ? Fixed : runtimeLanes;
     for (std::int64_t x = 0; x < width; ++x)
@@ -157,12 +157,11 @@ struct RowQuery
 
 /// q[i] = the value of voxel i of a row, upper[i] = its bin (kept from when its slice
 /// entered the window).
-template <class T>
+template <class T, class B>
 struct VoxelQueries
 {
   static VAO_ALWAYS_INLINE void run(const T* __restrict values, std::int64_t stride,
-    const std::uint16_t* __restrict bins, std::int64_t count, double* __restrict q,
-    int* __restrict upper)
+    const B* __restrict bins, std::int64_t count, double* __restrict q, int* __restrict upper)
   {
     if (stride == 1)
       for (std::int64_t i = 0; i < count; ++i)
