@@ -68,6 +68,66 @@ void ValueHistogram::merge(const ValueHistogram& other)
   }
 }
 
+namespace
+{
+
+/// Counts of 8- and 16-bit values, a cell per value, in four 32-bit counters per cell
+/// that consecutive voxels take in turn: a run of equal values (air in a CT) would
+/// otherwise increment one counter, each increment waiting for the one before it.
+class InterleavedCounts
+{
+public:
+  explicit InterleavedCounts(std::size_t cells)
+    : Counts(4 * cells, 0)
+  {
+  }
+
+  /// Counts n values `stride` apart into the cells from value `lowest` (clamped to the
+  /// cells), moving the counters into `total` before they could overflow.
+  template <class T>
+  void addRow(const T* row, std::int64_t n, std::int64_t stride, std::int64_t lowest,
+    std::vector<std::int64_t>& total)
+  {
+    if (this->Pending + n > kFlushAfter)
+      this->addTo(total);
+    this->Pending += n;
+    const auto last = static_cast<std::int64_t>(this->Counts.size() / 4) - 1;
+    std::uint32_t* counts = this->Counts.data();
+    const auto cell = [&](std::int64_t i) {
+      return 4 * std::min(last, std::max<std::int64_t>(0, std::int64_t(row[i * stride]) - lowest));
+    };
+    std::int64_t i = 0;
+    for (; i + 4 <= n; i += 4)
+    {
+      ++counts[cell(i)];
+      ++counts[cell(i + 1) + 1];
+      ++counts[cell(i + 2) + 2];
+      ++counts[cell(i + 3) + 3];
+    }
+    for (; i < n; ++i)
+      ++counts[cell(i)];
+  }
+
+  /// Adds the counters to `total` (a count per cell) and clears them.
+  void addTo(std::vector<std::int64_t>& total)
+  {
+    for (std::size_t c = 0; 4 * c < this->Counts.size(); ++c)
+    {
+      total[c] += std::int64_t(this->Counts[4 * c]) + this->Counts[4 * c + 1] +
+        this->Counts[4 * c + 2] + this->Counts[4 * c + 3];
+    }
+    std::fill(this->Counts.begin(), this->Counts.end(), 0u);
+    this->Pending = 0;
+  }
+
+private:
+  static constexpr std::int64_t kFlushAfter = std::int64_t(1) << 31;
+  std::vector<std::uint32_t> Counts;
+  std::int64_t Pending = 0; // values counted since the last addTo
+};
+
+} // namespace
+
 Status addToValueHistogram(const VolumeView& view, const Region& region, ValueHistogram& histogram,
   const Execution& execution)
 {
@@ -91,23 +151,18 @@ Status addToValueHistogram(const VolumeView& view, const Region& region, ValueHi
             {
               ValueHistogram part = histogram;
               std::fill(part.counts.begin(), part.counts.end(), 0);
+              constexpr bool kCellPerValue = std::is_integral<T>::value && sizeof(T) <= 2;
+              InterleavedCounts cellCounts(kCellPerValue ? part.counts.size() : 0);
               for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
               {
                 for (std::int64_t j = 0; j < region.size[1]; ++j)
                 {
                   const T* row = volume.row(region.begin[1] + j, region.begin[2] + k);
-                  if constexpr (std::is_integral<T>::value && sizeof(T) <= 2)
+                  if constexpr (kCellPerValue)
                   {
                     // A cell per value: count only; the cells' extrema are their values.
-                    const auto lowest = static_cast<std::int64_t>(part.lowest);
-                    const auto last = static_cast<std::int64_t>(part.counts.size()) - 1;
-                    for (std::int64_t i = region.begin[0]; i < region.begin[0] + region.size[0];
-                         ++i)
-                    {
-                      const std::int64_t c =
-                        static_cast<std::int64_t>(row[i * volume.stride]) - lowest;
-                      ++part.counts[std::min(last, std::max<std::int64_t>(0, c))];
-                    }
+                    cellCounts.addRow(row + region.begin[0] * volume.stride, region.size[0],
+                      volume.stride, static_cast<std::int64_t>(part.lowest), part.counts);
                     continue;
                   }
                   for (std::int64_t i = region.begin[0]; i < region.begin[0] + region.size[0]; ++i)
@@ -123,6 +178,7 @@ Status addToValueHistogram(const VolumeView& view, const Region& region, ValueHi
                 }
                 progress.advance();
               }
+              cellCounts.addTo(part.counts);
               if (part.integerCells)
               {
                 for (std::size_t c = 0; c < part.counts.size(); ++c)
