@@ -126,12 +126,17 @@ public:
         VAO_HAVE_AVX2_TARGET && simd == SimdTier::Avx512 && this->Keys.place(thresholds);
     if constexpr (kTable)
     {
+      // The values in ascending order, the count of thresholds below them walked along
+      // (thresholdIndex of each, without a search per value of a 16-bit type).
       const double lowest = static_cast<double>(std::numeric_limits<T>::lowest());
       this->Table.resize(std::size_t(1) << (8 * sizeof(T)));
+      std::size_t below = 0;
       for (std::size_t i = 0; i < this->Table.size(); ++i)
       {
-        this->Table[i] = static_cast<std::uint16_t>(thresholdIndex(
-          lowest + static_cast<double>(i), thresholds.data(), static_cast<int>(thresholds.size())));
+        const double value = lowest + static_cast<double>(i);
+        while (below < thresholds.size() && thresholds[below] < value)
+          ++below;
+        this->Table[i] = static_cast<std::uint16_t>(below);
       }
     }
   }
