@@ -1,21 +1,15 @@
 // The lane loops of Histogram CDF on the CPU (HistogramChannels.cxx). A pixel's histogram
 // is a vector of `lanes` small unsigned counts held cumulatively: lane c counts the voxels
 // of bin c or below, so that adding a voxel adds a row of a mask table and the count below
-// a bin is one lane. The loops are structs whose
-// run() runRows compiles for AVX2 as well (CpuDispatch.h); `Fixed` is the lane count when
-// it is known at compile time (the default 64 bins), 0 when it is read at run time.
+// a bin is one lane. The loops are structs whose run() runRows compiles for AVX2 as well
+// (CpuDispatch.h); `Fixed` is the lane count when it is known at compile time (the
+// default 64 bins), 0 when it is read at run time.
 #pragma once
 
 #include "cpu/simd/CpuDispatch.h"
 
-#include "vao/Estimators.h"
-
-#include <algorithm>
 #include <cstdint>
 #include <cstring>
-#include <limits>
-#include <type_traits>
-#include <vector>
 
 namespace vao
 {

@@ -78,21 +78,20 @@ __attribute__((target("avx2,fma"))) void runAvx2(Args... args)
   Kernel::run(args...);
 }
 
+// The AVX-512 subsets of x86-64-v4, with the AVX2 and FMA below them.
+#define VAO_AVX512_FEATURES "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"
+
 // GCC vectorises for 256 bits on AVX-512 unless told to use the full width; Clang takes
 // min_vector_width for the same.
 #if defined(__clang__)
-#define VAO_AVX512_TARGET                                                                          \
-  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"), min_vector_width(512)))
+#define VAO_AVX512_TARGET __attribute__((target(VAO_AVX512_FEATURES), min_vector_width(512)))
 #else
-#define VAO_AVX512_TARGET                                                                          \
-  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma,prefer-vector-width=512")))
+#define VAO_AVX512_TARGET __attribute__((target(VAO_AVX512_FEATURES ",prefer-vector-width=512")))
 #endif
 
 // Hand-written AVX-512 code (intrinsics): its entry points and the helpers they inline.
-#define VAO_AVX512_INLINE                                                                          \
-  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"))) inline
-#define VAO_AVX512_HELPER                                                                          \
-  __attribute__((target("avx512f,avx512vl,avx512dq,avx512bw,avx2,fma"), always_inline)) inline
+#define VAO_AVX512_INLINE __attribute__((target(VAO_AVX512_FEATURES))) inline
+#define VAO_AVX512_HELPER __attribute__((target(VAO_AVX512_FEATURES), always_inline)) inline
 
 template <class Kernel, class... Args>
 VAO_AVX512_TARGET void runAvx512(Args... args)
