@@ -114,6 +114,8 @@ class TileHistograms
 {
   /// A voxel's bin in the ring (binBytes).
   using B = typename std::conditional<Fixed == 64, std::uint8_t, std::uint16_t>::type;
+  template <int VectorBytes>
+  using RowQueryOf = RowQuery<L, Fixed, VectorBytes>;
 
 public:
   TileHistograms(const TypedVolume<T>& volume, const HistogramJob& job, const BinOf<T>& bin)
@@ -257,7 +259,7 @@ private:
     for (std::int64_t y = y0; y < y0 + ny; ++y)
     {
       this->queryBins(y, z);
-      runRows<RowQuery<L, Fixed>>(this->Job.simd, static_cast<const L*>(this->Columns.data()),
+      runRowsOfWidth<RowQueryOf>(this->Job.simd, static_cast<const L*>(this->Columns.data()),
         this->width(), this->X0 - this->HX0, this->NX, std::int64_t(r.x), this->Lanes,
         static_cast<const int*>(this->Upper.data()), this->Bins, this->Histograms.data(),
         this->Below.data(), this->At.data());

@@ -9,7 +9,6 @@
 #include "cpu/simd/CpuDispatch.h"
 
 #include <cstdint>
-#include <cstring>
 
 namespace vao
 {
@@ -60,8 +59,9 @@ struct SlideRows
 /// `histograms`. Output i then takes from its histogram the count below its bin upper[i]
 /// and the count in that bin: below[i] = h[u - 1] (0 for u = 0), at[i] = h[u] - below[i]
 /// (0 for u = bins). (Read once the row is stored: a lane read back from the vector just
-/// stored would wait for the store.)
-template <class L, int Fixed>
+/// stored would wait for the store.) VectorBytes: the target's vector width
+/// (runRowsOfWidth).
+template <class L, int Fixed, int VectorBytes>
 struct RowQuery
 {
   static VAO_ALWAYS_INLINE void run(const L* __restrict columns, std::int64_t width,
@@ -107,24 +107,25 @@ struct RowQuery
   }
 
   /// The running histogram of a known lane count in vector registers (GCC's and Clang's
-  /// vector types, 64 bytes each), stored per output: a value read back from memory would
-  /// wait for its own store on every output.
+  /// vector types of the target's width), stored per output: a value read back from memory
+  /// would wait for its own store on every output.
   static VAO_ALWAYS_INLINE void runningRegisters(const L* __restrict columns, std::int64_t width,
     std::int64_t first, std::int64_t count, std::int64_t r, std::int64_t lo, std::int64_t hi,
     L* __restrict histograms)
   {
-    typedef L Vector __attribute__((vector_size(64)));
-    constexpr int kPerVector = 64 / sizeof(L);
+    typedef L Vector __attribute__((vector_size(VectorBytes)));
+    // Memory as unaligned vectors free to alias the lanes: loads and stores by assignment,
+    // so that no address of a register vector is taken (which keeps it on the stack).
+    typedef L Memory __attribute__((vector_size(VectorBytes), aligned(alignof(L)), may_alias));
+    constexpr int kPerVector = VectorBytes / sizeof(L);
     constexpr int kVectors = Fixed / kPerVector;
     static_assert(Fixed % kPerVector == 0, "whole vectors of lanes");
+    const Memory* __restrict pixels = reinterpret_cast<const Memory*>(columns);
+    Memory* __restrict stored = reinterpret_cast<Memory*>(histograms);
     Vector h[kVectors] = {};
-    Vector v;
     for (std::int64_t x = lo; x <= hi; ++x)
       for (int k = 0; k < kVectors; ++k)
-      {
-        std::memcpy(&v, columns + x * Fixed + k * kPerVector, sizeof(v));
-        h[k] += v;
-      }
+        h[k] += pixels[x * kVectors + k];
     for (std::int64_t i = 0; i < count; ++i)
     {
       if (i > 0)
@@ -132,19 +133,13 @@ struct RowQuery
         const std::int64_t entering = first + i + r, leaving = first + i - r - 1;
         if (entering < width)
           for (int k = 0; k < kVectors; ++k)
-          {
-            std::memcpy(&v, columns + entering * Fixed + k * kPerVector, sizeof(v));
-            h[k] += v;
-          }
+            h[k] += pixels[entering * kVectors + k];
         if (leaving >= 0)
           for (int k = 0; k < kVectors; ++k)
-          {
-            std::memcpy(&v, columns + leaving * Fixed + k * kPerVector, sizeof(v));
-            h[k] -= v;
-          }
+            h[k] -= pixels[leaving * kVectors + k];
       }
       for (int k = 0; k < kVectors; ++k)
-        std::memcpy(histograms + i * Fixed + k * kPerVector, &h[k], sizeof(Vector));
+        stored[i * kVectors + k] = h[k];
     }
   }
 };

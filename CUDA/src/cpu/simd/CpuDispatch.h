@@ -120,5 +120,27 @@ void runRows(SimdTier tier, Args... args)
   runBaseline<Kernel>(args...);
 }
 
+/// Kernel<Bytes>::run(args...) in the version of `tier`, Bytes its vector width (16, 32 or
+/// 64): for loops written with GCC's and Clang's vector types, which a target narrower than
+/// the type would split through the stack.
+template <template <int> class Kernel, class... Args>
+void runRowsOfWidth(SimdTier tier, Args... args)
+{
+#if VAO_HAVE_AVX2_TARGET
+  if (tier == SimdTier::Avx512)
+  {
+    runAvx512<Kernel<64>>(args...);
+    return;
+  }
+  if (tier == SimdTier::Avx2)
+  {
+    runAvx2<Kernel<32>>(args...);
+    return;
+  }
+#endif
+  (void)tier;
+  runBaseline<Kernel<16>>(args...);
+}
+
 } // namespace detail
 } // namespace vao
