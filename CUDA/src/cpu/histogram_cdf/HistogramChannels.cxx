@@ -51,10 +51,11 @@ int laneCount(int bins)
   return (bins + kLaneMultiple - 1) / kLaneMultiple * kLaneMultiple;
 }
 
-/// Whether the window's counts (at most 2 Rz + 1 per pixel) fit 8-bit lanes.
+/// Whether the window's counts (at most 2 Rz + 1 per pixel) fit 8-bit lanes, with the
+/// difference of two counts in their signed range (SlideRows).
 bool narrowWindow(const Radius& r)
 {
-  return 2 * std::int64_t(r.z) + 1 <= 0xFF;
+  return 2 * std::int64_t(r.z) + 1 <= std::numeric_limits<std::int8_t>::max();
 }
 
 /// Slices whose bins a tile keeps: those of a z window and its next entering slice.

@@ -9,6 +9,7 @@
 #include "cpu/simd/CpuDispatch.h"
 
 #include <cstdint>
+#include <type_traits>
 
 namespace vao
 {
@@ -41,77 +42,90 @@ struct MoveRow
   }
 };
 
-/// columns += entering - leaving over n lanes: the y window's sums move one row down.
+/// columns += entering - leaving over n lanes: the y window's sums move one row down. The
+/// difference is taken in the window's width and sign-extended (one widening instead of
+/// two), which holds while a window count fits W's signed range (narrowWindow).
 template <class L, class W>
 struct SlideRows
 {
   static VAO_ALWAYS_INLINE void run(L* __restrict columns, const W* __restrict entering,
     const W* __restrict leaving, std::int64_t n)
   {
+    using Signed = typename std::make_signed<W>::type;
     for (std::int64_t c = 0; c < n; ++c)
-      columns[c] = static_cast<L>(columns[c] + L(entering[c]) - L(leaving[c]));
+      columns[c] = static_cast<L>(
+        columns[c] + static_cast<L>(static_cast<Signed>(static_cast<W>(entering[c] - leaving[c]))));
   }
 };
 
 /// The x window over one row of `columns` (width pixels, each the y and z window's
 /// cumulative counts), for the outputs from pixel `first`, `count` of them, half-width r:
-/// a running histogram plus the pixel entering minus the one leaving, stored per output in
-/// `histograms`. Output i then takes from its histogram the count below its bin upper[i]
-/// and the count in that bin: below[i] = h[u - 1] (0 for u = 0), at[i] = h[u] - below[i]
-/// (0 for u = bins). (Read once the row is stored: a lane read back from the vector just
-/// stored would wait for the store.) VectorBytes: the target's vector width
-/// (runRowsOfWidth).
+/// a running histogram plus the pixel entering minus the one leaving. Output i takes from
+/// its histogram the count below its bin upper[i] and the count in that bin: below[i] =
+/// h[u - 1] (0 for u = 0), at[i] = h[u] - below[i] (0 for u = bins). `histograms` holds
+/// `count` histograms (kLag for a known lane count). VectorBytes: the target's vector
+/// width (runRowsOfWidth).
 template <class L, int Fixed, int VectorBytes>
 struct RowQuery
 {
+  /// Outputs between a histogram's store and the reading of its two lanes: a lane read
+  /// back from the vector just stored would wait for the store.
+  static constexpr int kLag = 8;
+
   static VAO_ALWAYS_INLINE void run(const L* __restrict columns, std::int64_t width,
     std::int64_t first, std::int64_t count, std::int64_t r, int runtimeLanes,
     const int* __restrict upper, int bins, L* histograms, std::uint32_t* __restrict below,
     std::uint32_t* __restrict at)
   {
-    const int lanes = Fixed ? Fixed : runtimeLanes;
     const std::int64_t lo = first - r > 0 ? first - r : 0;
     const std::int64_t hi = first + r < width - 1 ? first + r : width - 1;
     if constexpr (Fixed > 0)
-      runningRegisters(columns, width, first, count, r, lo, hi, histograms);
-    else
     {
-      // Each output starts from the one stored before it.
+      (void)runtimeLanes;
+      runningRegisters(columns, width, first, count, r, lo, hi, upper, bins, histograms, below, at);
+      return;
+    }
+    const int lanes = runtimeLanes;
+    // Each output starts from the one stored before it.
+    for (int c = 0; c < lanes; ++c)
+      histograms[c] = 0;
+    for (std::int64_t x = lo; x <= hi; ++x)
       for (int c = 0; c < lanes; ++c)
-        histograms[c] = 0;
-      for (std::int64_t x = lo; x <= hi; ++x)
+        histograms[c] = static_cast<L>(histograms[c] + columns[x * lanes + c]);
+    for (std::int64_t i = 1; i < count; ++i)
+    {
+      const std::int64_t entering = first + i + r, leaving = first + i - r - 1;
+      L* next = histograms + i * lanes;
+      for (int c = 0; c < lanes; ++c)
+        next[c] = histograms[(i - 1) * lanes + c];
+      if (entering < width)
         for (int c = 0; c < lanes; ++c)
-          histograms[c] = static_cast<L>(histograms[c] + columns[x * lanes + c]);
-      for (std::int64_t i = 1; i < count; ++i)
-      {
-        const std::int64_t entering = first + i + r, leaving = first + i - r - 1;
-        L* next = histograms + i * lanes;
+          next[c] = static_cast<L>(next[c] + columns[entering * lanes + c]);
+      if (leaving >= 0)
         for (int c = 0; c < lanes; ++c)
-          next[c] = histograms[(i - 1) * lanes + c];
-        if (entering < width)
-          for (int c = 0; c < lanes; ++c)
-            next[c] = static_cast<L>(next[c] + columns[entering * lanes + c]);
-        if (leaving >= 0)
-          for (int c = 0; c < lanes; ++c)
-            next[c] = static_cast<L>(next[c] - columns[leaving * lanes + c]);
-      }
+          next[c] = static_cast<L>(next[c] - columns[leaving * lanes + c]);
     }
     for (std::int64_t i = 0; i < count; ++i)
-    {
-      const L* __restrict hist = histograms + i * lanes;
-      const int u = upper[i];
-      const std::uint32_t under = u > 0 ? hist[u - 1] : 0;
-      below[i] = under;
-      at[i] = u < bins ? static_cast<std::uint32_t>(static_cast<L>(hist[u] - under)) : 0;
-    }
+      take(histograms + i * lanes, upper[i], bins, below[i], at[i]);
+  }
+
+  /// The counts below and in bin u of a stored histogram.
+  static VAO_ALWAYS_INLINE void take(
+    const L* __restrict hist, int u, int bins, std::uint32_t& below, std::uint32_t& at)
+  {
+    const std::uint32_t under = u > 0 ? hist[u - 1] : 0;
+    below = under;
+    at = u < bins ? static_cast<std::uint32_t>(static_cast<L>(hist[u] - under)) : 0;
   }
 
   /// The running histogram of a known lane count in vector registers (GCC's and Clang's
-  /// vector types of the target's width), stored per output: a value read back from memory
-  /// would wait for its own store on every output.
+  /// vector types of the target's width), stored per output in a ring of kLag histograms
+  /// (which stays in the L1 cache) and read kLag - 1 outputs later: a value read back from
+  /// memory would wait for its own store on every output.
   static VAO_ALWAYS_INLINE void runningRegisters(const L* __restrict columns, std::int64_t width,
     std::int64_t first, std::int64_t count, std::int64_t r, std::int64_t lo, std::int64_t hi,
-    L* __restrict histograms)
+    const int* __restrict upper, int bins, L* __restrict ring, std::uint32_t* __restrict below,
+    std::uint32_t* __restrict at)
   {
     typedef L Vector __attribute__((vector_size(VectorBytes)));
     // Memory as unaligned vectors free to alias the lanes: loads and stores by assignment,
@@ -121,7 +135,7 @@ struct RowQuery
     constexpr int kVectors = Fixed / kPerVector;
     static_assert(Fixed % kPerVector == 0, "whole vectors of lanes");
     const Memory* __restrict pixels = reinterpret_cast<const Memory*>(columns);
-    Memory* __restrict stored = reinterpret_cast<Memory*>(histograms);
+    Memory* __restrict stored = reinterpret_cast<Memory*>(ring);
     Vector h[kVectors] = {};
     for (std::int64_t x = lo; x <= hi; ++x)
       for (int k = 0; k < kVectors; ++k)
@@ -138,9 +152,15 @@ struct RowQuery
           for (int k = 0; k < kVectors; ++k)
             h[k] -= pixels[leaving * kVectors + k];
       }
+      const std::int64_t slot = i % kLag;
       for (int k = 0; k < kVectors; ++k)
-        stored[i * kVectors + k] = h[k];
+        stored[slot * kVectors + k] = h[k];
+      const std::int64_t j = i - (kLag - 1); // the output whose lanes are read now
+      if (j >= 0)
+        take(ring + (j % kLag) * Fixed, upper[j], bins, below[j], at[j]);
     }
+    for (std::int64_t j = count > kLag - 1 ? count - (kLag - 1) : 0; j < count; ++j)
+      take(ring + (j % kLag) * Fixed, upper[j], bins, below[j], at[j]);
   }
 };
 
