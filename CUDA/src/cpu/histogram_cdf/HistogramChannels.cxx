@@ -3,8 +3,8 @@
 // A voxel falls in bin b = thresholdIndex(v) (v <= t_b, above t_(b-1)). The box counts of
 // all bins are separable box sums of one-hot indicator volumes, computed together as
 // vectors of `lanes` small unsigned integers per pixel, held cumulatively (lane c: bin c or
-// below; HistogramLanes.h). The work goes tile by tile (TileSize x TileSize output
-// columns, a z-range each), which keeps a tile's state in the L2 cache and the extra
+// below; HistogramLanes.h). The work goes tile by tile (a block of output columns and a
+// z-range, planTiles), which keeps a tile's state in the processor's cache and the extra
 // memory far below the input's size:
 //  - Window: the counts of the 2 Rz + 1 slices around z, per pixel of the tile grown by
 //    the radius, in 8-bit lanes where 2 Rz + 1 fits. Moving to the next slice adds one
@@ -71,34 +71,86 @@ int binBytes(int lanes)
   return lanes == 64 ? 1 : 2;
 }
 
-/// Bytes of one worker's state for tiles of `tile` columns: the window counts of the tile
-/// grown by the radius, one row of column sums, and the ring of the slices' bins.
-std::int64_t tileStateBytes(std::int64_t tile, const Radius& r, int lanes, int laneBytes)
+/// Bytes of one worker's state for tiles grown by the radius to spanX x spanY pixels: their
+/// window counts, one row of column sums, and the ring of the slices' bins.
+std::int64_t tileStateBytes(
+  std::int64_t spanX, std::int64_t spanY, const Radius& r, int lanes, int laneBytes)
 {
-  const std::int64_t span = tile + 2 * std::max(r.x, r.y);
   const int windowBytes = narrowWindow(r) ? 1 : laneBytes;
-  return (span * span * windowBytes + span * laneBytes) * lanes +
-    ringSlices(r) * span * span * binBytes(lanes);
+  return (spanX * spanY * windowBytes + spanX * laneBytes) * lanes +
+    ringSlices(r) * spanX * spanY * binBytes(lanes);
 }
 
-/// The tile's side: 64 (larger tiles leave the L2 cache, smaller ones recount more of
-/// their border), smaller when the workers' states would exceed an eighth of the input
-/// (the rest of the 25% the filter may add goes to buffers that do not shrink with the
-/// tile), down to 16.
-std::int64_t tileSize(
-  std::int64_t inputBytes, const Radius& r, int lanes, int laneBytes, int threads)
+/// How the region is cut: tiles of sideX x sideY output columns (tilesX x tilesY of them,
+/// balanced), each cut into zParts ranges of slices; a unit of work is one tile's z-range.
+/// A tile grown by the radius, within the volume, has at most spanX x spanY pixels.
+struct TilePlan
 {
-  std::int64_t tile = 64;
-  while (tile > 16 && threads * tileStateBytes(tile, r, lanes, laneBytes) > inputBytes / 8)
+  std::int64_t sideX = 0, sideY = 0, tilesX = 0, tilesY = 0, zParts = 0;
+  std::int64_t spanX = 0, spanY = 0;
+  std::int64_t units() const { return tilesX * tilesY * zParts; }
+};
+
+/// Tiles of `tiles` along an axis of n columns, as even as they can be: the longest's side.
+std::int64_t evenSide(std::int64_t n, std::int64_t tiles)
+{
+  return (n + tiles - 1) / tiles;
+}
+
+/// The plan whose slowest thread has the least work. A unit's work is its outputs plus its
+/// window's pixels over its slices and the 2 Rz slices that start the window, both grown
+/// by the border it recounts; the units go to the threads as they free up, so the slowest
+/// does ceil(units / threads) of the largest. Tiles are at most 256 columns a side (larger
+/// ones save little border and leave the processor's caches), and the workers' states
+/// together take at most a fifth of the input's bytes or 16 MiB, whichever is more (with
+/// the value histogram and the row buffers, the filter's extra memory stays within its 25%
+/// bar on volumes above 80 MiB; smaller ones get whole-slice tiles, which recount no
+/// border).
+TilePlan planTiles(const Index3& size, const Index3& dims, std::int64_t inputBytes, const Radius& r,
+  int lanes, int laneBytes, int threads)
+{
+  constexpr std::int64_t kLargestSide = 256, kSmallestSide = 16;
+  constexpr std::int64_t kSmallestBudget = std::int64_t(16) << 20;
+  const std::int64_t budget = std::max(inputBytes / 5, kSmallestBudget);
+  TilePlan best;
+  double bestWork = 0;
+  for (std::int64_t side = kLargestSide; side >= kSmallestSide; side -= 8)
   {
-    tile -= 8;
+    TilePlan plan;
+    plan.tilesX = std::max<std::int64_t>(1, (size[0] + side - 1) / side);
+    plan.tilesY = std::max<std::int64_t>(1, (size[1] + side - 1) / side);
+    plan.sideX = evenSide(size[0], plan.tilesX);
+    plan.sideY = evenSide(size[1], plan.tilesY);
+    plan.spanX = std::min(plan.sideX + 2 * std::int64_t(r.x), dims[0]);
+    plan.spanY = std::min(plan.sideY + 2 * std::int64_t(r.y), dims[1]);
+    const bool fits =
+      threads * tileStateBytes(plan.spanX, plan.spanY, r, lanes, laneBytes) <= budget;
+    if (!fits && side > kSmallestSide)
+      continue;
+    const std::int64_t tiles = plan.tilesX * plan.tilesY;
+    const double pixels = double(plan.spanX) * double(plan.spanY);
+    const double outputs = double(plan.sideX) * double(plan.sideY);
+    for (std::int64_t parts = 1; parts <= std::min<std::int64_t>(size[2], 8 * threads); ++parts)
+    {
+      const std::int64_t slices = evenSide(size[2], parts);
+      const std::int64_t rounds = (tiles * parts + threads - 1) / threads;
+      const double work = double(rounds) *
+        (outputs * double(slices) +
+          pixels * double(slices + std::min<std::int64_t>(2 * std::int64_t(r.z), size[2])));
+      if (best.zParts == 0 || work < bestWork)
+      {
+        best = plan;
+        best.zParts = parts;
+        bestWork = work;
+      }
+    }
   }
-  return tile;
+  return best;
 }
 
 struct HistogramJob
 {
-  std::int64_t tile; // side of the tiles in columns
+  TilePlan plan;
   const Region& region;
   const Radius& radius;
   const std::vector<double>& thresholds;
@@ -126,12 +178,12 @@ public:
     , Bins(static_cast<int>(job.thresholds.size()))
     , Lanes(laneCount(Bins))
   {
-    const std::int64_t tile = job.tile;
-    const std::int64_t span = tile + 2 * std::max(job.radius.x, job.radius.y);
+    const std::int64_t tile = job.plan.sideX; // outputs of a row
+    const std::int64_t span = job.plan.spanX; // pixels of a row
     this->RingSlices = ringSlices(job.radius);
-    this->SlicePixels = span * span;
+    this->SlicePixels = span * job.plan.spanY;
     this->SliceBins.resize(static_cast<std::size_t>(this->RingSlices * this->SlicePixels));
-    this->Window.resize(static_cast<std::size_t>(span * span * this->Lanes));
+    this->Window.resize(static_cast<std::size_t>(this->SlicePixels * this->Lanes));
     this->Columns.resize(static_cast<std::size_t>(span * this->Lanes));
     this->WindowZeros.assign(static_cast<std::size_t>(span * this->Lanes), W(0));
     this->Histograms.resize(static_cast<std::size_t>(tile * this->Lanes));
@@ -348,14 +400,9 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
 {
   const BinOf<T> bin(job.thresholds, job.simd);
   const Region& region = job.region;
-  const std::int64_t tile = job.tile;
-  const std::int64_t tilesX = (region.size[0] + tile - 1) / tile;
-  const std::int64_t tilesY = (region.size[1] + tile - 1) / tile;
+  const TilePlan& plan = job.plan;
+  const std::int64_t units = plan.units();
   const int threads = resolveThreadCount(execution.threads);
-  // Enough units for every thread several times over; each z-range starts its window anew.
-  const std::int64_t zParts = std::min<std::int64_t>(region.size[2],
-    std::max<std::int64_t>(1, (4 * threads + tilesX * tilesY - 1) / (tilesX * tilesY)));
-  const std::int64_t units = tilesX * tilesY * zParts;
   return parallelFor(units, static_cast<int>(std::min<std::int64_t>(units, 1 << 20)), threads,
     execution,
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
@@ -363,13 +410,14 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
       TileHistograms<T, L, W, Fixed> state(volume, job, bin);
       for (std::int64_t u = begin; u < end && !progress.stopped(); ++u)
       {
-        const std::int64_t part = u % zParts, t = u / zParts;
-        const std::int64_t tx = t % tilesX, ty = t / tilesX;
-        const std::int64_t x0 = region.begin[0] + tx * tile, y0 = region.begin[1] + ty * tile;
-        const std::int64_t z0 = region.begin[2] + region.size[2] * part / zParts;
-        const std::int64_t z1 = region.begin[2] + region.size[2] * (part + 1) / zParts;
-        state.compute(x0, std::min(tile, region.begin[0] + region.size[0] - x0), y0,
-          std::min(tile, region.begin[1] + region.size[1] - y0), z0, z1);
+        const std::int64_t part = u % plan.zParts, t = u / plan.zParts;
+        const std::int64_t tx = t % plan.tilesX, ty = t / plan.tilesX;
+        const std::int64_t x0 = region.begin[0] + tx * plan.sideX;
+        const std::int64_t y0 = region.begin[1] + ty * plan.sideY;
+        const std::int64_t z0 = region.begin[2] + region.size[2] * part / plan.zParts;
+        const std::int64_t z1 = region.begin[2] + region.size[2] * (part + 1) / plan.zParts;
+        state.compute(x0, std::min(plan.sideX, region.begin[0] + region.size[0] - x0), y0,
+          std::min(plan.sideY, region.begin[1] + region.size[1] - y0), z0, z1);
         progress.advance();
       }
     });
@@ -395,8 +443,8 @@ bool computeHistogramOpenness(const VolumeView& view, const Region& region, cons
       using T = decltype(tag);
       const TypedVolume<T> volume(view);
       const std::int64_t inputBytes = view.voxelCount() * static_cast<std::int64_t>(sizeof(T));
-      const HistogramJob job{ tileSize(inputBytes, radius, lanes, laneBytes,
-                                resolveThreadCount(execution.threads)),
+      const HistogramJob job{ planTiles(region.size, view.dims, inputBytes, radius, lanes,
+                                laneBytes, resolveThreadCount(execution.threads)),
         region, radius, thresholds, query, openness, cpuSimdTierUpTo(SimdTier::Avx512),
         range ? &seen : nullptr };
       // The default 64 bins in 16-bit lanes: loops of a known length.
