@@ -156,6 +156,58 @@ TEST(HistogramCdf, SummariesOfPartsMergeToTheWholeVolumes)
   }
 }
 
+namespace
+{
+
+/// addToValueHistogram's counts and extrema against a voxel-by-voxel tally over
+/// ValueHistogram::cell, on a sub-region of every other voxel (a stride of 2).
+template <class T>
+void expectCellsHoldTheirValues(std::vector<T> v, const vao::Index3& dims)
+{
+  const auto view = viewOf(v, dims, 2);
+  double lo = INFINITY, hi = -INFINITY;
+  for (std::size_t i = 0; i < v.size(); i += 2)
+    if (std::isfinite(double(v[i])))
+      lo = std::min(lo, double(v[i])), hi = std::max(hi, double(v[i]));
+  const vao::Region region{ { 1, 2, 1 }, { dims[0] - 2, dims[1] - 3, dims[2] - 1 } };
+  auto got = vao::ValueHistogram::forRange(view.type, lo, hi);
+  auto expected = got;
+  ASSERT_TRUE(vao::addToValueHistogram(view, region, got).ok);
+  for (std::int64_t z = 1; z < dims[2]; ++z)
+    for (std::int64_t y = 2; y < dims[1] - 1; ++y)
+      for (std::int64_t x = 1; x < dims[0] - 1; ++x)
+      {
+        const double value = double(v[2 * ((z * dims[1] + y) * dims[0] + x)]);
+        if (!std::isfinite(value))
+          continue;
+        const std::int64_t c = expected.cell(value);
+        ++expected.counts[c];
+        expected.minimum[c] = std::min(expected.minimum[c], value);
+        expected.maximum[c] = std::max(expected.maximum[c], value);
+      }
+  EXPECT_EQ(got.counts, expected.counts);
+  EXPECT_EQ(got.minimum, expected.minimum);
+  EXPECT_EQ(got.maximum, expected.maximum);
+}
+
+} // namespace
+
+TEST(HistogramCdf, ValueSummaryCellsHoldTheirValues)
+{
+  const vao::Index3 dims = { 37, 11, 9 }, twice = { 2 * 37, 11, 9 };
+  auto f = randomVolume<float>(twice, -3.5e6, 1e7, 3);
+  f[10] = NAN;
+  f[12] = -INFINITY;
+  expectCellsHoldTheirValues(f, dims);
+  expectCellsHoldTheirValues(randomVolume<float>(twice, 0.0, 1e-40, 4), dims); // subnormal
+  expectCellsHoldTheirValues(std::vector<float>(twice[0] * 11 * 9, 2.5f), dims);
+  expectCellsHoldTheirValues(randomVolume<double>(twice, -1.7e308, 1.7e308, 5), dims);
+  expectCellsHoldTheirValues(randomVolume<std::int32_t>(twice, -70000, 90000, 6), dims);
+  expectCellsHoldTheirValues(randomVolume<std::int32_t>(twice, -700, 900, 7), dims);
+  expectCellsHoldTheirValues(randomVolume<std::uint32_t>(twice, 0, 4e9, 8), dims);
+  expectCellsHoldTheirValues(randomVolume<std::int64_t>(twice, -9e18, 9e18, 9), dims);
+}
+
 TEST(HistogramCdf, MatchesTheDefinitionOnRandomVolumes)
 {
   const vao::Index3 dims = { 17, 11, 9 };

@@ -126,6 +126,151 @@ private:
   std::int64_t Pending = 0; // values counted since the last addTo
 };
 
+/// Counts and extrema of values on a ValueHistogram's cells, a cell's three together (one
+/// cache line per value where three arrays take three), the extrema in V (float for float
+/// data, exact). A row's cells are found first, in a loop the compiler vectorises.
+template <class V>
+class CellTallies
+{
+public:
+  explicit CellTallies(const ValueHistogram& histogram)
+    : Lowest(histogram.lowest)
+    , HalfLowest(histogram.lowest / 2)
+    , HalfWidth(histogram.highest / 2 - histogram.lowest / 2)
+    , Cells(static_cast<double>(histogram.counts.size()))
+    , Last(static_cast<double>(histogram.counts.size() - 1))
+    , IntegerCells(histogram.integerCells)
+    , Tallies(histogram.counts.size(),
+        Tally{ std::numeric_limits<V>::infinity(), -std::numeric_limits<V>::infinity(), 0 })
+  {
+  }
+
+  /// Adds n values `stride` apart; non-finite ones are skipped.
+  template <class T>
+  void addRow(const T* row, std::int64_t n, std::int64_t stride)
+  {
+    this->RowCells.resize(static_cast<std::size_t>(n));
+    std::int32_t* cells = this->RowCells.data();
+    // ValueHistogram::cell, clamped before the conversion (the same cell for every
+    // finite value); -1 marks a value that is not finite.
+    if (this->IntegerCells)
+      for (std::int64_t i = 0; i < n; ++i)
+      {
+        const double v = static_cast<double>(row[i * stride]);
+        cells[i] = this->toCell(v, v - this->Lowest);
+      }
+    else if (this->HalfWidth > 0.0)
+      for (std::int64_t i = 0; i < n; ++i)
+      {
+        const double v = static_cast<double>(row[i * stride]);
+        cells[i] = this->toCell(v, (v / 2 - this->HalfLowest) / this->HalfWidth * this->Cells);
+      }
+    else
+      for (std::int64_t i = 0; i < n; ++i)
+        cells[i] = std::isfinite(static_cast<double>(row[i * stride])) ? 0 : -1;
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      if (cells[i] < 0)
+        continue;
+      const V v = static_cast<V>(row[i * stride]);
+      Tally& t = this->Tallies[cells[i]];
+      ++t.count;
+      t.minimum = std::min(t.minimum, v);
+      t.maximum = std::max(t.maximum, v);
+    }
+  }
+
+  /// Adds the tallies to `histogram` (on the same cells).
+  void addTo(ValueHistogram& histogram) const
+  {
+    for (std::size_t c = 0; c < this->Tallies.size(); ++c)
+    {
+      const Tally& t = this->Tallies[c];
+      histogram.counts[c] += t.count;
+      histogram.minimum[c] = std::min(histogram.minimum[c], static_cast<double>(t.minimum));
+      histogram.maximum[c] = std::max(histogram.maximum[c], static_cast<double>(t.maximum));
+    }
+  }
+
+private:
+  struct Tally
+  {
+    V minimum, maximum;
+    std::int64_t count;
+  };
+
+  /// The cell of value v at position `at` in cells (never NaN for a finite v), or -1 where v
+  /// is not finite.
+  std::int32_t toCell(double v, double at) const
+  {
+    const double clamped = std::min(std::max(at, 0.0), this->Last);
+    return std::isfinite(v) ? static_cast<std::int32_t>(clamped) : -1;
+  }
+
+  double Lowest, HalfLowest, HalfWidth, Cells, Last;
+  bool IntegerCells;
+  std::vector<Tally> Tallies;
+  std::vector<std::int32_t> RowCells;
+};
+
+/// A cell per integer holds one value: its extrema, where it has a count.
+void setIntegerCellExtrema(ValueHistogram& histogram)
+{
+  if (!histogram.integerCells)
+    return;
+  for (std::size_t c = 0; c < histogram.counts.size(); ++c)
+    if (histogram.counts[c] > 0)
+      histogram.minimum[c] = histogram.maximum[c] = histogram.lowest + static_cast<double>(c);
+}
+
+/// Slices [begin, end) of the region of 8- or 16-bit data into `histogram`, a cell per
+/// value: counts only, the cells' extrema being their values.
+template <class T>
+void countCellPerValue(const detail::TypedVolume<T>& volume, const Region& region,
+  std::int64_t begin, std::int64_t end, detail::ChunkProgress& progress, ValueHistogram& histogram,
+  std::mutex& merging)
+{
+  std::vector<std::int64_t> counts(histogram.counts.size(), 0);
+  InterleavedCounts cellCounts(counts.size());
+  for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
+  {
+    for (std::int64_t j = 0; j < region.size[1]; ++j)
+    {
+      const T* row = volume.row(region.begin[1] + j, region.begin[2] + k);
+      cellCounts.addRow(row + region.begin[0] * volume.stride, region.size[0], volume.stride,
+        static_cast<std::int64_t>(histogram.lowest), counts);
+    }
+    progress.advance();
+  }
+  cellCounts.addTo(counts);
+  const std::lock_guard<std::mutex> lock(merging);
+  for (std::size_t c = 0; c < counts.size(); ++c)
+    histogram.counts[c] += counts[c];
+  setIntegerCellExtrema(histogram);
+}
+
+/// Slices [begin, end) of the region of any other type into `histogram`.
+template <class T>
+void tallyCells(const detail::TypedVolume<T>& volume, const Region& region, std::int64_t begin,
+  std::int64_t end, detail::ChunkProgress& progress, ValueHistogram& histogram, std::mutex& merging)
+{
+  CellTallies<typename std::conditional<std::is_same<T, float>::value, float, double>::type>
+    tallies(histogram);
+  for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
+  {
+    for (std::int64_t j = 0; j < region.size[1]; ++j)
+    {
+      const T* row = volume.row(region.begin[1] + j, region.begin[2] + k);
+      tallies.addRow(row + region.begin[0] * volume.stride, region.size[0], volume.stride);
+    }
+    progress.advance();
+  }
+  // Counts add and extrema combine in any order: the result does not depend on it.
+  const std::lock_guard<std::mutex> lock(merging);
+  tallies.addTo(histogram);
+  setIntegerCellExtrema(histogram);
+}
+
 } // namespace
 
 Status addToValueHistogram(const VolumeView& view, const Region& region, ValueHistogram& histogram,
@@ -149,50 +294,10 @@ Status addToValueHistogram(const VolumeView& view, const Region& region, ValueHi
           return detail::parallelFor(region.size[2], threads, threads, execution,
             [&](std::int64_t begin, std::int64_t end, detail::ChunkProgress& progress)
             {
-              ValueHistogram part = histogram;
-              std::fill(part.counts.begin(), part.counts.end(), 0);
-              constexpr bool kCellPerValue = std::is_integral<T>::value && sizeof(T) <= 2;
-              InterleavedCounts cellCounts(kCellPerValue ? part.counts.size() : 0);
-              for (std::int64_t k = begin; k < end && !progress.stopped(); ++k)
-              {
-                for (std::int64_t j = 0; j < region.size[1]; ++j)
-                {
-                  const T* row = volume.row(region.begin[1] + j, region.begin[2] + k);
-                  if constexpr (kCellPerValue)
-                  {
-                    // A cell per value: count only; the cells' extrema are their values.
-                    cellCounts.addRow(row + region.begin[0] * volume.stride, region.size[0],
-                      volume.stride, static_cast<std::int64_t>(part.lowest), part.counts);
-                    continue;
-                  }
-                  for (std::int64_t i = region.begin[0]; i < region.begin[0] + region.size[0]; ++i)
-                  {
-                    const double v = static_cast<double>(row[i * volume.stride]);
-                    if (!std::isfinite(v))
-                      continue;
-                    const std::int64_t c = part.cell(v);
-                    ++part.counts[c];
-                    part.minimum[c] = std::min(part.minimum[c], v);
-                    part.maximum[c] = std::max(part.maximum[c], v);
-                  }
-                }
-                progress.advance();
-              }
-              cellCounts.addTo(part.counts);
-              if (part.integerCells)
-              {
-                for (std::size_t c = 0; c < part.counts.size(); ++c)
-                  if (part.counts[c] > 0)
-                    part.minimum[c] = part.maximum[c] = part.lowest + static_cast<double>(c);
-              }
-              const std::lock_guard<std::mutex> lock(merging);
-              // Counts add and extrema combine in any order: the result does not depend on it.
-              for (std::size_t c = 0; c < part.counts.size(); ++c)
-              {
-                histogram.counts[c] += part.counts[c];
-                histogram.minimum[c] = std::min(histogram.minimum[c], part.minimum[c]);
-                histogram.maximum[c] = std::max(histogram.maximum[c], part.maximum[c]);
-              }
+              if constexpr (std::is_integral<T>::value && sizeof(T) <= 2)
+                countCellPerValue(volume, region, begin, end, progress, histogram, merging);
+              else
+                tallyCells(volume, region, begin, end, progress, histogram, merging);
             });
         });
       return finished ? Status::success() : Status::cancelled();
