@@ -4,18 +4,22 @@
 // all bins are separable box sums of one-hot indicator volumes, computed together as
 // vectors of `lanes` small unsigned integers per pixel, held cumulatively (lane c: bin c or
 // below; HistogramLanes.h). The work goes tile by tile (a block of output columns and a
-// z-range, planTiles), which keeps a tile's state in the processor's cache and the extra
-// memory far below the input's size:
+// z-range, planTiles in HistogramTiles.h), which keeps a tile's state in the processor's
+// cache and the extra memory far below the input's size:
 //  - Window: the counts of the 2 Rz + 1 slices around z, per pixel of the tile grown by
 //    the radius, in 8-bit lanes where 2 Rz + 1 fits. Moving to the next slice adds one
-//    voxel's bin and removes one: O(1) vector work, and nothing where both fall in the same
-//    bin. Each voxel's bin is found once per tile, when its slice enters, and kept in a
-//    ring of the 2 Rz + 2 slices' bins for the slice leaving and for the query.
+//    voxel's bin and removes one: O(1) vector work, none for a row whose entering and
+//    leaving voxels share their bins. Each voxel's bin is found once per tile, when its
+//    slice enters, and kept in a ring of the 2 Rz + 2 slices' bins (with each row's lowest
+//    and highest bin) for the slice leaving and for the query.
 //  - Columns: the window summed over the 2 Ry + 1 rows around the output row, per pixel of
 //    the row (a running sum that moves one row down by the entering and leaving rows).
 //  - The x window over the columns (a running histogram along the output row) gives each
 //    output voxel's 3-D box histogram, from which its query takes F just below and at the
 //    query's bin: two lanes.
+//  - A row whose boxes all hold one bin (the background of a segmented or generated
+//    volume, the padding around a scan) skips the columns and the x window: its counts
+//    follow from the bin and each box's voxel count, as the Gaussian CDF's flat boxes do.
 // Counts never exceed the box's voxel count; lanes are 16 bits when that fits and the
 // intermediate sums may wrap (unsigned arithmetic is modular, and the final counts are
 // below 2^16), else 32 bits.
@@ -23,6 +27,7 @@
 
 #include "cpu/histogram_cdf/HistogramBins.h"
 #include "cpu/histogram_cdf/HistogramLanes.h"
+#include "cpu/histogram_cdf/HistogramTiles.h"
 
 #include "VolumeAccess.h"
 #include "cpu/common/ConcurrentRange.h"
@@ -42,111 +47,6 @@ namespace detail
 {
 namespace
 {
-
-constexpr int kLaneMultiple = 16;
-
-/// Lanes of a bin count: a multiple of kLaneMultiple (the AVX2 width of 16-bit lanes).
-int laneCount(int bins)
-{
-  return (bins + kLaneMultiple - 1) / kLaneMultiple * kLaneMultiple;
-}
-
-/// Whether the window's counts (at most 2 Rz + 1 per pixel) fit 8-bit lanes, with the
-/// difference of two counts in their signed range (SlideRows).
-bool narrowWindow(const Radius& r)
-{
-  return 2 * std::int64_t(r.z) + 1 <= std::numeric_limits<std::int8_t>::max();
-}
-
-/// Slices whose bins a tile keeps: those of a z window and its next entering slice.
-std::int64_t ringSlices(const Radius& r)
-{
-  return 2 * std::int64_t(r.z) + 2;
-}
-
-/// Bytes of a voxel's bin in the ring: 8 bits for the default 64 bins (the loops of a known
-/// lane count), else 16.
-int binBytes(int lanes)
-{
-  return lanes == 64 ? 1 : 2;
-}
-
-/// Bytes of one worker's state for tiles grown by the radius to spanX x spanY pixels: their
-/// window counts, one row of column sums, and the ring of the slices' bins.
-std::int64_t tileStateBytes(
-  std::int64_t spanX, std::int64_t spanY, const Radius& r, int lanes, int laneBytes)
-{
-  const int windowBytes = narrowWindow(r) ? 1 : laneBytes;
-  return (spanX * spanY * windowBytes + spanX * laneBytes) * lanes +
-    ringSlices(r) * spanX * spanY * binBytes(lanes);
-}
-
-/// How the region is cut: tiles of sideX x sideY output columns (tilesX x tilesY of them,
-/// balanced), each cut into zParts ranges of slices; a unit of work is one tile's z-range.
-/// A tile grown by the radius, within the volume, has at most spanX x spanY pixels.
-struct TilePlan
-{
-  std::int64_t sideX = 0, sideY = 0, tilesX = 0, tilesY = 0, zParts = 0;
-  std::int64_t spanX = 0, spanY = 0;
-  std::int64_t units() const { return tilesX * tilesY * zParts; }
-};
-
-/// Tiles of `tiles` along an axis of n columns, as even as they can be: the longest's side.
-std::int64_t evenSide(std::int64_t n, std::int64_t tiles)
-{
-  return (n + tiles - 1) / tiles;
-}
-
-/// The plan whose slowest thread has the least work. A unit's work is its outputs plus its
-/// window's pixels over its slices and the 2 Rz slices that start the window, both grown
-/// by the border it recounts; the units go to the threads as they free up, so the slowest
-/// does ceil(units / threads) of the largest. Tiles are at most 256 columns a side (larger
-/// ones save little border and leave the processor's caches), and the workers' states
-/// together take at most a fifth of the input's bytes or 16 MiB, whichever is more (with
-/// the value histogram and the row buffers, the filter's extra memory stays within its 25%
-/// bar on volumes above 80 MiB; smaller ones get whole-slice tiles, which recount no
-/// border).
-TilePlan planTiles(const Index3& size, const Index3& dims, std::int64_t inputBytes, const Radius& r,
-  int lanes, int laneBytes, int threads)
-{
-  constexpr std::int64_t kLargestSide = 256, kSmallestSide = 16;
-  constexpr std::int64_t kSmallestBudget = std::int64_t(16) << 20;
-  const std::int64_t budget = std::max(inputBytes / 5, kSmallestBudget);
-  TilePlan best;
-  double bestWork = 0;
-  for (std::int64_t side = kLargestSide; side >= kSmallestSide; side -= 8)
-  {
-    TilePlan plan;
-    plan.tilesX = std::max<std::int64_t>(1, (size[0] + side - 1) / side);
-    plan.tilesY = std::max<std::int64_t>(1, (size[1] + side - 1) / side);
-    plan.sideX = evenSide(size[0], plan.tilesX);
-    plan.sideY = evenSide(size[1], plan.tilesY);
-    plan.spanX = std::min(plan.sideX + 2 * std::int64_t(r.x), dims[0]);
-    plan.spanY = std::min(plan.sideY + 2 * std::int64_t(r.y), dims[1]);
-    const bool fits =
-      threads * tileStateBytes(plan.spanX, plan.spanY, r, lanes, laneBytes) <= budget;
-    if (!fits && side > kSmallestSide)
-      continue;
-    const std::int64_t tiles = plan.tilesX * plan.tilesY;
-    const double pixels = double(plan.spanX) * double(plan.spanY);
-    const double outputs = double(plan.sideX) * double(plan.sideY);
-    for (std::int64_t parts = 1; parts <= std::min<std::int64_t>(size[2], 8 * threads); ++parts)
-    {
-      const std::int64_t slices = evenSide(size[2], parts);
-      const std::int64_t rounds = (tiles * parts + threads - 1) / threads;
-      const double work = double(rounds) *
-        (outputs * double(slices) +
-          pixels * double(slices + std::min<std::int64_t>(2 * std::int64_t(r.z), size[2])));
-      if (best.zParts == 0 || work < bestWork)
-      {
-        best = plan;
-        best.zParts = parts;
-        bestWork = work;
-      }
-    }
-  }
-  return best;
-}
 
 struct HistogramJob
 {
@@ -183,6 +83,8 @@ public:
     this->RingSlices = ringSlices(job.radius);
     this->SlicePixels = span * job.plan.spanY;
     this->SliceBins.resize(static_cast<std::size_t>(this->RingSlices * this->SlicePixels));
+    this->RowLow.resize(static_cast<std::size_t>(this->RingSlices * job.plan.spanY));
+    this->RowHigh.resize(this->RowLow.size());
     this->Window.resize(static_cast<std::size_t>(this->SlicePixels * this->Lanes));
     this->Columns.resize(static_cast<std::size_t>(span * this->Lanes));
     this->WindowZeros.assign(static_cast<std::size_t>(span * this->Lanes), W(0));
@@ -285,8 +187,14 @@ private:
       {
         in = this->binsOf(entering, y);
         this->Bin.row(this->Volume.row(y, entering) + this->HX0 * stride, stride, width, in);
+        const std::size_t at = this->rowRangeIndex(entering, y);
+        runRows<BinRange<B>>(
+          this->Job.simd, static_cast<const B*>(in), width, &this->RowLow[at], &this->RowHigh[at]);
       }
       const B* out = leaving >= 0 ? this->binsOf(leaving, y) : nullptr;
+      // A row whose entering and leaving voxels share their bins leaves the window as it is.
+      if (in && out && std::equal(out, out + width, static_cast<const B*>(in)))
+        continue;
       runRows<MoveRow<W, Fixed, B>>(this->Job.simd, static_cast<const B*>(in), out, width,
         &this->Window[(y - this->HY0) * width * this->Lanes],
         static_cast<const W*>(this->Masks.data()), this->Lanes, this->Bins);
@@ -294,36 +202,119 @@ private:
   }
 
   /// The openness of output rows [y0, y0 + ny) of slice z from the window (the counts of
-  /// the slices around z): the columns start as the sums of the window rows around y0;
-  /// per output row, the query's bin, the x window's counts below and in that bin
-  /// (RowQuery) and the openness; then the columns slide one row down.
+  /// the slices around z). Per output row: the query's bin; the columns (the sums of the
+  /// window rows around the row) slid one row down from the row before, or summed anew;
+  /// the x window's counts below and in the query's bin (RowQuery); the openness. A row
+  /// whose boxes hold one bin only (uniformBin) needs no columns: its counts follow from
+  /// the bin, and the next row's columns from the same constant.
   void outputSlice(std::int64_t y0, std::int64_t ny, std::int64_t z)
   {
     const Radius& r = this->Job.radius;
     const Index3& dims = this->Volume.dims;
     const std::int64_t values = this->width() * this->Lanes;
-    std::fill(this->Columns.begin(), this->Columns.begin() + values, L(0));
-    for (std::int64_t y = std::max<std::int64_t>(0, y0 - r.y);
-         y <= std::min<std::int64_t>(dims[1] - 1, y0 + r.y); ++y)
-    {
-      runRows<SlideRows<L, W>>(
-        this->Job.simd, this->Columns.data(), this->windowRow(y), this->WindowZeros.data(), values);
-    }
+    // The row whose columns are held, and the last uniform row and its bin (y0 - 2: none).
+    std::int64_t columnsRow = y0 - 2, uniformRow = y0 - 2;
+    int uniform = -1;
     for (std::int64_t y = y0; y < y0 + ny; ++y)
     {
       this->queryBins(y, z);
-      runRowsOfWidth<RowQueryOf>(this->Job.simd, static_cast<const L*>(this->Columns.data()),
-        this->width(), this->X0 - this->HX0, this->NX, std::int64_t(r.x), this->Lanes,
-        static_cast<const int*>(this->Upper.data()), this->Bins, this->Histograms.data(),
-        this->Below.data(), this->At.data());
-      this->writeOpenness(y, z);
-      if (y + 1 < y0 + ny)
+      const int bin = this->uniformBin(y, z);
+      if (bin >= 0)
       {
-        runRows<SlideRows<L, W>>(this->Job.simd, this->Columns.data(),
-          this->windowRow(y + r.y + 1 < dims[1] ? y + r.y + 1 : -1), this->windowRow(y - r.y),
-          values);
+        this->uniformCounts(bin, y, z);
+        uniform = bin;
+        uniformRow = y;
       }
+      else
+      {
+        if (uniformRow == y - 1 && columnsRow != y - 1)
+        {
+          this->constantColumns(uniform, y - 1, z);
+          columnsRow = y - 1;
+        }
+        if (columnsRow == y - 1)
+          runRows<SlideRows<L, W>>(this->Job.simd, this->Columns.data(),
+            this->windowRow(y + r.y < dims[1] ? y + r.y : -1), this->windowRow(y - r.y - 1),
+            values);
+        else
+        {
+          std::fill(this->Columns.begin(), this->Columns.begin() + values, L(0));
+          for (std::int64_t w = std::max<std::int64_t>(0, y - r.y);
+               w <= std::min<std::int64_t>(dims[1] - 1, y + r.y); ++w)
+            runRows<SlideRows<L, W>>(this->Job.simd, this->Columns.data(), this->windowRow(w),
+              this->WindowZeros.data(), values);
+        }
+        columnsRow = y;
+        runRowsOfWidth<RowQueryOf>(this->Job.simd, static_cast<const L*>(this->Columns.data()),
+          this->width(), this->X0 - this->HX0, this->NX, std::int64_t(r.x), this->Lanes,
+          static_cast<const int*>(this->Upper.data()), this->Bins, this->Histograms.data(),
+          this->Below.data(), this->At.data());
+      }
+      this->writeOpenness(y, z);
     }
+  }
+
+  /// Where the ranges of the bins of row y of slice s are kept.
+  std::size_t rowRangeIndex(std::int64_t s, std::int64_t y) const
+  {
+    return static_cast<std::size_t>(
+      (s % this->RingSlices) * this->Job.plan.spanY + (y - this->HY0));
+  }
+
+  /// The bin of every voxel of the boxes of output row y of slice z (the rows and slices
+  /// of its y and z windows, across the tile grown by the radius) where they share one,
+  /// else -1.
+  int uniformBin(std::int64_t y, std::int64_t z) const
+  {
+    const Radius& r = this->Job.radius;
+    const Index3& dims = this->Volume.dims;
+    int bin = -1;
+    for (std::int64_t s = std::max<std::int64_t>(0, z - r.z);
+         s <= std::min<std::int64_t>(dims[2] - 1, z + r.z); ++s)
+      for (std::int64_t w = std::max<std::int64_t>(0, y - r.y);
+           w <= std::min<std::int64_t>(dims[1] - 1, y + r.y); ++w)
+      {
+        const std::size_t at = this->rowRangeIndex(s, w);
+        const int low = this->RowLow[at];
+        if (low != this->RowHigh[at] || (bin >= 0 && low != bin))
+          return -1;
+        bin = low;
+      }
+    return bin;
+  }
+
+  /// Voxels in the y and z windows of row y of slice z (clipped to the volume).
+  std::uint32_t windowCountYZ(std::int64_t y, std::int64_t z) const
+  {
+    const Radius& r = this->Job.radius;
+    const Index3& dims = this->Volume.dims;
+    return static_cast<std::uint32_t>(
+      clippedWindowCount(y, r.y, dims[1]) * clippedWindowCount(z, r.z, dims[2]));
+  }
+
+  /// RowQuery's counts for row y of slice z whose boxes hold bin b only: a box's n voxels
+  /// are at or below every threshold from t_b, none below it.
+  void uniformCounts(int b, std::int64_t y, std::int64_t z)
+  {
+    const std::uint32_t countYZ = this->windowCountYZ(y, z);
+    for (std::int64_t i = 0; i < this->NX; ++i)
+    {
+      const std::uint32_t n = static_cast<std::uint32_t>(this->CountX[i]) * countYZ;
+      const int u = this->Upper[i];
+      this->Below[i] = u - 1 >= b ? n : 0;
+      this->At[i] = u == b && u < this->Bins ? n : 0;
+    }
+  }
+
+  /// The columns of row y of slice z whose window rows hold bin b only: each pixel the
+  /// voxel count of its y and z windows in the lanes of bin b's mask.
+  void constantColumns(int b, std::int64_t y, std::int64_t z)
+  {
+    const L n = static_cast<L>(this->windowCountYZ(y, z));
+    const W* mask = &this->Masks[std::size_t(b) * this->Lanes];
+    for (std::int64_t x = 0; x < this->width(); ++x)
+      for (int c = 0; c < this->Lanes; ++c)
+        this->Columns[x * this->Lanes + c] = static_cast<L>(n * L(mask[c]));
   }
 
   /// The query of each output voxel of row y of slice z, and its bin.
@@ -383,11 +374,12 @@ private:
   std::int64_t RingSlices = 0, SlicePixels = 0;
   std::int64_t X0 = 0, NX = 0, HX0 = 0, HX1 = 0, HY0 = 0, HY1 = 0;
   std::vector<W> Window;
-  std::vector<L> Columns;     // one row of the y window's sums of the window
-  std::vector<W> WindowZeros; // a window row outside the volume
-  std::vector<B> SliceBins;   // the ring of the slices' bins (binsOf)
-  std::vector<W> Masks;       // row b: ones in the lanes from b (cumulative counts)
-  std::vector<L> Histograms;  // RowQuery's box histograms of one output row
+  std::vector<L> Columns;         // one row of the y window's sums of the window
+  std::vector<W> WindowZeros;     // a window row outside the volume
+  std::vector<B> SliceBins;       // the ring of the slices' bins (binsOf)
+  std::vector<B> RowLow, RowHigh; // per row of the ring's slices: its lowest and highest bin
+  std::vector<W> Masks;           // row b: ones in the lanes from b (cumulative counts)
+  std::vector<L> Histograms;      // RowQuery's box histograms of one output row
   std::vector<int> Upper;
   std::vector<std::uint32_t> Below, At;
   std::vector<double> Query;

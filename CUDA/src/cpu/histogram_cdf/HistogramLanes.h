@@ -42,6 +42,24 @@ struct MoveRow
   }
 };
 
+/// The lowest and highest of a row of n bins.
+template <class B>
+struct BinRange
+{
+  static VAO_ALWAYS_INLINE void run(
+    const B* __restrict bins, std::int64_t n, B* __restrict lowest, B* __restrict highest)
+  {
+    B low = bins[0], high = bins[0];
+    for (std::int64_t x = 1; x < n; ++x)
+    {
+      low = bins[x] < low ? bins[x] : low;
+      high = bins[x] > high ? bins[x] : high;
+    }
+    *lowest = low;
+    *highest = high;
+  }
+};
+
 /// columns += entering - leaving over n lanes: the y window's sums move one row down. The
 /// difference is taken in the window's width and sign-extended (one widening instead of
 /// two), which holds while a window count fits W's signed range (narrowWindow).
