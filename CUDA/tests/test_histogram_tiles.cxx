@@ -48,8 +48,8 @@ TEST(HistogramCdfTiles, RowsOfOneBinGiveTheDefinition)
   for (const vao::Radius r : { vao::Radius{ 1, 1, 1 }, { 2, 3, 1 }, { 0, 2, 2 }, { 3, 0, 3 } })
     for (const int threads : { 1, 3 })
     {
-      SCOPED_TRACE(testing::Message() << "radius " << r.x << "," << r.y << "," << r.z
-                                      << ", threads " << threads);
+      SCOPED_TRACE(testing::Message()
+        << "radius " << r.x << "," << r.y << "," << r.z << ", threads " << threads);
       expectMatchesDefinition(v, dims, r, thresholds, vao::QueryMode::VoxelValue, 0.0, threads);
       expectMatchesDefinition(v, dims, r, thresholds, vao::QueryMode::IsoValue, 250.0, threads);
       expectMatchesDefinition(v, dims, r, below300, vao::QueryMode::VoxelValue, 0.0, threads);
@@ -72,9 +72,8 @@ TEST(HistogramCdfTiles, EveryPlanGivesTheSameNumbers)
   const vao::Region region{ { 3, 4, 2 }, { 60, 37, 29 } };
   const auto one = histogramOpenness(view, region, r, thresholds, vao::QueryMode::VoxelValue, 0, 1);
   for (const int threads : { 2, 3, 5, 8, 16 })
-    EXPECT_EQ(histogramOpenness(view, region, r, thresholds, vao::QueryMode::VoxelValue, 0,
-                threads),
-      one)
+    EXPECT_EQ(
+      histogramOpenness(view, region, r, thresholds, vao::QueryMode::VoxelValue, 0, threads), one)
       << threads << " threads";
   expectMatchesDefinition(v, dims, r, thresholds, vao::QueryMode::VoxelValue, 0.0, 7);
 }
