@@ -1,6 +1,7 @@
 #include "vtkAmbientOcclusionPyramidImages.h"
 
 #include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -115,9 +116,21 @@ vtkSmartPointer<vtkImageData> LevelPiece(
   image->SetExtent(levelExt);
   image->SetOrigin(origin);
   auto part = vtkSmartPointer<vtkImageData>::New();
-  if (!vtkAmbientOcclusionExtents::EmptyExtent(wanted))
+  if (vtkAmbientOcclusionExtents::EmptyExtent(wanted))
   {
-    vtkAmbientOcclusionExtents::CopyRequestedExtent(image, part, wanted);
+    return part;
+  }
+  vtkAmbientOcclusionExtents::CopyRequestedExtent(image, part, wanted);
+  // The whole level handed on as it is: its ranges as the build kept them, where it did.
+  const bool wholeLevel = std::equal(wanted, wanted + 6, levelExt);
+  for (const auto& [name, range] :
+    { std::make_pair("Mean", level.meanRange), std::make_pair("Variance", level.varianceRange) })
+  {
+    if (wholeLevel && range.known)
+    {
+      vtkAmbientOcclusionRanges::CacheKnown(
+        part->GetPointData()->GetArray(name), range.lowest, range.highest);
+    }
   }
   return part;
 }

@@ -6,6 +6,7 @@
 #include "vtkAmbientOcclusionPhantom.h"
 #include "vtkIsosurfaceAmbientOcclusion.h"
 #include "vtkOcclusionSweeping.h"
+#include "vtkVarianceOcclusionMap.h"
 #include "vtkVolumetricAmbientOcclusion.h"
 
 #include "vtkDataSet.h"
@@ -14,6 +15,7 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationInformationVectorKey.h"
+#include "vtkMultiBlockDataSet.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
@@ -138,6 +140,27 @@ TEST(CachedRanges, RangesTheMomentMethodsKeepEqualVtksRanges)
       ExpectCachedRangesOfVtk(filter->GetOutput(), variance ? 2 : 1);
     }
   }
+}
+
+// The pyramid's levels carry the ranges the build kept, whole or as one piece of two.
+TEST(CachedRanges, PyramidLevelsEqualVtksRanges)
+{
+  auto input = Phantom();
+  for (const int half : { 0, 1 })
+    for (const int pieces : { 1, 2 })
+    {
+      SCOPED_TRACE(testing::Message() << "half " << half << ", pieces " << pieces);
+      vtkNew<vtkVarianceOcclusionMap> filter;
+      filter->SetInputData(input);
+      filter->SetNumberOfLevels(3);
+      filter->SetStartAtHalfResolution(half);
+      filter->UpdatePiece(pieces - 1, pieces, 0);
+      auto* output = vtkMultiBlockDataSet::SafeDownCast(filter->GetOutputDataObject(0));
+      ASSERT_TRUE(output);
+      ASSERT_EQ(output->GetNumberOfBlocks(), 3u);
+      for (unsigned int l = 0; l < 3; ++l)
+        ExpectCachedRangesOfVtk(vtkDataSet::SafeDownCast(output->GetBlock(l)), 2);
+    }
 }
 
 TEST(CachedRanges, SurfaceArraysWithDistinctComponentsEqualVtksRanges)

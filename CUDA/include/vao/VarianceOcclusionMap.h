@@ -40,6 +40,9 @@ struct MomentLevel
     kUnsetBound, kUnsetBound };
   LevelArray mean;
   LevelArray variance; // E[v^2] - E[v]^2 of the blurred moments, clamped at 0
+  // The range of each, kept as buildMomentPyramid writes the level (a caller handing the
+  // arrays on need not read them again); not known for a level built otherwise.
+  OutputRange meanRange, varianceRange;
   // The variance rounding alone can leave in a flat region (sumRoundingVariance of the
   // volume's largest deviation from the moments' shift): the estimators treat a sample
   // at or below it as flat.

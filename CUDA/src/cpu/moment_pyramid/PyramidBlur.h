@@ -24,6 +24,7 @@
 #include "vao/VarianceOcclusionMap.h"
 
 #include "VolumeAccess.h"
+#include "cpu/common/ConcurrentRange.h"
 #include "cpu/common/Parallel.h"
 #include "cpu/moment_pyramid/PyramidPlan.h"
 #include "cpu/moment_pyramid/PyramidRows.h"
@@ -346,7 +347,8 @@ inline auto levelRows(float* mean, float* variance, const Index3& out, std::int6
 }
 
 /// Blurs the source and keeps every `step`-th voxel per axis (step 1 or 2) into `out`
-/// (dims, mean and variance; geometry is the caller's). Returns false when cancelled.
+/// (dims, mean and variance and their ranges, each slice's taken while it is in the
+/// cache; geometry is the caller's). Returns false when cancelled.
 template <class Source>
 bool blurDecimate(const Source& source, int step, double shift, MomentLevel& out,
   const Execution& execution, int threads)
@@ -358,21 +360,32 @@ bool blurDecimate(const Source& source, int step, double shift, MomentLevel& out
   const auto outCount = static_cast<std::size_t>(plan.out[0] * plan.out[1] * plan.out[2]);
   out.mean.resize(outCount);
   out.variance.resize(outCount);
+  out.meanRange = out.varianceRange = OutputRange{};
   const int chunks =
     static_cast<int>(std::min<std::int64_t>(plan.out[2], std::max(1, threads) * 4));
-  return parallelFor(plan.out[2], chunks, threads, execution,
+  const std::int64_t slice = plan.out[0] * plan.out[1];
+  ConcurrentRange means, variances;
+  const bool done = parallelFor(plan.out[2], chunks, threads, execution,
     [&](std::int64_t zBegin, std::int64_t zEnd, ChunkProgress& progress)
     {
       SliceBlur<Source> blur(source, plan);
       for (std::int64_t zo = zBegin; zo < zEnd; ++zo)
       {
         blur.slice(zo, levelRows(out.mean.data(), out.variance.data(), plan.out, zo));
+        means.add(out.mean.data() + zo * slice, slice);
+        variances.add(out.variance.data() + zo * slice, slice);
         if (!progress.advance())
         {
           return;
         }
       }
     });
+  if (done)
+  {
+    out.meanRange = means.result();
+    out.varianceRange = variances.result();
+  }
+  return done;
 }
 
 /// Levels [from, levels.size()) of a pyramid, each blurred from the one before it and
