@@ -284,22 +284,22 @@ private:
   }
 
   /// Voxels in the y and z windows of row y of slice z (clipped to the volume).
-  std::uint32_t windowCountYZ(std::int64_t y, std::int64_t z) const
+  std::int64_t windowCountYZ(std::int64_t y, std::int64_t z) const
   {
     const Radius& r = this->Job.radius;
     const Index3& dims = this->Volume.dims;
-    return static_cast<std::uint32_t>(
-      clippedWindowCount(y, r.y, dims[1]) * clippedWindowCount(z, r.z, dims[2]));
+    return clippedWindowCount(y, r.y, dims[1]) * clippedWindowCount(z, r.z, dims[2]);
   }
 
   /// RowQuery's counts for row y of slice z whose boxes hold bin b only: a box's n voxels
   /// are at or below every threshold from t_b, none below it.
   void uniformCounts(int b, std::int64_t y, std::int64_t z)
   {
-    const std::uint32_t countYZ = this->windowCountYZ(y, z);
+    const std::int64_t countYZ = this->windowCountYZ(y, z);
     for (std::int64_t i = 0; i < this->NX; ++i)
     {
-      const std::uint32_t n = static_cast<std::uint32_t>(this->CountX[i]) * countYZ;
+      const auto n =
+        static_cast<std::uint32_t>(static_cast<std::int64_t>(this->CountX[i]) * countYZ);
       const int u = this->Upper[i];
       this->Below[i] = u - 1 >= b ? n : 0;
       this->At[i] = u == b && u < this->Bins ? n : 0;
@@ -340,11 +340,8 @@ private:
   /// The openness of row y of slice z from the counts below and in each query's bin.
   void writeOpenness(std::int64_t y, std::int64_t z)
   {
-    const Radius& r = this->Job.radius;
-    const Index3& dims = this->Volume.dims;
     const std::vector<double>& t = this->Job.thresholds;
-    const double countYZ = static_cast<double>(clippedWindowCount(y, r.y, dims[1])) *
-      static_cast<double>(clippedWindowCount(z, r.z, dims[2]));
+    const auto countYZ = static_cast<double>(this->windowCountYZ(y, z));
     for (std::int64_t i = 0; i < this->NX; ++i)
       this->BoxCounts[i] = this->CountX[i] * countYZ;
     runRows<CdfOpenness>(this->Job.simd, static_cast<const double*>(this->Query.data()),
