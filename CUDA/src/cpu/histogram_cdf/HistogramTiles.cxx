@@ -29,15 +29,6 @@ std::int64_t evenSide(std::int64_t n, std::int64_t tiles)
 
 } // namespace
 
-/// The plan whose slowest thread has the least work. A unit's work is its outputs plus its
-/// window's pixels over its slices and the 2 Rz slices that start the window, both grown
-/// by the border it recounts; the units go to the threads as they free up, so the slowest
-/// does ceil(units / threads) of the largest. Tiles are at most 256 columns a side (larger
-/// ones save little border and leave the processor's caches), and the workers' states
-/// together take at most a fifth of the input's bytes or 16 MiB, whichever is more (with
-/// the value histogram and the row buffers, the filter's extra memory stays within its 25%
-/// bar on volumes above 80 MiB; smaller ones get whole-slice tiles, which recount no
-/// border).
 TilePlan planTiles(const Index3& size, const Index3& dims, std::int64_t inputBytes, const Radius& r,
   int lanes, int laneBytes, int threads)
 {
