@@ -105,8 +105,23 @@ TEST(HistogramCdf, SummariesOfPartsMergeToTheWholeVolumes)
 namespace
 {
 
-/// addToValueHistogram's counts and extrema against a voxel-by-voxel tally over
-/// ValueHistogram::cell, on a sub-region of every other voxel (a stride of 2).
+/// The cell of a finite value as vao/HistogramCdf.h defines it: one per integer from the
+/// lowest value, or equal cells over the range (in long double, where the width of a
+/// range of the largest doubles does not overflow).
+std::int64_t definedCell(const vao::ValueHistogram& h, double value)
+{
+  const auto cells = static_cast<std::int64_t>(h.counts.size());
+  if (h.integerCells)
+    return static_cast<std::int64_t>(value - h.lowest);
+  if (cells == 1)
+    return 0;
+  const long double at = (static_cast<long double>(value) - h.lowest) /
+    (static_cast<long double>(h.highest) - h.lowest) * cells;
+  return std::min<std::int64_t>(cells - 1, static_cast<std::int64_t>(std::floor(at)));
+}
+
+/// addToValueHistogram's counts and extrema against a voxel-by-voxel tally over the
+/// defined cells, on a sub-region of every other voxel (a stride of 2).
 template <class T>
 void expectCellsHoldTheirValues(std::vector<T> v, const vao::Index3& dims)
 {
@@ -126,7 +141,8 @@ void expectCellsHoldTheirValues(std::vector<T> v, const vao::Index3& dims)
         const double value = double(v[2 * ((z * dims[1] + y) * dims[0] + x)]);
         if (!std::isfinite(value))
           continue;
-        const std::int64_t c = expected.cell(value);
+        const std::int64_t c = definedCell(expected, value);
+        EXPECT_EQ(c, expected.cell(value)) << value;
         ++expected.counts[c];
         expected.minimum[c] = std::min(expected.minimum[c], value);
         expected.maximum[c] = std::max(expected.maximum[c], value);

@@ -32,22 +32,58 @@ ValueHistogram ValueHistogram::forRange(ScalarType type, double lowest, double h
   return h;
 }
 
+namespace
+{
+
+/// The cells of a ValueHistogram as numbers: a value's position on them, clamped to them
+/// before the conversion (so that a position beyond them, even an infinite one where the
+/// range is near the smallest doubles, gives the end cell). Halves: the width of a range
+/// near the largest doubles does not overflow.
+class CellGrid
+{
+public:
+  explicit CellGrid(const ValueHistogram& histogram)
+    : Lowest(histogram.lowest)
+    , HalfLowest(histogram.lowest / 2)
+    , HalfWidth(histogram.highest / 2 - histogram.lowest / 2)
+    , Cells(static_cast<double>(histogram.counts.size()))
+    , Last(static_cast<double>(histogram.counts.size() - 1))
+    , IntegerCells(histogram.integerCells)
+  {
+  }
+
+  bool integerCells() const { return this->IntegerCells; }
+  /// Whether the cells have a width (a range of one value has one cell: 0).
+  bool scaled() const { return this->HalfWidth > 0.0; }
+
+  /// The position of finite v, a cell per integer, clamped to the cells; its integer
+  /// part is the cell. (A position, not yet a cell: a row's loop computes it for every
+  /// value and converts only the finite ones, without a branch.)
+  double integerPosition(double v) const { return this->clamped(v - this->Lowest); }
+  /// The position of finite v on equal cells over the range (scaled()), clamped.
+  double scaledPosition(double v) const
+  {
+    return this->clamped((v / 2 - this->HalfLowest) / this->HalfWidth * this->Cells);
+  }
+  std::int32_t cell(double v) const
+  {
+    return static_cast<std::int32_t>(this->IntegerCells ? this->integerPosition(v)
+        : this->scaled()                                ? this->scaledPosition(v)
+                                                        : 0.0);
+  }
+
+private:
+  double clamped(double at) const { return std::min(std::max(at, 0.0), this->Last); }
+
+  double Lowest, HalfLowest, HalfWidth, Cells, Last;
+  bool IntegerCells;
+};
+
+} // namespace
+
 std::int64_t ValueHistogram::cell(double v) const
 {
-  const auto last = static_cast<std::int64_t>(this->counts.size()) - 1;
-  if (this->integerCells)
-  {
-    return std::min<std::int64_t>(
-      last, std::max<std::int64_t>(0, static_cast<std::int64_t>(v - this->lowest)));
-  }
-  // Halves: the width of a range near the largest doubles does not overflow.
-  const double width = this->highest / 2 - this->lowest / 2;
-  if (!(width > 0.0))
-  {
-    return 0;
-  }
-  const double at = (v / 2 - this->lowest / 2) / width * static_cast<double>(this->counts.size());
-  return std::min<std::int64_t>(last, std::max<std::int64_t>(0, static_cast<std::int64_t>(at)));
+  return CellGrid(*this).cell(v);
 }
 
 std::int64_t ValueHistogram::totalCount() const
@@ -134,12 +170,7 @@ class CellTallies
 {
 public:
   explicit CellTallies(const ValueHistogram& histogram)
-    : Lowest(histogram.lowest)
-    , HalfLowest(histogram.lowest / 2)
-    , HalfWidth(histogram.highest / 2 - histogram.lowest / 2)
-    , Cells(static_cast<double>(histogram.counts.size()))
-    , Last(static_cast<double>(histogram.counts.size() - 1))
-    , IntegerCells(histogram.integerCells)
+    : Grid(histogram)
     , Tallies(histogram.counts.size(),
         Tally{ std::numeric_limits<V>::infinity(), -std::numeric_limits<V>::infinity(), 0 })
   {
@@ -151,19 +182,21 @@ public:
   {
     this->RowCells.resize(static_cast<std::size_t>(n));
     std::int32_t* cells = this->RowCells.data();
-    // ValueHistogram::cell, clamped before the conversion (the same cell for every
-    // finite value); -1 marks a value that is not finite.
-    if (this->IntegerCells)
+    // ValueHistogram::cell, one loop per kind of grid; -1 marks a value that is not finite.
+    const CellGrid grid = this->Grid; // a copy: its numbers stay in registers
+    if (grid.integerCells())
       for (std::int64_t i = 0; i < n; ++i)
       {
         const double v = static_cast<double>(row[i * stride]);
-        cells[i] = this->toCell(v, v - this->Lowest);
+        const double at = grid.integerPosition(v);
+        cells[i] = std::isfinite(v) ? static_cast<std::int32_t>(at) : -1;
       }
-    else if (this->HalfWidth > 0.0)
+    else if (grid.scaled())
       for (std::int64_t i = 0; i < n; ++i)
       {
         const double v = static_cast<double>(row[i * stride]);
-        cells[i] = this->toCell(v, (v / 2 - this->HalfLowest) / this->HalfWidth * this->Cells);
+        const double at = grid.scaledPosition(v);
+        cells[i] = std::isfinite(v) ? static_cast<std::int32_t>(at) : -1;
       }
     else
       for (std::int64_t i = 0; i < n; ++i)
@@ -199,16 +232,7 @@ private:
     std::int64_t count;
   };
 
-  /// The cell of value v at position `at` in cells (never NaN for a finite v), or -1 where v
-  /// is not finite.
-  std::int32_t toCell(double v, double at) const
-  {
-    const double clamped = std::min(std::max(at, 0.0), this->Last);
-    return std::isfinite(v) ? static_cast<std::int32_t>(clamped) : -1;
-  }
-
-  double Lowest, HalfLowest, HalfWidth, Cells, Last;
-  bool IntegerCells;
+  CellGrid Grid;
   std::vector<Tally> Tallies;
   std::vector<std::int32_t> RowCells;
 };
