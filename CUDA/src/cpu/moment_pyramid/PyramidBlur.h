@@ -167,8 +167,8 @@ public:
   SliceBlur(const Source& source, const BlurPlan& plan)
     : Src(source)
     , Plan(plan)
-    , RingA(static_cast<std::size_t>(kTaps * plan.in[0]))
-    , RingB(static_cast<std::size_t>(kTaps * plan.in[0]))
+    , RingStride((plan.in[0] + 7) / 8 * 8 + 8)
+    , Rings(static_cast<std::size_t>(2 * kTaps * RingStride + kRingSkew))
     , RowA(static_cast<std::size_t>(plan.in[0] + 2 * kHalf + 2 * plan.step), 0.0)
     , RowB(RowA.size(), 0.0)
   {
@@ -207,7 +207,6 @@ public:
   void slice(std::int64_t zo, Rows&& rows)
   {
     const BlurPlan& p = this->Plan;
-    const std::int64_t nx = p.in[0];
     const std::int64_t xa = this->Xa, width = this->Xb - this->Xa;
     for (int k = 0; k < kTaps; ++k) // clipped taps read a valid row with weight 0
     {
@@ -227,8 +226,8 @@ public:
       {
         const int slot = this->zBlurredRow(
           std::min(std::max<std::int64_t>(yo * p.step + k - kHalf, 0), p.in[1] - 1), zo);
-        ia[k] = &this->RingA[slot * nx + xa];
-        ib[k] = &this->RingB[slot * nx + xa];
+        ia[k] = this->ringA(slot) + xa;
+        ib[k] = this->ringB(slot) + xa;
       }
       runRows<ColumnRows>(p.simd, &ia[0], &ib[0], &p.wy[yo * kTaps], width,
         this->RowA.data() + kHalf + xa, this->RowB.data() + kHalf + xa);
@@ -272,10 +271,9 @@ private:
     const int slot = static_cast<int>(y % kTaps);
     if (this->Tags[slot] != y)
     {
-      const std::int64_t nx = this->Plan.in[0];
       this->Src.blurRows(y, 1, this->ZRows, &this->Plan.wz[zo * kTaps], this->Xa,
-        this->Xb - this->Xa, &this->RingA[slot * nx + this->Xa], &this->RingB[slot * nx + this->Xa],
-        0, this->Plan.simd);
+        this->Xb - this->Xa, this->ringA(slot) + this->Xa, this->ringB(slot) + this->Xa, 0,
+        this->Plan.simd);
       this->Tags[slot] = y;
     }
     return slot;
@@ -321,9 +319,20 @@ private:
       clipped(xo);
   }
 
+  /// A ring slot's z-blurred row (first moment, second moment). Rows of a power-of-two
+  /// width a page apart would share one set of the L1 cache, and the y pass reads ten of
+  /// them at once, more than its ways: each row starts a cache line further along.
+  double* ringA(int slot) { return this->Rings.data() + slot * this->RingStride; }
+  double* ringB(int slot)
+  {
+    return this->Rings.data() + (kTaps + slot) * this->RingStride + kRingSkew;
+  }
+  static constexpr std::int64_t kRingSkew = 5 * 8; // the second moments' rows: 5 lines on
+
   const Source& Src;
   const BlurPlan& Plan;
-  std::vector<double> RingA, RingB;
+  std::int64_t RingStride;
+  std::vector<double> Rings;
   std::int64_t Tags[kTaps];
   std::int64_t ZRows[kTaps];
   std::vector<double> RowA, RowB;
