@@ -10,6 +10,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <random>
 
 namespace vaotest
 {
@@ -205,6 +206,59 @@ inline double average(const std::vector<float>& v)
   for (float x : v)
     s += x;
   return s / v.size();
+}
+
+/// A sphere of radius 5.5 voxels about c inside a box shell (11 to 14 voxels from c):
+/// the signed distance to the nearer, in voxel coordinates.
+inline Field sphereInShell(const vao::Index3& d, const Vec3& c)
+{
+  return makeField(d,
+    [&](double x, double y, double z)
+    {
+      const double sphere =
+        std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) -
+        5.5;
+      const double m =
+        std::max(std::fabs(x - c[0]), std::max(std::fabs(y - c[1]), std::fabs(z - c[2])));
+      return std::min(sphere, std::max(11.0 - m, m - 14.0));
+    });
+}
+
+/// sphereInShell on a grid that is no multiple of the tiles, off the origin, with unequal
+/// spacings: the tiles at the far faces are partial.
+inline Field shellScene(const vao::Index3& d)
+{
+  Field f = sphereInShell(d, { 0.47 * d[0], 0.52 * d[1], 0.5 * d[2] });
+  f.origin = { -3.25, 1.5, 0.75 };
+  f.spacing = { 0.8, 1.1, 0.95 };
+  return f;
+}
+
+/// Surface points of the scene's sphere plus points anywhere in (and just outside) the
+/// volume, with normals of every direction and length.
+inline void scenePoints(const Field& f, std::vector<double>& points, std::vector<double>& normals)
+{
+  const Vec3 c = { f.origin[0] + 0.47 * f.dims[0] * f.spacing[0],
+    f.origin[1] + 0.52 * f.dims[1] * f.spacing[1], f.origin[2] + 0.5 * f.dims[2] * f.spacing[2] };
+  spherePoints(c, 5.5, 301, points, normals);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(-0.05, 1.05), direction(-1.0, 1.0);
+  for (int i = 0; i < 150; ++i)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      points.push_back(f.origin[a] + unit(random) * (f.dims[a] - 1) * f.spacing[a]);
+      normals.push_back(direction(random) + (a == 2 ? 1e-3 : 0.0));
+    }
+  }
+}
+
+inline vao::SurfacePyramid surfacePyramidOf(const Field& f, const vao::PyramidParameters& p)
+{
+  vao::SurfacePyramid pyramid;
+  const vao::Status s = vao::buildSurfacePyramid(f.view(), f.origin, f.spacing, p, pyramid);
+  EXPECT_TRUE(s.ok) << s.message;
+  return pyramid;
 }
 
 } // namespace vaotest

@@ -262,16 +262,7 @@ TEST(SurfacePoints, FloatPointsGiveTheBitsOfTheirDoubles)
   // bit for bit, AO and shadows, with both queries and the estimators of both levels' paths.
   const vao::Index3 d = { 40, 36, 44 };
   const Vec3 c = { 19.3, 17.6, 21.1 };
-  const Field f = makeField(d,
-    [&](double x, double y, double z)
-    {
-      const double sphere =
-        std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) -
-        5.5;
-      const double m =
-        std::max(std::fabs(x - c[0]), std::max(std::fabs(y - c[1]), std::fabs(z - c[2])));
-      return std::min(sphere, std::max(11.0 - m, m - 14.0));
-    });
+  const Field f = sphereInShell(d, c);
   const auto pyramid = pyramidOf(f);
   std::vector<double> points, normals;
   spherePoints(c, 5.5, 333, points, normals); // 333: the last batch of lanes is partial

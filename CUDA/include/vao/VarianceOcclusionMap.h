@@ -207,6 +207,20 @@ Status surfaceShadow(SurfacePyramid& pyramid, const float* points, const float* 
   std::int64_t count, const std::array<double, 3>& lightDirection,
   const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution = {});
 
+/// surfaceAmbientOcclusion and surfaceShadow of the same points on a SurfacePyramid in one
+/// sweep: each tile both reach is built once (separately, the second query builds again
+/// the tiles the first released). The same numbers as the two calls.
+Status surfaceOcclusionAndShadow(SurfacePyramid& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const double* points,
+  const double* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* occlusion, float* shadow,
+  const Execution& execution = {});
+Status surfaceOcclusionAndShadow(SurfacePyramid& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const float* points,
+  const float* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* occlusion, float* shadow,
+  const Execution& execution = {});
+
 /// Trilinear sample of a level's mean and variance at a world position (clamped to the
 /// level's bounds).
 void sampleLevel(

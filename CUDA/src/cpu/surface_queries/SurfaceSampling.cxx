@@ -6,7 +6,7 @@
 #include "VolumeAccess.h"
 #include "cpu/common/Parallel.h"
 #include "cpu/moment_pyramid/LevelTiles.h"
-#include "cpu/surface_queries/RayBounds.h"
+#include "cpu/surface_queries/PreparedPyramid.h"
 #include "cpu/surface_queries/SurfaceBatches.h"
 #include "cpu/surface_queries/SurfaceChecks.h"
 #include "cpu/surface_queries/SurfaceLanes.h"
@@ -25,67 +25,7 @@ using detail::MarchBounds;
 using detail::PointLanes;
 using detail::RawSampler;
 
-/// The levels a query uses, prepared for sampling.
-struct PreparedPyramid
-{
-  std::vector<detail::LevelGrid> grids;
-  std::vector<double> kernelRadius;
-
-  // The vector march applies: the processor has AVX2 (or AVX-512, `tier`) and every
-  // level's indices fit in 32 bits.
-  detail::SimdTier tier = detail::cpuSimdTier();
-  bool vectorMarch = tier >= detail::SimdTier::Avx2;
-
-  /// `tiles`: a SurfacePyramid's tiled levels (read where their tiles are built).
-  PreparedPyramid(
-    const std::vector<MomentLevel>& pyramid, int levels, const detail::PyramidTiles* tiles)
-  {
-    for (int l = 0; l < levels; ++l)
-    {
-      const detail::LevelTiles* tiled = tiles ? tiles->at(l) : nullptr;
-      this->grids.push_back(tiled ? tiled->grid() : detail::LevelGrid(pyramid[l]));
-      this->levels.push_back(&pyramid[l]);
-      this->kernelRadius.push_back(pyramid[l].kernelRadius);
-      this->vectorMarch = this->vectorMarch && this->grids.back().narrowIndices;
-    }
-  }
-
-  /// Cell bounds for the vector march on the whole levels of at most one voxel a point
-  /// (building them reads the level once): the coarsest, where most of a march's steps
-  /// fall. (The next level, with 8 voxels a point, holds few of a march's steps: its bounds
-  /// would cost memory for little.)
-  void boundCells(std::int64_t count)
-  {
-    this->bounds.reserve(this->grids.size());
-    for (std::size_t l = 0; l < this->grids.size() && this->vectorMarch; ++l)
-    {
-      if (!this->grids[l].tiled && this->levels[l]->mean.size() <= static_cast<std::size_t>(count))
-        this->bounds.emplace_back(*this->levels[l], this->grids[l]);
-    }
-  }
-
-  /// The ray bounds of the last level, where it has cell bounds, for the march's steps
-  /// along the unit `light`: they let a lane stop once nothing ahead can raise it, which
-  /// saves more steps than building them costs.
-  void boundRays(const std::array<double, 3>& light)
-  {
-    const int last = static_cast<int>(this->grids.size()) - 1;
-    if (last >= 0 && this->grids[last].cellBounds)
-      this->rays.emplace_back(
-        this->grids[last], detail::kMarchStepFraction * this->kernelRadius[last], light);
-  }
-  /// The ray bounds (null without them) and their level, the last.
-  const float* rayBounds() const
-  {
-    return this->rays.empty() ? nullptr : this->rays.front().data();
-  }
-  int rayLevel() const { return static_cast<int>(this->grids.size()) - 1; }
-
-private:
-  std::vector<const MomentLevel*> levels;
-  std::vector<detail::CellBounds> bounds;
-  std::vector<detail::RayBounds> rays;
-};
+using detail::PreparedPyramid;
 
 } // namespace
 
@@ -204,12 +144,15 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds,
   }
 }
 
-/// `tiles`: a SurfacePyramid's tiled levels; the tiles the samples reach are built first.
-template <class P>
-Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles,
+/// A surface query in two parts for the sweep (SurfaceWalk.h): mark(lanes, tiles) marks
+/// the tiled levels' tiles a batch's samples reach, sample(lanes) writes its results.
+/// withOcclusion and withShadow check their arguments, prepare the levels and return
+/// run(mark, sample), or the error. `tiles`: a SurfacePyramid's tiled levels, or null.
+template <class P, class Run>
+Status withOcclusion(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles,
   const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const P* points, const P* normals, std::int64_t count,
-  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
+  const SurfaceOcclusionParameters& parameters, float* out, Run&& run)
 {
   int levels = 0;
   Status status = detail::checkQuery(
@@ -244,7 +187,7 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles
     }
   };
   const PreparedPyramid prepared(pyramid, levels, tiles);
-  const bool finished = detail::dispatchScalarType(half ? volume.type : ScalarType::Float32,
+  return detail::dispatchScalarType(half ? volume.type : ScalarType::Float32,
     [&](auto tag)
     {
       const RawSampler<decltype(tag)> raw(
@@ -262,25 +205,24 @@ Status occlusionOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles
         else
           std::fill(lanes.query, lanes.query + detail::kLanes, parameters.isoValue);
       };
-      return detail::sweepPoints(tiles, points, normals, count, execution, mark,
-        [&](PointLanes& lanes)
+      const auto sample = [&](PointLanes& lanes)
+      {
+        double occlusion[detail::kLanes];
+        batchOcclusion(prepared, levels, lanes, parameters, query, occlusion);
+        for (int k = 0; k < lanes.used; ++k)
         {
-          double occlusion[detail::kLanes];
-          batchOcclusion(prepared, levels, lanes, parameters, query, occlusion);
-          for (int k = 0; k < lanes.used; ++k)
-          {
-            out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
-          }
-        });
+          out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
+        }
+      };
+      return run(mark, sample);
     });
-  return finished ? Status::success() : Status::cancelled();
 }
 
-template <class P>
-Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles,
+template <class P, class Run>
+Status withShadow(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles,
   const P* points, const P* normals, std::int64_t count,
   const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
-  float* out, const Execution& execution)
+  float* out, Run&& run)
 {
   int levels = 0;
   Status status = detail::checkQuery(
@@ -328,26 +270,38 @@ Status shadowOf(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* t
   };
   prepared.boundCells(count);
   prepared.boundRays(light);
-  const bool finished = detail::sweepPoints(tiles, points, normals, count, execution, mark,
-    [&](PointLanes& lanes)
+  const auto sample = [&](PointLanes& lanes)
+  {
+    if (parameters.query == SurfaceQuery::HalfVoxelInside)
     {
-      if (parameters.query == SurfaceQuery::HalfVoxelInside)
-      {
-        // No raw volume here: level 0's (blurred) mean half a voxel inside.
-        double x[detail::kLanes], y[detail::kLanes], z[detail::kLanes];
-        lanes.along(-0.5 * h, x, y, z);
-        detail::meanLanes(prepared.grids[0], x, y, z, lanes.query);
-      }
-      else
-        std::fill(lanes.query, lanes.query + detail::kLanes, parameters.isoValue);
-      double occlusion[detail::kLanes];
-      batchMarch(prepared, bounds, schedule, lanes, light, parameters.estimator, occlusion);
-      for (int k = 0; k < lanes.used; ++k)
-      {
-        out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
-      }
-    });
-  return finished ? Status::success() : Status::cancelled();
+      // No raw volume here: level 0's (blurred) mean half a voxel inside.
+      double x[detail::kLanes], y[detail::kLanes], z[detail::kLanes];
+      lanes.along(-0.5 * h, x, y, z);
+      detail::meanLanes(prepared.grids[0], x, y, z, lanes.query);
+    }
+    else
+      std::fill(lanes.query, lanes.query + detail::kLanes, parameters.isoValue);
+    double occlusion[detail::kLanes];
+    batchMarch(prepared, bounds, schedule, lanes, light, parameters.estimator, occlusion);
+    for (int k = 0; k < lanes.used; ++k)
+    {
+      out[lanes.index[k]] = static_cast<float>(1.0 - clamp01(occlusion[k]));
+    }
+  };
+  return run(mark, sample);
+}
+
+/// run(mark, sample) of withOcclusion or withShadow: the sweep of the points.
+template <class P>
+auto sweepWith(detail::PyramidTiles* tiles, const P* points, const P* normals, std::int64_t count,
+  const Execution& execution)
+{
+  return [=, &execution](auto& mark, auto& sample)
+  {
+    return detail::sweepPoints(tiles, points, normals, count, execution, mark, sample)
+      ? Status::success()
+      : Status::cancelled();
+  };
 }
 
 /// Every query's entry: its buffers (cell and ray bounds, sweep order) and, on a
@@ -363,8 +317,8 @@ Status guardedOcclusion(const std::vector<MomentLevel>& levels, detail::PyramidT
   return catchOutOfMemory(kQueryBuffers,
     [&]
     {
-      return occlusionOf(
-        levels, tiles, volume, origin, spacing, points, normals, count, parameters, out, execution);
+      return withOcclusion(levels, tiles, volume, origin, spacing, points, normals, count,
+        parameters, out, sweepWith(tiles, points, normals, count, execution));
     });
 }
 
@@ -377,8 +331,45 @@ Status guardedShadow(const std::vector<MomentLevel>& levels, detail::PyramidTile
   return catchOutOfMemory(kQueryBuffers,
     [&]
     {
-      return shadowOf(
-        levels, tiles, points, normals, count, lightDirection, parameters, out, execution);
+      return withShadow(levels, tiles, points, normals, count, lightDirection, parameters, out,
+        sweepWith(tiles, points, normals, count, execution));
+    });
+}
+
+/// Both queries in one sweep: each batch marks the tiles of both and samples both, so a
+/// tile both reach is built once (their results are those of the two sweeps).
+template <class P>
+Status guardedBoth(const std::vector<MomentLevel>& levels, detail::PyramidTiles* tiles,
+  const VolumeView& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const P* points, const P* normals, std::int64_t count,
+  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
+  float* occlusion, float* shadow, const Execution& execution)
+{
+  const auto sweep = sweepWith(tiles, points, normals, count, execution);
+  return catchOutOfMemory(kQueryBuffers,
+    [&]
+    {
+      return withOcclusion(levels, tiles, volume, origin, spacing, points, normals, count,
+        parameters, occlusion,
+        [&](auto& markOcclusion, auto& sampleOcclusion)
+        {
+          return withShadow(levels, tiles, points, normals, count, lightDirection, parameters,
+            shadow,
+            [&](auto& markShadow, auto& sampleShadow)
+            {
+              const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t)
+              {
+                markOcclusion(lanes, t);
+                markShadow(lanes, t);
+              };
+              const auto sample = [&](PointLanes& lanes)
+              {
+                sampleOcclusion(lanes);
+                sampleShadow(lanes);
+              };
+              return sweep(mark, sample);
+            });
+        });
     });
 }
 
@@ -450,6 +441,26 @@ Status surfaceShadow(SurfacePyramid& pyramid, const float* points, const float* 
 {
   return guardedShadow(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), points,
     normals, count, lightDirection, parameters, out, execution);
+}
+
+Status surfaceOcclusionAndShadow(SurfacePyramid& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const double* points,
+  const double* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* occlusion, float* shadow,
+  const Execution& execution)
+{
+  return guardedBoth(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), volume, origin,
+    spacing, points, normals, count, lightDirection, parameters, occlusion, shadow, execution);
+}
+
+Status surfaceOcclusionAndShadow(SurfacePyramid& pyramid, const VolumeView& volume,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing, const float* points,
+  const float* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* occlusion, float* shadow,
+  const Execution& execution)
+{
+  return guardedBoth(pyramid.levels(), SurfacePyramidAccess::tiles(pyramid).get(), volume, origin,
+    spacing, points, normals, count, lightDirection, parameters, occlusion, shadow, execution);
 }
 
 } // namespace vao
