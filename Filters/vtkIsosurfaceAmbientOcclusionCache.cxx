@@ -30,6 +30,7 @@
 #include <limits>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <vector>
 
 namespace Extents = vtkAmbientOcclusionExtents;
@@ -164,13 +165,17 @@ struct Sampling
   const vao::Execution execution;
 };
 
-/// The shading's two kernels on the form of the pyramid this process holds (see Shade).
+/// The shading's kernels on the form of the pyramid this process holds (see Shade): AO,
+/// shadows, and both in one pass (on a SurfacePyramid a tile both reach is built once).
 struct PyramidKernels
 {
   std::function<vao::Status(const SurfacePoints& points, float* out)> occlusion;
   std::function<vao::Status(
     const SurfacePoints& points, const std::array<double, 3>& light, float* out)>
     shadow;
+  std::function<vao::Status(const SurfacePoints& points, const std::array<double, 3>& light,
+    float* occlusion, float* shadow)>
+    both;
 };
 
 /// The two queries on `source`: in one process the SurfacePyramid, whose finest levels are
@@ -198,6 +203,19 @@ PyramidKernels Kernels(Source& source, const Sampling& s)
         return vao::surfaceShadow(
           source, xyz, normals, points.count, light, s.parameters, out, s.execution);
       });
+  };
+  kernels.both = [&source, &s, kernels](const SurfacePoints& points,
+                   const std::array<double, 3>& light, float* occlusion, float* shadow)
+  {
+    if constexpr (std::is_same<Source, vao::SurfacePyramid>::value)
+      return points.Run(
+        [&](auto xyz, auto normals)
+        {
+          return vao::surfaceOcclusionAndShadow(source, s.volume, s.origin, s.spacing, xyz, normals,
+            points.count, light, s.parameters, occlusion, shadow, s.execution);
+        });
+    const vao::Status status = kernels.occlusion(points, occlusion);
+    return status.ok ? kernels.shadow(points, light, shadow) : status;
   };
   return kernels;
 }
@@ -417,6 +435,16 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
   // pyramid, UpdateDistributedPyramid (MPI) the whole levels of this process's piece.
   const PyramidKernels kernels =
     cache.surface.empty() ? Kernels(cache.levels, sampling) : Kernels(cache.surface, sampling);
+  vtkNew<vtkFloatArray> shadow;
+  if (this->ComputeShadows)
+  {
+    shadow->SetName("Shadow");
+    vtkAmbientOcclusionMemory::Allocate(shadow, points.count, "the Shadow output");
+  }
+  const std::array<double, 3> light = frame.identity
+    ? std::array<double, 3>{ this->LightDirection[0], this->LightDirection[1],
+        this->LightDirection[2] }
+    : frame.VectorToImage(this->LightDirection);
   vao::Status status = vao::Status::success();
   if (newOcclusion)
   {
@@ -424,22 +452,17 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
     vtkNew<vtkFloatArray> occlusion;
     occlusion->SetName("AmbientOcclusion");
     vtkAmbientOcclusionMemory::Allocate(occlusion, points.count, "the AmbientOcclusion output");
-    status = kernels.occlusion(points, occlusion->GetPointer(0));
+    status = this->ComputeShadows
+      ? kernels.both(points, light, occlusion->GetPointer(0), shadow->GetPointer(0))
+      : kernels.occlusion(points, occlusion->GetPointer(0));
     if (status.ok)
     {
       cache.occlusion = occlusion;
       cache.occlusionKey = key;
     }
   }
-  vtkNew<vtkFloatArray> shadow;
-  if (status.ok && this->ComputeShadows)
+  else if (this->ComputeShadows)
   {
-    shadow->SetName("Shadow");
-    vtkAmbientOcclusionMemory::Allocate(shadow, points.count, "the Shadow output");
-    const std::array<double, 3> light = frame.identity
-      ? std::array<double, 3>{ this->LightDirection[0], this->LightDirection[1],
-          this->LightDirection[2] }
-      : frame.VectorToImage(this->LightDirection);
     status = kernels.shadow(points, light, shadow->GetPointer(0));
   }
   if (!status.ok)
