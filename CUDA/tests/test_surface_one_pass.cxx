@@ -31,18 +31,17 @@ TEST(SurfaceOnePass, OcclusionAndShadowEqualTheTwoQueries)
             : vao::surfaceAmbientOcclusion(whole, f.view(), f.origin, f.spacing, points.data(),
                 normals.data(), n, p, ao.data());
           const vao::Status b = single
-            ? vao::surfaceShadow(
-                whole, pointsF.data(), normalsF.data(), n, light, p, shadow.data())
+            ? vao::surfaceShadow(whole, pointsF.data(), normalsF.data(), n, light, p, shadow.data())
             : vao::surfaceShadow(whole, points.data(), normals.data(), n, light, p, shadow.data());
           ASSERT_TRUE(a.ok && b.ok) << a.message << b.message;
           vao::SurfacePyramid surface = surfacePyramidOf(f, {});
           surface.setKeptTileBytes(0);
           std::vector<float> gotAo(n, -1.0f), gotShadow(n, -1.0f);
           const vao::Status s = single
-            ? vao::surfaceOcclusionAndShadow(surface, f.view(), f.origin, f.spacing,
-                pointsF.data(), normalsF.data(), n, light, p, gotAo.data(), gotShadow.data())
-            : vao::surfaceOcclusionAndShadow(surface, f.view(), f.origin, f.spacing,
-                points.data(), normals.data(), n, light, p, gotAo.data(), gotShadow.data());
+            ? vao::surfaceOcclusionAndShadow(surface, f.view(), f.origin, f.spacing, pointsF.data(),
+                normalsF.data(), n, light, p, gotAo.data(), gotShadow.data())
+            : vao::surfaceOcclusionAndShadow(surface, f.view(), f.origin, f.spacing, points.data(),
+                normals.data(), n, light, p, gotAo.data(), gotShadow.data());
           ASSERT_TRUE(s.ok) << s.message;
           EXPECT_EQ(gotAo, ao) << "float points " << single;
           EXPECT_EQ(gotShadow, shadow) << "float points " << single;

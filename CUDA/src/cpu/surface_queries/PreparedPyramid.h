@@ -28,8 +28,7 @@ struct PreparedPyramid
   bool vectorMarch = tier >= SimdTier::Avx2;
 
   /// `tiles`: a SurfacePyramid's tiled levels (read where their tiles are built).
-  PreparedPyramid(
-    const std::vector<MomentLevel>& pyramid, int levels, const PyramidTiles* tiles)
+  PreparedPyramid(const std::vector<MomentLevel>& pyramid, int levels, const PyramidTiles* tiles)
   {
     for (int l = 0; l < levels; ++l)
     {
