@@ -8,8 +8,11 @@
 
 #include "vtkAlgorithm.h"
 #include "vtkCommunicator.h"
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationObjectBaseKey.h"
 #include "vtkInformationVector.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
@@ -232,6 +235,44 @@ bool Compute(vtkMultiProcessController* controller, const Piece& piece, int bins
   }
   thresholds = vao::histogramThresholds(histogram, bins);
   return true;
+}
+
+namespace
+{
+/// The array's kept thresholds: its MTime, the component and the bins, then the values. An
+/// object key, which VTK's writers do not save with the array (a number key would be).
+vtkInformationObjectBaseKey* KeptThresholds()
+{
+  static vtkInformationObjectBaseKey* const key = new vtkInformationObjectBaseKey(
+    "HISTOGRAM_THRESHOLDS", "vtkAmbientOcclusionThresholds", "vtkDoubleArray");
+  return key;
+}
+constexpr vtkIdType kHead = 3;
+} // namespace
+
+bool Recall(vtkDataArray* array, int component, int bins, std::vector<double>& thresholds)
+{
+  vtkInformation* info = array && array->HasInformation() ? array->GetInformation() : nullptr;
+  auto* kept = info ? vtkDoubleArray::SafeDownCast(info->Get(KeptThresholds())) : nullptr;
+  if (!kept || kept->GetNumberOfValues() < kHead ||
+    kept->GetValue(0) != static_cast<double>(array->GetMTime()) || kept->GetValue(1) != component ||
+    kept->GetValue(2) != bins)
+    return false;
+  thresholds.assign(kept->GetPointer(kHead), kept->GetPointer(0) + kept->GetNumberOfValues());
+  return true;
+}
+
+void Remember(vtkDataArray* array, int component, int bins, const std::vector<double>& thresholds)
+{
+  if (!array)
+    return;
+  vtkNew<vtkDoubleArray> kept;
+  kept->InsertNextValue(static_cast<double>(array->GetMTime()));
+  kept->InsertNextValue(component);
+  kept->InsertNextValue(bins);
+  for (const double t : thresholds)
+    kept->InsertNextValue(t);
+  array->GetInformation()->Set(KeptThresholds(), kept);
 }
 
 bool ComputeInSlabs(vtkAlgorithm* producer, int port, int slabs, int bins,

@@ -9,6 +9,7 @@
 #include <vector>
 
 class vtkAlgorithm;
+class vtkDataArray;
 class vtkImageData;
 class vtkMultiProcessController;
 namespace vao
@@ -47,6 +48,15 @@ struct Piece
 /// data set's).
 bool Compute(vtkMultiProcessController* controller, const Piece& piece, int bins,
   std::vector<double>& thresholds, std::string& error);
+
+/// Thresholds kept on the array they were counted from, in its vtkInformation, like the
+/// ranges vtkDataArray keeps there: another Histogram CDF run on the same array (another
+/// radius, another filter on the same reader) takes them instead of counting its values
+/// again. They hold while the array's MTime, the component and the number of bins stay:
+/// whoever changes the values calls Modified(), as VTK requires. Recall gives false when
+/// the array holds none for these.
+bool Recall(vtkDataArray* array, int component, int bins, std::vector<double>& thresholds);
+void Remember(vtkDataArray* array, int component, int bins, const std::vector<double>& thresholds);
 
 /// The thresholds of the data set produced by `producer` (output `port`), read in `slabs`
 /// slabs along z, each an update of the upstream pipeline with that extent, so that a

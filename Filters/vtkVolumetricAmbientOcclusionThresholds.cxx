@@ -9,6 +9,7 @@
 #include "vao/Validation.h"
 
 #include "vtkAlgorithmOutput.h"
+#include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkImageData.h"
 #include "vtkMultiProcessController.h"
@@ -104,6 +105,13 @@ bool vtkVolumetricAmbientOcclusion::Thresholds(vtkImageData* input, const vao::V
     // Distributed: each process counts its output piece (together they tile the data
     // set); one process counts its input, which is the whole extent.
     const bool distributed = this->IsDistributed();
+    // One process counts the whole array: its thresholds are kept on it for the next run.
+    vtkDataArray* counted =
+      !distributed && volume ? this->GetInputArrayToProcess(0, input) : nullptr;
+    if (counted &&
+      vtkAmbientOcclusionThresholds::Recall(
+        counted, this->Component, this->NumberOfBins, thresholds))
+      return !failed;
     vtkAmbientOcclusionThresholds::Piece piece;
     piece.volume = volume;
     piece.scan = &scan;
@@ -115,6 +123,9 @@ bool vtkVolumetricAmbientOcclusion::Thresholds(vtkImageData* input, const vao::V
       distributed ? this->Controller.Get() : nullptr, piece, this->NumberOfBins, thresholds, error);
     if (!computed && error.empty())
       return false; // aborted, or this process failed and said why before
+    if (computed)
+      vtkAmbientOcclusionThresholds::Remember(
+        counted, this->Component, this->NumberOfBins, thresholds);
   }
   if (!error.empty())
   {

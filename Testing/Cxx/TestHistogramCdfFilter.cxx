@@ -1,10 +1,11 @@
 // The filter with Histogram CDF and the smoothed query: streaming gives the whole run's
 // numbers, bad settings give a clear error, the smoothed query is in voxels whatever the
-// spacing.
+// spacing, and the thresholds kept on an array hold only while it is unchanged.
 #include "ReferenceFormulas.h"
 #include "VolumetricTestSupport.h"
 
 #include "vtkAmbientOcclusionPhantom.h"
+#include "vtkAmbientOcclusionThresholds.h"
 
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
@@ -270,4 +271,43 @@ TEST(HistogramCdfFilter, RejectsBadGivenThresholds)
       [&](vtkVolumetricAmbientOcclusion* f) { f->SetHistogramThresholds(thresholds); },
       "HistogramThresholds");
   }
+}
+
+TEST(HistogramCdfFilter, ThresholdsAreKeptOnTheArrayWhileItIsUnchanged)
+{
+  auto image = RandomImage(20, 17, 23, 11);
+  auto fresh = vtkSmartPointer<vtkImageData>::New(); // the same values, nothing kept
+  fresh->DeepCopy(image);
+  vtkDataArray* values = image->GetPointData()->GetScalars();
+  auto run = [&](vtkImageData* input, int bins)
+  {
+    vtkNew<vtkVolumetricAmbientOcclusion> filter;
+    filter->SetInputData(input);
+    filter->SetRadius(2);
+    filter->SetNumberOfBins(bins);
+    filter->Update();
+    vtkDataArray* used = filter->GetOutput()->GetFieldData()->GetArray("HistogramThresholds");
+    return used ? Values(used) : std::vector<double>{};
+  };
+  const std::vector<double> counted = run(image, 64);
+  ASSERT_FALSE(counted.empty());
+  // Another filter on the same, unchanged array takes the thresholds kept on it: planted
+  // ones show that it read them instead of counting.
+  std::vector<double> planted = counted;
+  for (double& t : planted)
+    t = 2.0 * t + 1.0;
+  vtkAmbientOcclusionThresholds::Remember(values, -1, 64, planted);
+  EXPECT_EQ(run(image, 64), planted);
+  // Other bins are counted afresh, and so is the array once it is Modified().
+  EXPECT_EQ(run(image, 16), run(fresh, 16));
+  values->Modified();
+  EXPECT_EQ(run(image, 64), counted);
+  // Changed values (and Modified) give their own thresholds, those of a fresh copy.
+  for (vtkIdType i = 0; i < values->GetNumberOfValues(); ++i)
+    values->SetComponent(i, 0, 3.0 * values->GetComponent(i, 0));
+  values->Modified();
+  fresh->DeepCopy(image);
+  const std::vector<double> changed = run(image, 64);
+  EXPECT_EQ(changed, run(fresh, 64));
+  EXPECT_NE(changed, counted);
 }
