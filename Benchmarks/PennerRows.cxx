@@ -172,20 +172,12 @@ void BenchmarkRelighting(const Options& options, const char* name, vtkImageData*
   vao::buildSurfacePyramid(view, origin, spacing, {}, surface, execution);
   std::vector<float> ao(n), shadow(n);
   const std::array<double, 3> light = { 0.0, -1.0, 1.0 };
-  // AO and shadows of a new surface, as the filter computes them: on the SurfacePyramid in
-  // one pass, on the whole pyramid one after the other.
-  auto both = [&](bool tiled)
+  // AO and shadows of a new surface on the SurfacePyramid in one pass, as the filter
+  // computes them.
+  auto onePass = [&]
   {
-    if (tiled)
-    {
-      vao::surfaceOcclusionAndShadow(surface, view, origin, spacing, points.data(), normals.data(),
-        n, light, {}, ao.data(), shadow.data(), execution);
-      return;
-    }
-    vao::surfaceAmbientOcclusion(
-      pyramid, view, origin, spacing, points.data(), normals.data(), n, {}, ao.data(), execution);
-    vao::surfaceShadow(
-      pyramid, points.data(), normals.data(), n, light, {}, shadow.data(), execution);
+    vao::surfaceOcclusionAndShadow(surface, view, origin, spacing, points.data(), normals.data(), n,
+      light, {}, ao.data(), shadow.data(), execution);
   };
   // The best of `repeat` runs of AO, shadows or both, on either pyramid, in M points/s.
   auto rate = [&](bool tiled, bool occlusion, bool shadows)
@@ -194,18 +186,21 @@ void BenchmarkRelighting(const Options& options, const char* name, vtkImageData*
     for (int r = 0; r < options.repeat; ++r)
     {
       const auto start = std::chrono::steady_clock::now();
-      if (occlusion && shadows)
-        both(tiled);
-      else if (occlusion)
-        tiled ? vao::surfaceAmbientOcclusion(surface, view, origin, spacing, points.data(),
-                  normals.data(), n, {}, ao.data(), execution)
-              : vao::surfaceAmbientOcclusion(pyramid, view, origin, spacing, points.data(),
-                  normals.data(), n, {}, ao.data(), execution);
-      else if (shadows)
-        tiled ? vao::surfaceShadow(
-                  surface, points.data(), normals.data(), n, light, {}, shadow.data(), execution)
-              : vao::surfaceShadow(
-                  pyramid, points.data(), normals.data(), n, light, {}, shadow.data(), execution);
+      if (tiled && occlusion && shadows)
+        onePass();
+      else
+      {
+        if (occlusion)
+          tiled ? vao::surfaceAmbientOcclusion(surface, view, origin, spacing, points.data(),
+                    normals.data(), n, {}, ao.data(), execution)
+                : vao::surfaceAmbientOcclusion(pyramid, view, origin, spacing, points.data(),
+                    normals.data(), n, {}, ao.data(), execution);
+        if (shadows)
+          tiled ? vao::surfaceShadow(
+                    surface, points.data(), normals.data(), n, light, {}, shadow.data(), execution)
+                : vao::surfaceShadow(
+                    pyramid, points.data(), normals.data(), n, light, {}, shadow.data(), execution);
+      }
       best = std::min(best, Seconds(start));
     }
     return n / best / 1e6;
@@ -218,7 +213,7 @@ void BenchmarkRelighting(const Options& options, const char* name, vtkImageData*
     const auto built = std::chrono::steady_clock::now();
     vao::buildSurfacePyramid(view, origin, spacing, {}, surface, execution);
     const auto start = std::chrono::steady_clock::now();
-    both(true);
+    onePass();
     first = std::min(first, Seconds(start));
     withBuild = std::min(withBuild, Seconds(built));
   }
