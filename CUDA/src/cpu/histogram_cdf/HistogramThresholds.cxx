@@ -184,23 +184,21 @@ public:
     std::int32_t* cells = this->RowCells.data();
     // ValueHistogram::cell, one loop per kind of grid; -1 marks a value that is not finite.
     const CellGrid grid = this->Grid; // a copy: its numbers stay in registers
+    const auto findCells = [&](auto position)
+    {
+      for (std::int64_t i = 0; i < n; ++i)
+      {
+        const double v = static_cast<double>(row[i * stride]);
+        const double at = position(v);
+        cells[i] = std::isfinite(v) ? static_cast<std::int32_t>(at) : -1;
+      }
+    };
     if (grid.integerCells())
-      for (std::int64_t i = 0; i < n; ++i)
-      {
-        const double v = static_cast<double>(row[i * stride]);
-        const double at = grid.integerPosition(v);
-        cells[i] = std::isfinite(v) ? static_cast<std::int32_t>(at) : -1;
-      }
+      findCells([&](double v) { return grid.integerPosition(v); });
     else if (grid.scaled())
-      for (std::int64_t i = 0; i < n; ++i)
-      {
-        const double v = static_cast<double>(row[i * stride]);
-        const double at = grid.scaledPosition(v);
-        cells[i] = std::isfinite(v) ? static_cast<std::int32_t>(at) : -1;
-      }
+      findCells([&](double v) { return grid.scaledPosition(v); });
     else
-      for (std::int64_t i = 0; i < n; ++i)
-        cells[i] = std::isfinite(static_cast<double>(row[i * stride])) ? 0 : -1;
+      findCells([](double) { return 0.0; });
     for (std::int64_t i = 0; i < n; ++i)
     {
       if (cells[i] < 0)
