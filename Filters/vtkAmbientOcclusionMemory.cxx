@@ -19,7 +19,7 @@ void Allocate(vtkDataArray* array, vtkIdType tuples, const std::string& what)
 {
   // Not SetNumberOfTuples: a VTK built without NDEBUG (Debian's) aborts when that fails.
   // The block is ours to allocate (vao/Storage.h: huge pages where large), then the
-  // array's, freed with freeStorage.
+  // array's, freed with recycleStorage (kept for the next output of its size).
   const vtkIdType values = tuples * array->GetNumberOfComponents();
   if (values <= 0)
   {
@@ -33,7 +33,7 @@ void Allocate(vtkDataArray* array, vtkIdType tuples, const std::string& what)
     throw Shortage{ bytes, what };
   }
   array->SetVoidArray(block, values, 0, vtkAbstractArray::VTK_DATA_ARRAY_USER_DEFINED);
-  array->SetArrayFreeFunction(&vao::freeStorage);
+  array->SetArrayFreeFunction(&vao::recycleStorage);
 }
 
 void Reserve(double bytes, const std::string& what)

@@ -91,7 +91,7 @@ vtkSmartPointer<vtkImageData> LevelAsImage(vao::MomentLevel& level)
     array->SetName(name);
     const auto count = static_cast<vtkIdType>(values->size());
     array->SetArray(values->release(), count, 0, vtkAbstractArray::VTK_DATA_ARRAY_USER_DEFINED);
-    array->SetArrayFreeFunction(&vao::freeStorage);
+    array->SetArrayFreeFunction(&vao::recycleStorage);
     image->GetPointData()->AddArray(array);
   }
   image->GetPointData()->SetActiveScalars("Mean");

@@ -1,5 +1,6 @@
 // The storage of the large arrays (vao/Storage.h): uninitialised arrays that keep their
-// block, hand it over, refuse sizes they cannot hold, and ask Linux for huge pages.
+// block, hand it over, refuse sizes they cannot hold, and ask Linux for huge pages; and
+// the outputs' blocks, kept for the next block of their size.
 #include "vao/Storage.h"
 
 #include <gtest/gtest.h>
@@ -61,6 +62,41 @@ TEST(Storage, SizesBeyondMemoryThrowAndLeaveTheArray)
   ASSERT_EQ(a.size(), 4u);
   EXPECT_EQ(a[3], 1.5);
   EXPECT_EQ(vao::allocateStorage(std::numeric_limits<std::size_t>::max() - 4096), nullptr);
+}
+
+TEST(Storage, RecycledBlocksServeTheNextBlockOfTheirSizeOnly)
+{
+  vao::releaseKeptStorage();
+  ASSERT_EQ(vao::keptStorageBytes(), 0u);
+  // 3 huge pages and 5 bytes round up to 4 huge pages: a block of 4 is the same size.
+  auto* first = static_cast<unsigned char*>(vao::allocateStorage(3 * kHugePage + 5));
+  ASSERT_NE(first, nullptr);
+  for (std::size_t i = 0; i < 3 * kHugePage + 5; ++i)
+    first[i] = static_cast<unsigned char>(i);
+  vao::recycleStorage(first);
+  EXPECT_EQ(vao::keptStorageBytes(), 4 * kHugePage);
+  auto* again = static_cast<unsigned char*>(vao::allocateStorage(4 * kHugePage));
+  EXPECT_EQ(again, first);
+  EXPECT_EQ(vao::keptStorageBytes(), 0u);
+  for (std::size_t i = 0; i < 4 * kHugePage; ++i) // lazily freed pages are writable again
+    again[i] = 7;
+  EXPECT_EQ(again[4 * kHugePage - 1], 7);
+  // A block of another size finds none to take, and every kept block is given back first.
+  vao::recycleStorage(again);
+  EXPECT_EQ(vao::keptStorageBytes(), 4 * kHugePage);
+  void* other = vao::allocateStorage(2 * kHugePage);
+  ASSERT_NE(other, nullptr);
+  EXPECT_EQ(vao::keptStorageBytes(), 0u);
+  // Small blocks, blocks freed with freeStorage, and nullptr are not kept.
+  vao::recycleStorage(vao::allocateStorage(100));
+  vao::freeStorage(other);
+  vao::recycleStorage(nullptr);
+  EXPECT_EQ(vao::keptStorageBytes(), 0u);
+  // Kept blocks are given back on demand.
+  vao::recycleStorage(vao::allocateStorage(kHugePage));
+  EXPECT_EQ(vao::keptStorageBytes(), kHugePage);
+  vao::releaseKeptStorage();
+  EXPECT_EQ(vao::keptStorageBytes(), 0u);
 }
 
 #if defined(__linux__)

@@ -18,12 +18,25 @@ namespace vao
 /// type; 64 bytes on Windows). From 2 MiB it is aligned to 2 MiB and, on Linux, rounded up
 /// to whole 2 MiB pages and advised to use transparent huge pages (advice the kernel may
 /// ignore, e.g. where THP is off). 0 bytes give a block of 1. Sizes within 2 MiB of
-/// SIZE_MAX, which the rounding would wrap, give nullptr. Free it with freeStorage.
+/// SIZE_MAX, which the rounding would wrap, give nullptr. Free it with freeStorage, or
+/// recycleStorage.
 void* allocateStorage(std::size_t bytes);
 /// Frees a block of allocateStorage (nullptr: nothing). Its signature is that of a VTK
 /// array's free function (vtkAbstractArray::SetArrayFreeFunction), so a VTK array can own
 /// such a block without a copy.
 void freeStorage(void* block) noexcept;
+/// Frees a block of allocateStorage that held a filter's output (the free function of the
+/// VTK arrays the filters hand over), keeping a block of 2 MiB or more for the next
+/// allocateStorage of the same rounded size: a filter run again, or a new one on data of
+/// the same size, writes into pages the system has already backed, instead of pages it
+/// must first zero and map (docs/performance.md, Storage). Kept blocks are freed
+/// lazily on Linux (MADV_FREE: the system takes them back when it runs short, without
+/// swapping), at most an eighth of the physical memory is kept, and an allocateStorage of
+/// a size none of them has gives them all back first, so they never sit beside a new block.
+void recycleStorage(void* block) noexcept;
+/// The bytes recycleStorage keeps, and a way to give them all back now.
+std::size_t keptStorageBytes() noexcept;
+void releaseKeptStorage() noexcept;
 
 namespace detail
 {
@@ -43,7 +56,7 @@ bool prepareSparseStorage(void* at, std::size_t bytes) noexcept;
 /// An array of T in storage. resize leaves the elements uninitialised: the kernels write
 /// every one, in parallel, so a fresh array is first touched by the threads that fill it
 /// instead of by one serial zero-fill. release() hands the block to a new owner (a VTK
-/// array, without a copy), who frees it with freeStorage.
+/// array, without a copy), who frees it with freeStorage or recycleStorage.
 template <class T>
 class StorageArray
 {

@@ -1,13 +1,22 @@
 // Storage of the large arrays: blocks aligned to 2 MiB and advised to use transparent huge
-// pages, and sparse reservations backed page by page (see vao/Storage.h).
+// pages, the outputs' blocks kept for the next output of their size, and sparse
+// reservations backed page by page (see vao/Storage.h).
 #include "vao/Storage.h"
 
 #include <cerrno>
+#include <cstddef>
 #include <cstdlib>
 #include <limits>
+#include <mutex>
+#include <unordered_map>
+#include <utility>
+#include <vector>
 
 #if defined(__linux__)
 #include <sys/mman.h>
+#endif
+#if defined(__unix__)
+#include <unistd.h>
 #endif
 #if defined(_WIN32)
 #include <malloc.h>
@@ -16,13 +25,12 @@
 namespace vao
 {
 
-void* allocateStorage(std::size_t bytes)
+namespace
 {
-  constexpr std::size_t kHugePage = std::size_t(2) << 20;
-  if (bytes > std::numeric_limits<std::size_t>::max() - kHugePage)
-  {
-    return nullptr; // no such block; rounding it up to whole huge pages would wrap
-  }
+constexpr std::size_t kHugePage = std::size_t(2) << 20;
+
+void* allocateBlock(std::size_t bytes)
+{
 #if defined(_WIN32)
   return _aligned_malloc(bytes > 0 ? bytes : 1, bytes < kHugePage ? 64 : kHugePage);
 #else
@@ -30,25 +38,184 @@ void* allocateStorage(std::size_t bytes)
   {
     return std::malloc(bytes > 0 ? bytes : 1);
   }
-  const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
-  void* block = std::aligned_alloc(kHugePage, rounded);
+  void* block = std::aligned_alloc(kHugePage, bytes);
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   if (block)
   {
-    madvise(block, rounded, MADV_HUGEPAGE); // advisory: ignored where THP is off
+    madvise(block, bytes, MADV_HUGEPAGE); // advisory: ignored where THP is off
   }
 #endif
   return block;
 #endif
 }
 
-void freeStorage(void* block) noexcept
+void freeBlock(void* block) noexcept
 {
 #if defined(_WIN32)
   _aligned_free(block);
 #else
   std::free(block);
 #endif
+}
+
+std::size_t physicalMemory()
+{
+#if defined(__unix__)
+  const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+  if (pages > 0 && pageSize > 0)
+  {
+    return static_cast<std::size_t>(pages) * static_cast<std::size_t>(pageSize);
+  }
+#endif
+  return std::size_t(8) << 30;
+}
+
+/// The large blocks' sizes (freeing one by pointer must know it), and the blocks
+/// recycleStorage keeps, oldest first.
+struct LargeBlocks
+{
+  std::mutex lock;
+  std::unordered_map<void*, std::size_t> live;
+  std::vector<std::pair<void*, std::size_t>> kept;
+  std::size_t keptBytes = 0;
+  const std::size_t keptAtMost = physicalMemory() / 8;
+
+  /// Frees the oldest `count` kept blocks (under the lock: nothing here can throw).
+  void giveBackOldest(std::size_t count) noexcept
+  {
+    for (std::size_t i = 0; i < count; ++i)
+    {
+      freeBlock(this->kept[i].first);
+      this->keptBytes -= this->kept[i].second;
+    }
+    this->kept.erase(this->kept.begin(), this->kept.begin() + static_cast<std::ptrdiff_t>(count));
+  }
+};
+
+/// Never destroyed: VTK arrays may free their blocks during the static destruction at exit.
+LargeBlocks& largeBlocks()
+{
+  static LargeBlocks* blocks = new LargeBlocks;
+  return *blocks;
+}
+
+} // namespace
+
+void* allocateStorage(std::size_t bytes)
+{
+  if (bytes > std::numeric_limits<std::size_t>::max() - kHugePage)
+  {
+    return nullptr; // no such block; rounding it up to whole huge pages would wrap
+  }
+  if (bytes < kHugePage)
+  {
+    return allocateBlock(bytes);
+  }
+  const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+  LargeBlocks& blocks = largeBlocks();
+  std::lock_guard<std::mutex> hold(blocks.lock);
+  for (std::size_t i = blocks.kept.size(); i-- > 0;) // the most recently kept first
+  {
+    if (blocks.kept[i].second == rounded)
+    {
+      void* block = blocks.kept[i].first;
+      try
+      {
+        blocks.live.emplace(block, rounded);
+      }
+      catch (...)
+      {
+        return nullptr; // the block stays kept
+      }
+      blocks.keptBytes -= rounded;
+      blocks.kept.erase(blocks.kept.begin() + static_cast<std::ptrdiff_t>(i));
+      return block;
+    }
+  }
+  blocks.giveBackOldest(blocks.kept.size()); // none fits: they must not add to the peak
+  void* block = allocateBlock(rounded);
+  try
+  {
+    if (block)
+    {
+      blocks.live.emplace(block, rounded);
+    }
+  }
+  catch (...)
+  {
+    freeBlock(block);
+    return nullptr;
+  }
+  return block;
+}
+
+void freeStorage(void* block) noexcept
+{
+  if (!block)
+  {
+    return;
+  }
+  LargeBlocks& blocks = largeBlocks();
+  {
+    std::lock_guard<std::mutex> hold(blocks.lock);
+    blocks.live.erase(block);
+  }
+  freeBlock(block);
+}
+
+void recycleStorage(void* block) noexcept
+{
+  if (!block)
+  {
+    return;
+  }
+  LargeBlocks& blocks = largeBlocks();
+  std::lock_guard<std::mutex> hold(blocks.lock);
+  const auto found = blocks.live.find(block);
+  const std::size_t bytes = found == blocks.live.end() ? 0 : found->second;
+  if (bytes > 0)
+  {
+    blocks.live.erase(found);
+  }
+  if (bytes == 0 || bytes > blocks.keptAtMost)
+  {
+    freeBlock(block); // a small block, or one too large to keep
+    return;
+  }
+  std::size_t oldest = 0;
+  std::size_t keeping = blocks.keptBytes;
+  while (keeping + bytes > blocks.keptAtMost)
+  {
+    keeping -= blocks.kept[oldest++].second;
+  }
+  blocks.giveBackOldest(oldest);
+  try
+  {
+    blocks.kept.emplace_back(block, bytes);
+  }
+  catch (...)
+  {
+    freeBlock(block);
+    return;
+  }
+  blocks.keptBytes += bytes;
+#if defined(__linux__) && defined(MADV_FREE)
+  madvise(block, bytes, MADV_FREE); // reclaimable; zero pages where the system takes them
+#endif
+}
+
+std::size_t keptStorageBytes() noexcept
+{
+  LargeBlocks& blocks = largeBlocks();
+  std::lock_guard<std::mutex> hold(blocks.lock);
+  return blocks.keptBytes;
+}
+
+void releaseKeptStorage() noexcept
+{
+  LargeBlocks& blocks = largeBlocks();
+  std::lock_guard<std::mutex> hold(blocks.lock);
+  blocks.giveBackOldest(blocks.kept.size());
 }
 
 namespace detail
