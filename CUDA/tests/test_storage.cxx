@@ -99,6 +99,41 @@ TEST(Storage, RecycledBlocksServeTheNextBlockOfTheirSizeOnly)
   EXPECT_EQ(vao::keptStorageBytes(), 0u);
 }
 
+TEST(Storage, RecycledBlocksBeyondTheLimitGoBackOldestFirst)
+{
+  vao::releaseKeptStorage();
+  const std::size_t limit = vao::detail::setKeptStorageLimit(3 * kHugePage);
+  void* blocks[4];
+  for (void*& block : blocks)
+  {
+    block = vao::allocateStorage(kHugePage);
+    ASSERT_NE(block, nullptr);
+  }
+  for (void* block : blocks)
+    vao::recycleStorage(block);
+  // The fourth pushed the first out; the newest comes back first.
+  EXPECT_EQ(vao::keptStorageBytes(), 3 * kHugePage);
+  void* taken[3];
+  for (void*& block : taken)
+    block = vao::allocateStorage(kHugePage);
+  EXPECT_EQ(taken[0], blocks[3]);
+  EXPECT_EQ(taken[1], blocks[2]);
+  EXPECT_EQ(taken[2], blocks[1]);
+  EXPECT_EQ(vao::keptStorageBytes(), 0u);
+  for (void* block : taken)
+    vao::freeStorage(block);
+  // A block larger than the limit is freed, and the kept one stays.
+  void* large = vao::allocateStorage(4 * kHugePage);
+  ASSERT_NE(large, nullptr);
+  vao::recycleStorage(vao::allocateStorage(kHugePage));
+  vao::recycleStorage(large);
+  EXPECT_EQ(vao::keptStorageBytes(), kHugePage);
+  // Lowering the limit gives back the oldest blocks beyond it.
+  vao::detail::setKeptStorageLimit(0);
+  EXPECT_EQ(vao::keptStorageBytes(), 0u);
+  vao::detail::setKeptStorageLimit(limit);
+}
+
 #if defined(__linux__)
 /// The "THPeligible" line of the mapping that holds `address` in /proc/self/smaps
 /// (-1 when the kernel does not report it).

@@ -40,6 +40,10 @@ void releaseKeptStorage() noexcept;
 
 namespace detail
 {
+/// Sets the most bytes recycleStorage keeps (by default an eighth of the physical memory),
+/// giving back the oldest kept blocks beyond it, and returns the limit it replaces.
+std::size_t setKeptStorageLimit(std::size_t bytes) noexcept;
+
 /// A zero-filled reservation of `bytes` whose 4 KiB pages take memory only once written
 /// (nullptr when it cannot be had): for data kept sparsely at fixed places, such as the
 /// tiles of a level built on demand. Never backed by huge pages, which would fill in 2 MiB

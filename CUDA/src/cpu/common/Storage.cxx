@@ -78,7 +78,7 @@ struct LargeBlocks
   std::unordered_map<void*, std::size_t> live;
   std::vector<std::pair<void*, std::size_t>> kept;
   std::size_t keptBytes = 0;
-  const std::size_t keptAtMost = physicalMemory() / 8;
+  std::size_t keptAtMost = physicalMemory() / 8;
 
   /// Frees the oldest `count` kept blocks (under the lock: nothing here can throw).
   void giveBackOldest(std::size_t count) noexcept
@@ -220,6 +220,19 @@ void releaseKeptStorage() noexcept
 
 namespace detail
 {
+
+std::size_t setKeptStorageLimit(std::size_t bytes) noexcept
+{
+  LargeBlocks& blocks = largeBlocks();
+  std::lock_guard<std::mutex> hold(blocks.lock);
+  const std::size_t before = blocks.keptAtMost;
+  blocks.keptAtMost = bytes;
+  std::size_t oldest = 0;
+  for (std::size_t keeping = blocks.keptBytes; keeping > bytes; ++oldest)
+    keeping -= blocks.kept[oldest].second;
+  blocks.giveBackOldest(oldest);
+  return before;
+}
 
 void* allocateSparseStorage(std::size_t bytes)
 {
