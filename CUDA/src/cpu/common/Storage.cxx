@@ -5,9 +5,11 @@
 
 #include <cerrno>
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <limits>
 #include <mutex>
+#include <new>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -92,11 +94,20 @@ struct LargeBlocks
   }
 };
 
-/// Never destroyed: VTK arrays may free their blocks during the static destruction at exit.
+/// Made in static storage on first use (no allocation that could throw) and never
+/// destroyed: VTK arrays may free their blocks during the static destruction at exit.
 LargeBlocks& largeBlocks()
 {
-  static LargeBlocks* blocks = new LargeBlocks;
+  alignas(LargeBlocks) static unsigned char storage[sizeof(LargeBlocks)];
+  static LargeBlocks* blocks = new (storage) LargeBlocks;
   return *blocks;
+}
+
+/// Large blocks start on a huge page; malloc's small ones practically never do, and those
+/// that do are looked up and not found.
+bool mayBeLarge(const void* block)
+{
+  return reinterpret_cast<std::uintptr_t>(block) % kHugePage == 0;
 }
 
 } // namespace
@@ -151,12 +162,9 @@ void* allocateStorage(std::size_t bytes)
 
 void freeStorage(void* block) noexcept
 {
-  if (!block)
+  if (mayBeLarge(block) && block)
   {
-    return;
-  }
-  LargeBlocks& blocks = largeBlocks();
-  {
+    LargeBlocks& blocks = largeBlocks();
     std::lock_guard<std::mutex> hold(blocks.lock);
     blocks.live.erase(block);
   }
@@ -165,8 +173,9 @@ void freeStorage(void* block) noexcept
 
 void recycleStorage(void* block) noexcept
 {
-  if (!block)
+  if (!mayBeLarge(block) || !block)
   {
+    freeBlock(block);
     return;
   }
   LargeBlocks& blocks = largeBlocks();
