@@ -82,13 +82,15 @@ struct LargeBlocks
   std::size_t keptBytes = 0;
   std::size_t keptAtMost = physicalMemory() / 8;
 
-  /// Frees the oldest `count` kept blocks (under the lock: nothing here can throw).
-  void giveBackOldest(std::size_t count) noexcept
+  /// Frees the oldest kept blocks until at most `bytes` are kept (under the lock: nothing
+  /// here can throw).
+  void keepAtMost(std::size_t bytes) noexcept
   {
-    for (std::size_t i = 0; i < count; ++i)
+    std::size_t count = 0;
+    for (; this->keptBytes > bytes; ++count)
     {
-      freeBlock(this->kept[i].first);
-      this->keptBytes -= this->kept[i].second;
+      freeBlock(this->kept[count].first);
+      this->keptBytes -= this->kept[count].second;
     }
     this->kept.erase(this->kept.begin(), this->kept.begin() + static_cast<std::ptrdiff_t>(count));
   }
@@ -143,7 +145,7 @@ void* allocateStorage(std::size_t bytes)
       return block;
     }
   }
-  blocks.giveBackOldest(blocks.kept.size()); // none fits: they must not add to the peak
+  blocks.keepAtMost(0); // none fits: they must not add to the peak
   void* block = allocateBlock(rounded);
   try
   {
@@ -191,13 +193,7 @@ void recycleStorage(void* block) noexcept
     freeBlock(block); // a small block, or one too large to keep
     return;
   }
-  std::size_t oldest = 0;
-  std::size_t keeping = blocks.keptBytes;
-  while (keeping + bytes > blocks.keptAtMost)
-  {
-    keeping -= blocks.kept[oldest++].second;
-  }
-  blocks.giveBackOldest(oldest);
+  blocks.keepAtMost(blocks.keptAtMost - bytes); // room for this one
   try
   {
     blocks.kept.emplace_back(block, bytes);
@@ -224,7 +220,7 @@ void releaseKeptStorage() noexcept
 {
   LargeBlocks& blocks = largeBlocks();
   std::lock_guard<std::mutex> hold(blocks.lock);
-  blocks.giveBackOldest(blocks.kept.size());
+  blocks.keepAtMost(0);
 }
 
 namespace detail
@@ -236,10 +232,7 @@ std::size_t setKeptStorageLimit(std::size_t bytes) noexcept
   std::lock_guard<std::mutex> hold(blocks.lock);
   const std::size_t before = blocks.keptAtMost;
   blocks.keptAtMost = bytes;
-  std::size_t oldest = 0;
-  for (std::size_t keeping = blocks.keptBytes; keeping > bytes; ++oldest)
-    keeping -= blocks.kept[oldest].second;
-  blocks.giveBackOldest(oldest);
+  blocks.keepAtMost(bytes);
   return before;
 }
 
