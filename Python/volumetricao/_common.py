@@ -311,8 +311,8 @@ def run(algorithm, progress=False, cuda_asked=False, label=None):
 
 def point_arrays(output, names, shape, name_of=None):
     """The named point arrays of `output` as numpy arrays of `shape` (plus components):
-    views of the filter's own arrays, not copies (a copy costs a tenth of a Gaussian CDF
-    run); each view holds its VTK array, so the memory lives as long as the result."""
+    views of the filter's own arrays, not copies, so the output is never written twice;
+    each view holds its VTK array, so the memory lives as long as the result."""
     results = []
     for name in names:
         array = output.GetPointData().GetArray(name) if output is not None else None
