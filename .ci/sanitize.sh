@@ -16,30 +16,40 @@ cd "$(dirname "$0")/.."
 asan="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize=object-size,null,alignment -fno-sanitize-recover=all -fno-omit-frame-pointer -g"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
+# -O1, as the sanitizers' authors advise, with assertions on: the instrumented kernel library
+# and its tests build in about two thirds of the time -O3 takes (Histogram CDF's channels
+# under ASan: 64 s against 172 s), and the tests run no slower under ASan.
+sanitizerBuild=(-DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -g")
 
 echo "== kernel tests under AddressSanitizer + UndefinedBehaviorSanitizer"
-cmake -S CUDA -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVAO_ENABLE_CUDA=OFF \
+cmake -S CUDA -B build-asan -G Ninja "${sanitizerBuild[@]}" -DVAO_ENABLE_CUDA=OFF \
   -DCMAKE_CXX_FLAGS="$asan" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined"
 cmake --build build-asan -j "$(nproc)"
 ctest --test-dir build-asan -j "$(nproc)" --output-on-failure
 
 echo "== kernel tests under ThreadSanitizer"
-cmake -S CUDA -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVAO_ENABLE_CUDA=OFF \
+cmake -S CUDA -B build-tsan -G Ninja "${sanitizerBuild[@]}" -DVAO_ENABLE_CUDA=OFF \
   -DCMAKE_CXX_FLAGS="-fsanitize=thread -g" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread"
 cmake --build build-tsan -j "$(nproc)"
 # Death tests fork, which ThreadSanitizer does not follow: they run in the ASan build.
 # With --ci, the box statistics' typed and precision suites and the flat backgrounds stay
 # in the ASan build: they repeat the threads' pattern of BoxStatistics.* and Openness.*
-# for each type and magnitude.
+# for each type and magnitude. So do the surface pyramid's queries on every SIMD tier (the
+# aborted queries' test runs the same threads) and block sweeping's every split (its rounds'
+# test runs the same exchange): together they took 40% of the ThreadSanitizer run.
+tsanSkipped="ABrokenPropertyIsReported"
 tsanTests=()
-[[ "${1:-}" == "--ci" ]] && tsanTests=(-R "WorkerPool|Sweep|BlockSweeping|Openness|^BoxStatistics\\.|Pyramid")
-ctest --test-dir build-tsan -j "$(nproc)" --output-on-failure -E "ABrokenPropertyIsReported" "${tsanTests[@]}"
+if [[ "${1:-}" == "--ci" ]]; then
+  tsanTests=(-R "WorkerPool|Sweep|BlockSweeping|Openness|^BoxStatistics\\.|Pyramid")
+  tsanSkipped+="|QueriesEqualTheWholePyramidBitForBitOnEveryTier|BlockSweeping\\.EverySplit"
+fi
+ctest --test-dir build-tsan -j "$(nproc)" --output-on-failure -E "$tsanSkipped" "${tsanTests[@]}"
 
 if [[ "${1:-}" == "--filters" ]]; then
   echo "== VTK filter tests under AddressSanitizer + UndefinedBehaviorSanitizer"
   # VTK's own libraries are not instrumented; leaks inside them are not ours.
   export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1
-  cmake -S . -B build-asan-filters -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVAO_ENABLE_CUDA=OFF \
+  cmake -S . -B build-asan-filters -G Ninja "${sanitizerBuild[@]}" -DVAO_ENABLE_CUDA=OFF \
     -DCMAKE_CXX_FLAGS="$asan" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
     -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined"
   cmake --build build-asan-filters -j "$(nproc)"
