@@ -4,7 +4,7 @@
 #     finding fatal: build-asan/;
 #  2. ThreadSanitizer: build-tsan/.
 # With --filters, also the VTK filters' C++ tests under ASan + UBSan (the whole project
-# built instrumented in build-asan-filters/: about 15 minutes more on two cores). With
+# built instrumented in build-asan-filters/: about 22 minutes more on two cores). With
 # --ci (what .ci/run does), ThreadSanitizer runs only the tests that exercise the threads
 # (the pool, the sweeps' wavefront, the streamed statistics), to keep CI short.
 # GCC's sanitizers come with g++ (libasan8, libubsan1, libtsan2). CI runs the kernel part.
