@@ -265,13 +265,14 @@ void BenchmarkRelighting(const Options& options, const char* name, vtkImageData*
   // With every tile the surface reaches kept, a query samples just what the whole
   // pyramid's does: the gap between the rows above is the tiles the default budget
   // rebuilds, and the first query's gap is the tiles it builds.
-  const double inputBytes = 2.0 * static_cast<double>(view.voxelCount());
+  const double inputBytes = static_cast<double>(sizeof(short) * view.voxelCount());
   const double budget = static_cast<double>(surface.keptTileBytes());
   surface.setKeptTileBytes(static_cast<std::size_t>(-1));
   onePass();
-  std::printf("    every tile kept:   AO + shadows %.1f (tiles %.1f MB, %.0f%% of the input's "
-              "bytes; the default keeps %.0f%%)\n",
-    rate(true, true, true), surface.tileMemory() / 1e6,
+  std::printf("    every tile kept:   AO + shadows %.1f (%lld tiles of level 0 and %lld of level "
+              "1, %.1f MB, %.0f%% of the input's bytes; the default keeps %.0f%%)\n",
+    rate(true, true, true), static_cast<long long>(surface.builtTiles(0)),
+    static_cast<long long>(surface.builtTiles(1)), surface.tileMemory() / 1e6,
     100.0 * static_cast<double>(surface.tileMemory()) / inputBytes, 100.0 * budget / inputBytes);
 }
 
