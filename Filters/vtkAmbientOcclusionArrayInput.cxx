@@ -4,6 +4,7 @@
 #include "vao/VarianceOcclusionMap.h"
 
 #include "vtkAlgorithm.h"
+#include "vtkCellArray.h"
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -12,6 +13,7 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -170,52 +172,165 @@ vtkDataArray* GivenNormals(vtkPolyData* surface)
   return given && given->GetNumberOfComponents() == 3 ? given : nullptr;
 }
 
+namespace
+{
+
+bool UsableNormal(const double* n)
+{
+  const double length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+  return std::isfinite(length2) && length2 > 0.0;
+}
+
+/// The volume's gradient at p (image frame), turned towards lower values and made unit
+/// length; false where it is zero.
+bool GradientNormal(const ScalarVolume& volume, const std::array<double, 3>& origin,
+  const std::array<double, 3>& spacing, const double* p, double* normal)
+{
+  double g[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    std::array<double, 3> forward = { p[0], p[1], p[2] }, backward = forward;
+    forward[a] += spacing[a];
+    backward[a] -= spacing[a];
+    g[a] = (vao::sampleVolume(volume.view, origin, spacing, forward) -
+             vao::sampleVolume(volume.view, origin, spacing, backward)) /
+      (2.0 * spacing[a]);
+  }
+  const double length = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+  if (!(length > 0.0) || !std::isfinite(length))
+  {
+    return false;
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    normal[a] = -g[a] / length;
+  }
+  return true;
+}
+
+/// For the points marked in `missing`, the area-weighted normal of the polygons around
+/// them (image frame, from `points`), turned to agree with the usable normals of the
+/// polygons' other points. A point with no polygon, or whose polygons have no area, keeps
+/// its marker.
+void FaceNormals(vtkPolyData* surface, const std::vector<double>& points,
+  std::vector<double>& normals, std::vector<char>& missing)
+{
+  vtkCellArray* polys = surface->GetPolys();
+  if (!polys || polys->GetNumberOfCells() == 0)
+  {
+    return;
+  }
+  const size_t n = missing.size();
+  std::vector<double> face(3 * n, 0.0), around(3 * n, 0.0);
+  vtkIdType count = 0;
+  const vtkIdType* ids = nullptr;
+  for (polys->InitTraversal(); polys->GetNextCell(count, ids);)
+  {
+    bool touches = false;
+    for (vtkIdType k = 0; k < count && !touches; ++k)
+      touches = missing[static_cast<size_t>(ids[k])] != 0;
+    if (!touches)
+      continue;
+    double area[3] = { 0.0, 0.0, 0.0 }; // Newell's method: twice the area along the normal
+    for (vtkIdType k = 0; k < count; ++k)
+    {
+      const double* a = &points[3 * static_cast<size_t>(ids[k])];
+      const double* b = &points[3 * static_cast<size_t>(ids[(k + 1) % count])];
+      area[0] += (a[1] - b[1]) * (a[2] + b[2]);
+      area[1] += (a[2] - b[2]) * (a[0] + b[0]);
+      area[2] += (a[0] - b[0]) * (a[1] + b[1]);
+    }
+    for (vtkIdType k = 0; k < count; ++k)
+    {
+      const size_t i = static_cast<size_t>(ids[k]);
+      if (!missing[i])
+        continue;
+      for (vtkIdType m = 0; m < count; ++m)
+      {
+        const size_t j = static_cast<size_t>(ids[m]);
+        for (int a = 0; a < 3 && !missing[j]; ++a)
+          around[3 * i + a] += normals[3 * j + a];
+      }
+      for (int a = 0; a < 3; ++a)
+        face[3 * i + a] += area[a];
+    }
+  }
+  for (size_t i = 0; i < n; ++i)
+  {
+    double* f = &face[3 * i];
+    const double* r = &around[3 * i];
+    const double length = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    if (!missing[i] || !(length > 0.0) || !std::isfinite(length))
+      continue;
+    const double sign = f[0] * r[0] + f[1] * r[1] + f[2] * r[2] < 0.0 ? -1.0 : 1.0;
+    for (int a = 0; a < 3; ++a)
+      normals[3 * i + a] = sign * f[a] / length;
+    missing[i] = 0;
+  }
+}
+
+bool AllUsable(vtkFloatArray* normals, vtkIdType count)
+{
+  const float* n = normals->GetPointer(0);
+  for (vtkIdType i = 0; i < count; ++i)
+  {
+    const double v[3] = { n[3 * i], n[3 * i + 1], n[3 * i + 2] };
+    if (!UsableNormal(v))
+      return false;
+  }
+  return true;
+}
+
+}
+
 bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points,
   const vtkAmbientOcclusionFrame::Frame& frame, const ScalarVolume& volume,
   const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
-  std::vector<double>& normals, std::string& error)
+  std::vector<double>& normals, vtkIdType& replaced, std::string& error)
 {
   const vtkIdType n = surface->GetNumberOfPoints();
   normals.resize(static_cast<size_t>(3 * n));
-  if (vtkDataArray* given = GivenNormals(surface))
-  {
-    for (vtkIdType i = 0; i < n; ++i)
-    {
-      given->GetTuple(i, &normals[3 * i]);
-      if (!frame.identity)
-      {
-        const std::array<double, 3> turned = frame.VectorToImage(&normals[3 * i]);
-        std::copy(turned.begin(), turned.end(), normals.begin() + 3 * i);
-      }
-    }
-    return true;
-  }
+  std::vector<char> missing(static_cast<size_t>(n), 0);
+  vtkDataArray* given = GivenNormals(surface);
+  replaced = 0;
   for (vtkIdType i = 0; i < n; ++i)
   {
-    const double* p = &points[3 * i];
-    double g[3];
-    for (int a = 0; a < 3; ++a)
+    double* normal = &normals[3 * i];
+    if (given)
     {
-      std::array<double, 3> forward = { p[0], p[1], p[2] }, backward = forward;
-      forward[a] += spacing[a];
-      backward[a] -= spacing[a];
-      g[a] = (vao::sampleVolume(volume.view, origin, spacing, forward) -
-               vao::sampleVolume(volume.view, origin, spacing, backward)) /
-        (2.0 * spacing[a]);
+      given->GetTuple(i, normal);
+      if (UsableNormal(normal))
+      {
+        if (!frame.identity)
+        {
+          const std::array<double, 3> turned = frame.VectorToImage(normal);
+          std::copy(turned.begin(), turned.end(), normal);
+        }
+        continue;
+      }
+      ++replaced;
     }
-    const double length = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-    if (!(length > 0.0))
+    if (!GradientNormal(volume, origin, spacing, &points[3 * i], normal))
     {
-      std::ostringstream why;
-      why << "The surface has no point normals and the volume's gradient is zero at point " << i
-          << ": add normals (e.g. Contour with Compute Normals, or Generate Surface Normals).";
-      error = why.str();
-      return false;
+      missing[static_cast<size_t>(i)] = 1;
     }
-    for (int a = 0; a < 3; ++a)
-    {
-      normals[3 * i + a] = -g[a] / length;
-    }
+  }
+  // The gradient vanishes only at rare points of a contour (a saddle, a flat top): their
+  // polygons still say which way the surface faces.
+  if (std::find(missing.begin(), missing.end(), 1) != missing.end())
+  {
+    FaceNormals(surface, points, normals, missing);
+  }
+  const auto left = std::find(missing.begin(), missing.end(), 1);
+  if (left != missing.end())
+  {
+    std::ostringstream why;
+    why << "Point " << (left - missing.begin()) << " of the surface has "
+        << (given ? "a zero or non-finite normal" : "no normal")
+        << ", the volume's gradient is zero there and it has no polygon with an area: "
+           "remove it (e.g. Clean), or give it a normal.";
+    error = why.str();
+    return false;
   }
   return true;
 }
@@ -238,7 +353,8 @@ bool ReadSurfacePoints(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Fra
   vtkFloatArray* floatPoints =
     vtkFloatArray::SafeDownCast(surface->GetPoints() ? surface->GetPoints()->GetData() : nullptr);
   vtkFloatArray* floatNormals = vtkFloatArray::SafeDownCast(givenNormals);
-  out.inPlace = floatPoints && floatNormals && frame.identity;
+  // A zero or non-finite normal is replaced (SurfaceNormals): that takes the copy.
+  out.inPlace = floatPoints && floatNormals && frame.identity && AllUsable(floatNormals, n);
   if (out.inPlace)
   {
     out.floatPoints = floatPoints->GetPointer(0);
@@ -259,7 +375,8 @@ bool ReadSurfacePoints(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Fra
       std::copy(p.begin(), p.end(), out.points.begin() + 3 * i);
     }
   }
-  return SurfaceNormals(surface, out.points, frame, volume, origin, spacing, out.normals, error);
+  return SurfaceNormals(
+    surface, out.points, frame, volume, origin, spacing, out.normals, out.replacedNormals, error);
 }
 
 vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads)

@@ -53,12 +53,14 @@ vtkDataArray* GivenNormals(vtkPolyData* surface);
 /// The unit normals of the surface's points as the surface kernels read them (3 doubles
 /// a point, in the image's frame): its point normals turned into that frame, or without
 /// them the gradient of `volume` (voxel 0 at `origin`) at `points` (3 doubles a point,
-/// already in the image's frame), pointing towards lower values. On failure (no normals
-/// and a zero gradient) returns false and says why in `error`.
+/// already in the image's frame), pointing towards lower values. A given normal that is
+/// zero or not finite is replaced the same way (`replaced` counts them), and where the
+/// gradient is zero too by the normal of the point's polygons. On failure (a point with
+/// none of these) returns false and says why in `error`.
 bool SurfaceNormals(vtkPolyData* surface, const std::vector<double>& points,
   const vtkAmbientOcclusionFrame::Frame& frame, const ScalarVolume& volume,
   const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
-  std::vector<double>& normals, std::string& error);
+  std::vector<double>& normals, vtkIdType& replaced, std::string& error);
 
 /// A surface's points and normals as the surface kernels read them: its float arrays in
 /// place (what contours give), or a copy in doubles in the image's frame.
@@ -69,6 +71,7 @@ struct SurfacePoints
   const float* floatPoints = nullptr;
   const float* floatNormals = nullptr;
   std::vector<double> points, normals;
+  vtkIdType replacedNormals = 0; ///< given normals that were zero or not finite
 
   /// kernel(points, normals) on whichever form is held: one call for either.
   template <class Kernel>

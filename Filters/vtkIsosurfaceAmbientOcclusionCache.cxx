@@ -431,6 +431,12 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
     vtkErrorMacro(<< error);
     return false;
   }
+  if (points.replacedNormals > 0)
+  {
+    vtkWarningMacro(<< points.replacedNormals << " of the surface's " << points.count
+                    << " point normals are zero or not finite: those points take the "
+                       "volume's gradient (or their polygons' normal) instead.");
+  }
   // The serial/MPI decision, made once: UpdatePyramid (one process) built the tiled
   // pyramid, UpdateDistributedPyramid (MPI) the whole levels of this process's piece.
   const PyramidKernels kernels =
