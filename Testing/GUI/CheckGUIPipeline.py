@@ -4,8 +4,8 @@
 # driver RunGUITest.cmake reads the status file), and a screenshot of the render view.
 import os
 import traceback
-from paraview.simple import (ColorBy, GetActiveViewOrCreate, GetDisplayProperties,
-                             GetSources, Hide, SaveScreenshot, Show)
+from paraview.simple import (GetActiveViewOrCreate, GetColorTransferFunction, GetDisplayProperties,
+                             GetScalarBar, GetSources, Hide, SaveScreenshot, Show)
 
 out_dir = VAO_GUI_OUTPUT_DIR  # noqa: F821 (given by the exec() in the playback)
 lines = []
@@ -43,14 +43,32 @@ try:
         if vao.GetProperty(name).SMProperty.GetPanelVisibility() != 'advanced':
             raise RuntimeError('%s is not an advanced property' % name)
 
+    # What Apply showed, untouched: each filter's AO (not an Outline), the Shading's
+    # colours as they are, without a colour legend for them.
     view = GetActiveViewOrCreate('RenderView')
+    for xml_name, kind, array in (('VolumetricAmbientOcclusion', 'Slice', 'AmbientOcclusion'),
+                                  ('OcclusionSweeping', 'Slice', 'AmbientOcclusion'),
+                                  ('AmbientOcclusionShading', 'Volume', 'ShadedRGBA')):
+        display = GetDisplayProperties(by_xml[xml_name], view)
+        lines.append('%s shown as %s coloured by %s' % (xml_name, display.Representation,
+                                                        list(display.ColorArrayName)))
+        if display.Representation != kind or list(display.ColorArrayName) != ['POINTS', array]:
+            raise RuntimeError('%s after Apply: %s coloured by %s, not %s coloured by %s'
+                               % (xml_name, display.Representation, list(display.ColorArrayName), kind, array))
+    points = list(GetColorTransferFunction('AmbientOcclusion').RGBPoints)
+    lines.append('AmbientOcclusion map %s' % points)
+    if points[0] != 0.0 or points[-4] != 1.0 or any(
+            points[i + 1] != points[i + 2] or points[i + 1] != points[i + 3] for i in range(0, len(points), 4)):
+        raise RuntimeError('the AmbientOcclusion map is not grey over [0, 1]: %s' % points)
+    shading = GetDisplayProperties(by_xml['AmbientOcclusionShading'], view)
+    if shading.MapScalars != 0:
+        raise RuntimeError('the Shading is shown through a colour map (Map Scalars on)')
+    if GetScalarBar(GetColorTransferFunction('ShadedRGBA'), view).Visibility:
+        raise RuntimeError('a colour legend is shown for ShadedRGBA, whose colours are not mapped')
+
     for proxy in GetSources().values():
         Hide(proxy, view)
-    display = Show(vao, view)
-    display.SetRepresentationType('Slice')
-    ColorBy(display, ('POINTS', 'AmbientOcclusion'))
-    display.RescaleTransferFunctionToDataRange(True, False)
-    display.SetScalarBarVisibility(view, True)
+    Show(vao, view)
     view.ResetCamera()
     png = os.path.join(out_dir, 'AmbientOcclusionGUI.png')
     SaveScreenshot(png, view, ImageResolution=[800, 600])
