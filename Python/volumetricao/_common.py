@@ -2,7 +2,7 @@
 vtkImageData, running a filter with Python's errors, warnings and progress, and the
 report of what ran."""
 import collections
-import numbers
+import operator
 import re
 import sys
 import warnings
@@ -65,17 +65,50 @@ def check_backend(backend):
 
 
 def check_threads(threads):
-    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
-        raise TypeError("threads must be an integer (0: the cores this process may use), got %r" % (threads,))
-    return int(threads)
+    return number(threads, "threads", integer=True)
 
 
-def number(value, name):
-    """A float, or TypeError naming the argument."""
+# What no numeric argument takes, though float() or int() would: float("5") reads a
+# string, True is 1, and float() of a complex number drops its imaginary part.
+_NOT_NUMBERS = (str, bytes, bytearray, memoryview, bool, np.bool_, complex, np.complexfloating, np.ndarray)
+
+
+def number(value, name, integer=False):
+    """The one check of every numeric argument: a float (an int with integer=True), or
+    TypeError naming the argument. A real number is taken (Python's, numpy's, a 0-d
+    array); strings, bytes, bools and complex numbers are refused, and an integer argument
+    refuses floats, 2.0 included, as numpy does for a shape (operator.index)."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if not isinstance(value, _NOT_NUMBERS):
+        try:
+            return operator.index(value) if integer else float(value)
+        except (TypeError, ValueError):
+            pass
+    raise TypeError("%s must be %s, got %r" % (name, "an integer" if integer else "a real number", value))
+
+
+def numbers(value, name):
+    """A float64 array of value's shape from a number or a sequence or array of them,
+    each checked as number() checks one (a numeric array at once)."""
+    if isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
+        return value.astype(np.float64)
     try:
-        return float(value)
+        items = np.asarray(value, dtype=object)
+        return np.array([number(v, name) for v in items.reshape(-1)], dtype=np.float64).reshape(items.shape)
     except (TypeError, ValueError):
-        raise TypeError("%s must be a number, got %r" % (name, value)) from None
+        raise TypeError("%s: real numbers expected, got %r" % (name, value)) from None
+
+
+def flags(value, name, count):
+    """`count` booleans (or 0 and 1) as ints; TypeError for strings ("0" would be True)."""
+    array = np.asarray(value)
+    if array.dtype.kind not in "biuf":
+        raise TypeError("%s: %d flags (bools or 0 and 1) expected, got %r" % (name, count, value))
+    result = [int(bool(v)) for v in array.reshape(-1)]
+    if len(result) != count:
+        raise ValueError("%s: %d flags, got %d" % (name, count, len(result)))
+    return result
 
 
 def opacity_function(opacity, name="opacity"):
@@ -92,8 +125,8 @@ def opacity_function(opacity, name="opacity"):
             return function
         raise TypeError("%s: %r is not an opacity (piecewise) transfer function" % (name, opacity))
     try:
-        points = np.asarray(opacity, dtype=float)
-    except (TypeError, ValueError):
+        points = numbers(opacity, name)
+    except TypeError:
         raise TypeError("%s: a vtkPiecewiseFunction or (value, opacity) points, got %r" % (name, opacity)) from None
     if points.ndim == 1 and points.size % 4 == 0 and points.size > 0:
         points = points.reshape(-1, 4)
@@ -115,15 +148,20 @@ def opacity_function(opacity, name="opacity"):
 
 def three(value, name):
     """Three floats from a scalar or a sequence of three."""
-    try:
-        values = np.asarray(value, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise TypeError("%s: numbers expected, got %r" % (name, value)) from None
+    values = numbers(value, name).reshape(-1)
     if values.size == 1:
         values = np.repeat(values, 3)
     if values.size != 3:
         raise ValueError("%s: one value, or one per array axis (3), got %d" % (name, values.size))
     return tuple(float(v) for v in values)
+
+
+def pair(value, name):
+    """Two floats (low, high)."""
+    values = numbers(value, name).reshape(-1)
+    if values.size != 2:
+        raise ValueError("%s: two values (low, high), got %d" % (name, values.size))
+    return float(values[0]), float(values[1])
 
 
 def readable(array, name="volume"):
@@ -213,9 +251,192 @@ def choose_scalars(algorithm, scalars, port=0):
 
 def set_component(algorithm, component):
     if component is not None:
-        if isinstance(component, bool) or not isinstance(component, numbers.Integral):
-            raise TypeError("component must be an integer, got %r" % (component,))
-        algorithm.SetComponent(int(component))
+        algorithm.SetComponent(number(component, "component", integer=True))
+
+
+# Why the filters refuse non-finite values, in their words.
+IN_A_VOLUME = "a non-finite value has no place in a cumulative distribution or an isosurface"
+IN_COLOURS = "they have no colour, opacity or shade"
+_AXES = {1: "vertex", 3: "z, y, x", 4: "z, y, x, component"}
+
+
+def non_finite(values):
+    """(count, index): how many NaN and infinite values `values` holds, and the index of
+    the first in C order (None when there is none; integer arrays have none). Read in
+    blocks along the first axis, so that a finite volume costs no mask of its size."""
+    if values.dtype.kind != "f" or values.size == 0:
+        return 0, None
+    step = max(1, (1 << 22) // max(1, values.size // values.shape[0]))
+    count, first = 0, None
+    for start in range(0, values.shape[0], step):
+        bad = ~np.isfinite(values[start:start + step])
+        found = int(np.count_nonzero(bad))
+        if found and first is None:
+            first = tuple(int(i) for i in np.unravel_index(np.argmax(bad), bad.shape))
+            first = (first[0] + start,) + first[1:]
+        count += found
+    return count, first
+
+
+def non_finite_sentence(what, count, index, reason, name="array"):
+    """The message for `count` non-finite values of `what`, the first at numpy `index`."""
+    return ("%s has %d NaN or infinite value%s, the first in C order at index [%s] (%s): %s. Replace them "
+            "first, e.g. with np.nan_to_num(%s, nan=0.0, posinf=high, neginf=low), or through a mask: "
+            "%s[~np.isfinite(%s)] = value"
+            % (what, count, "" if count == 1 else "s", ", ".join(str(i) for i in index),
+               _AXES.get(len(index), "index"), reason, name, name, name))
+
+
+def check_finite(values, name, reason):
+    """ValueError naming the first non-finite value of the numpy array `values` (given as
+    argument `name`) by its numpy index."""
+    count, first = non_finite(values)
+    if count:
+        raise ValueError(non_finite_sentence(name, count, first, reason, name))
+
+
+def check_volume(volume, component, name):
+    """What every volume filter refuses, said in numpy's terms before it runs: fewer than 2
+    voxels along an axis, a component the array does not have, NaN or infinite values
+    (the filters name voxels in VTK's (x, y, z) order). A vtkImageData's values are left to
+    the filter, whose message numpy_terms translates."""
+    if min(volume.shape) < 2:
+        raise ValueError("%s: the filter needs a 3-D volume, at least 2 voxels along every axis; got shape %s "
+                         "(z, y, x)" % (name, tuple(int(n) for n in volume.shape)))
+    values = volume.keep
+    if values is None:
+        return
+    components = values.shape[3] if values.ndim == 4 else 1
+    picked = -1 if component is None else number(component, "component", integer=True)
+    picked = 0 if picked < 0 and components == 1 else picked
+    if not 0 <= picked < components:
+        raise ValueError("%s has %d component%s (axis 3 of [z, y, x, component]): pass component, one of 0..%d "
+                         "(got %r)" % (name, components, "" if components == 1 else "s", components - 1, component))
+    if values.ndim == 4:
+        # In place: the column the filter reads; the index names it as the fourth.
+        count, first = non_finite(values[..., picked])
+        if count:
+            raise ValueError(non_finite_sentence(name, count, first + (picked,), IN_A_VOLUME, name))
+    else:
+        check_finite(values, name, IN_A_VOLUME)
+
+
+def _reversed(match, first=1):
+    """The three numbers of groups first..first+2, in (z, y, x) order."""
+    return "(%s, %s, %s)" % (match.group(first + 2), match.group(first + 1), match.group(first))
+
+
+def _voxel_index(match, image, x=3):
+    """Groups x, x+1, x+2 (a voxel of the image's extent, x first) as a numpy index."""
+    start = image.GetExtent()[::2] if image is not None else (0, 0, 0)
+    return tuple(int(match.group(x + a)) - start[a] for a in (2, 1, 0))
+
+
+def _point_index(point, image, vertices):
+    """A filter's point id as a numpy index: a vertex's row, or a voxel [z, y, x]."""
+    if vertices or image is None:
+        return (point,)
+    nx, ny, nz = image.GetDimensions()
+    return tuple(int(i) for i in np.unravel_index(point, (nz, ny, nx)))
+
+
+_NUMBER = r"([^\s,()]+)"
+_ADVICE = r" \(e\.g\. with the Calculator or Threshold filters\)"
+# The filters' messages that name voxels, shapes, axes or spacings in VTK's (x, y, z) order,
+# or ParaView's filters as the remedy, and what the numpy functions say instead. Each is
+# (pattern, replacement(match, image, vertices)); the specific ones come first.
+_TRANSLATIONS = [(re.compile(pattern), replacement) for pattern, replacement in [
+    (r"Array '([^']*)' has (\d+) NaN or infinite values \(the first at voxel (-?\d+), (-?\d+), (-?\d+)\)\. "
+     r"A non-finite value has no place in a cumulative distribution or an isosurface: replace them" + _ADVICE +
+     r" first\.",
+     lambda m, image, vertices: non_finite_sentence("array '%s'" % m.group(1), int(m.group(2)),
+                                                    _voxel_index(m, image), IN_A_VOLUME)),
+    (r"Array '([^']*)' has (\d+) NaN or infinite values \(the first at point (\d+)\): they have no colour, "
+     r"opacity or shade; replace them" + _ADVICE + r" first\.",
+     lambda m, image, vertices: non_finite_sentence("array '%s'" % m.group(1), int(m.group(2)),
+                                                    _point_index(int(m.group(3)), image, vertices), IN_COLOURS)),
+    (r"\(the first at voxel (-?\d+), (-?\d+), (-?\d+)\)",
+     lambda m, image, vertices: "(the first in C order at index [%d, %d, %d] (z, y, x))" % _voxel_index(m, image, 1)),
+    (r"\(the first at point (\d+)\)",
+     lambda m, image, vertices: "(the first in C order at index [%s])"
+     % ", ".join(str(i) for i in _point_index(int(m.group(1)), image, vertices))),
+    (r"the first at voxel index (\d+)",
+     lambda m, image, vertices: "the first in C order at index [%s]"
+     % ", ".join(str(i) for i in _point_index(int(m.group(1)), image, False))),
+    (r"replace them" + _ADVICE + r" first",
+     lambda m, image, vertices: "replace them first, e.g. with np.nan_to_num(array, nan=0.0, posinf=high, "
+                                "neginf=low), or through a mask: array[~np.isfinite(array)] = value"),
+    (r"(overflow double precision\)?): rescale the data \(e\.g\. with the Calculator\) first",
+     lambda m, image, vertices: m.group(1) + ": rescale the array first, e.g. array / np.abs(array).max()"),
+    (r"rescale the data \(e\.g\. with the Calculator\) first",
+     lambda m, image, vertices: "rescale the array first, e.g. (array - array.min()) / np.ptp(array)"),
+    (r"Subtract an offset first \(e\.g\. with the Calculator\)",
+     lambda m, image, vertices: "Subtract an offset first (e.g. array - array.mean())"),
+    (r"Radius " + _NUMBER + r"( \(world units\))? \((\d+) x (\d+) x (\d+) voxels\) covers the whole "
+     r"(\d+) x (\d+) x (\d+) volume",
+     lambda m, image, vertices: "Radius %s%s (%s, %s, %s voxels along axes 0, 1, 2) covers the whole volume of "
+                                "shape %s" % (m.group(1), m.group(2) or "", m.group(5), m.group(4), m.group(3),
+                                              _reversed(m, 6))),
+    (r"The filter needs a 3-D volume; the input is (\d+) x (\d+) x (\d+) voxels \(empty, a single voxel, or 2-D\)",
+     lambda m, image, vertices: "The filter needs a 3-D volume, at least 2 voxels along every axis; got shape %s "
+                                "(z, y, x)" % _reversed(m)),
+    (r"(-?\d+) x (-?\d+) x (-?\d+)( voxels)?",
+     lambda m, image, vertices: "shape %s (z, y, x)" % _reversed(m)),
+    (r"the input's is " + _NUMBER + ", " + _NUMBER + ", " + _NUMBER + r"\. Fix the spacing \(e\.g\. with Change "
+     r"Spacing\) or give the radius in voxels",
+     lambda m, image, vertices: "the sampling (z, y, x) is %s: give a finite, positive sampling, or the radius in "
+                                "voxels (world_radius=False)" % _reversed(m)),
+    (r"occlusion sweeping needs spacings between " + _NUMBER + " and " + _NUMBER + r" \(its distances are float; "
+     r"got " + _NUMBER + ", " + _NUMBER + ", " + _NUMBER + r"\): rescale the volume \(e\.g\. with Change Spacing\)",
+     lambda m, image, vertices: "occlusion sweeping needs a sampling between %s and %s on every axis (its distances "
+                                "are float; got %s for (z, y, x)): give the sampling in other units"
+     % (m.group(1), m.group(2), _reversed(m, 3))),
+    (r"(?:the )?spacing must be finite and positive \(got " + _NUMBER + ", " + _NUMBER + ", " + _NUMBER + r"\)",
+     lambda m, image, vertices: "the sampling must be finite and positive (got %s for (z, y, x))" % _reversed(m)),
+    (r"the origin must be finite \(got " + _NUMBER + ", " + _NUMBER + ", " + _NUMBER + r"\)",
+     lambda m, image, vertices: "the origin must be finite (got %s for (z, y, x))" % _reversed(m)),
+    (r"LightDirection must be (finite|a non-zero vector of finite length) \(got " + _NUMBER + ", " + _NUMBER + ", "
+     + _NUMBER + r"\)",
+     lambda m, image, vertices: "light_direction must be %s (got %s for (z, y, x))" % (m.group(1), _reversed(m, 2))),
+    (r"\(axis (\d): surface ",
+     lambda m, image, vertices: "(axis %d of the volume [z, y, x] and of the vertices (z, y, x): surface "
+     % (2 - int(m.group(1)))),
+    (r"\b(of|on) axis (\d)\b",
+     lambda m, image, vertices: "%s axis %d (z, y, x)" % (m.group(1), 2 - int(m.group(2)))),
+    (r"The surface has no point normals and the volume's gradient is zero at point (\d+): add normals "
+     r"\(e\.g\. Contour with Compute Normals, or Generate Surface Normals\)",
+     lambda m, image, vertices: "The volume's gradient is zero at vertex %s, so it gives that vertex no normal: "
+                                "pass normals ((N, 3), (z, y, x) order, towards lower values), or leave the vertex "
+                                "out" % m.group(1)),
+    (r"Point (\d+) of the surface has (no normal|a zero or non-finite normal), the volume's gradient is zero there "
+     r"and it has no polygon with an area: remove it \(e\.g\. Clean\), or give it a normal",
+     lambda m, image, vertices: "Vertex %s has %s and the volume's gradient is zero there: pass normals with a "
+                                "usable row %s ((N, 3), (z, y, x) order, towards lower values), or leave the vertex "
+                                "out" % (m.group(1), "no normal (normals=None)" if m.group(2) == "no normal"
+                                         else "a zero or non-finite normal (row %s of normals)" % m.group(1),
+                                         m.group(1))),
+    (r"(non-finite coordinate|non-finite normal|zero normal) at point (\d+)",
+     lambda m, image, vertices: "%s at vertex %s (row %s of %s)" % (m.group(1), m.group(2), m.group(2),
+                                                                   "vertices" if "coordinate" in m.group(1)
+                                                                   else "normals")),
+    (r"(\d+) of the surface's (\d+) point normals are zero or not finite: those points take the volume's "
+     r"gradient \(or their polygons' normal\) instead",
+     lambda m, image, vertices: "%s of the %s rows of normals are zero or not finite: those vertices take the "
+                                "volume's gradient instead" % (m.group(1), m.group(2))),
+    (r"set Component to one of 0\.\.(-?\d+) \(got (-?\d+)\)",
+     lambda m, image, vertices: "pass component, one of 0..%s (got %s)"
+     % (m.group(1), "None" if m.group(2) == "-1" else m.group(2))),
+]]
+
+
+def numpy_terms(text, image=None, vertices=False):
+    """A filter's message in the numpy functions' terms: voxels, shapes, axes and spacings
+    in array order [z, y, x] (the filters speak VTK's (x, y, z)), and numpy's remedies
+    where they name ParaView's filters. `image`: the volume, whose extent turns a voxel
+    into an index of the results; `vertices`: the filter's points are the vertices given."""
+    for pattern, replacement in _TRANSLATIONS:
+        text = pattern.sub(lambda match: replacement(match, image, vertices), text)
+    return text
 
 
 class _Bar:
@@ -262,12 +483,13 @@ def _progress_callback(progress, label):
     raise TypeError("progress must be True, False or a callable taking the fraction done, got %r" % (progress,))
 
 
-def run(algorithm, progress=False, cuda_asked=False, label=None):
+def run(algorithm, progress=False, cuda_asked=False, label=None, image=None, vertices=False):
     """Updates `algorithm`: its errors raise, its warnings are warned, its progress is
     shown. Warnings point at the caller's caller (the user's call of a public function).
 
     An error the filter reports about its arguments or data raises ValueError with its
     sentence; a computation that failed (memory, a device, another process) RuntimeError.
+    Both, and the warnings, speak numpy's terms (numpy_terms, with `image` and `vertices`).
     """
     name = algorithm.GetClassName()
     if cuda_asked:
@@ -302,10 +524,11 @@ def run(algorithm, progress=False, cuda_asked=False, label=None):
         if isinstance(bar, _Bar):
             bar.close()
     for note in notes:
-        warnings.warn(note, VolumetricAOWarning, stacklevel=3)
+        warnings.warn(numpy_terms(note, image, vertices), VolumetricAOWarning, stacklevel=3)
     if errors:
         text = "\n".join(dict.fromkeys(e for e in errors if e)) or "%s failed" % name
-        raise (RuntimeError if _FAILURE.search(text) else ValueError)(text)
+        # Which kind is read from the filter's own words.
+        raise (RuntimeError if _FAILURE.search(text) else ValueError)(numpy_terms(text, image, vertices))
     return algorithm.GetOutputDataObject(0)
 
 

@@ -4,6 +4,8 @@ and soft shadows of a mesh's vertices) and Ambient Occlusion Shading (colours).
 Vertices, normals and directions are in array order (z, y, x), like the vertices of
 ``skimage.measure.marching_cubes(volume, level, spacing=sampling)``: index times sampling.
 """
+import math
+
 import numpy as np
 
 from vtkmodules.vtkCommonCore import vtkPoints
@@ -38,6 +40,42 @@ def _per_vertex(values, name, count):
     if array.shape != (count,):
         raise ValueError("%s: one value per vertex (%d,), got shape %s" % (name, count, array.shape))
     return array
+
+
+def _check_vertices(points_xyz, image):
+    """What the filter refuses of the vertices on a numpy volume, said in numpy's terms
+    before it runs: a vertex that is not finite, or one outside the volume by more than
+    half a voxel (the filter's test, on the same doubles: it names VTK's axis)."""
+    zyx = points_xyz[:, ::-1].astype(np.float64)  # exact, and compared as the filter compares
+    bad = ~np.isfinite(zyx).all(axis=1)
+    if bad.any():
+        row = int(np.argmax(bad))
+        raise ValueError("vertices: vertex %d (row %d) is not finite (%s): remove it, e.g. "
+                         "vertices[np.isfinite(vertices).all(axis=1)]" % (row, row, ", ".join(map(repr, zyx[row]))))
+    h = np.array(image.GetSpacing()[::-1])
+    shape = np.array(image.GetDimensions()[::-1])
+    top = 0.0 + (shape - 1) * h                   # the last voxel; the first is at 0
+    outside = (zyx < 0.0 - 0.5 * h) | (zyx > top + 0.5 * h)
+    rows = outside.any(axis=1)
+    if rows.any():
+        row = int(np.argmax(rows))
+        axis = int(np.argmax(outside[row]))
+        raise ValueError(
+            "The surface reaches outside the volume: vertex %d (row %d of vertices) lies at %g along axis %d, beyond "
+            "the volume's 0..%g along that axis by more than half a voxel (shape %s, sampling %s); %d of the %d "
+            "vertices lie outside. Give the volume the vertices were extracted from, with its sampling: vertices "
+            "are (z, y, x) positions in the units of sampling, counted from the first voxel."
+            % (row, row, zyx[row, axis], axis, top[axis], tuple(int(n) for n in shape),
+               tuple(float(v) for v in h), int(rows.sum()), len(rows)))
+
+
+def _check_light(light):
+    """The filter's test of the light direction (x, y, z), said in numpy's (z, y, x)."""
+    x, y, z = light[2], light[1], light[0]
+    length = math.sqrt(x * x + y * y + z * z)
+    if not (math.isfinite(length) and length > 0.0):
+        raise ValueError("light_direction must be a finite, non-zero direction towards the light in (z, y, x) order, "
+                         "got %s" % (light,))
 
 
 def isosurface_ambient_occlusion(volume, vertices, normals=None, *, sampling=None, iso_value=None, levels=4,
@@ -81,8 +119,12 @@ def isosurface_ambient_occlusion(volume, vertices, normals=None, *, sampling=Non
     (dtype('float32'), True, True)
     """
     backend_key = _common.check_backend(backend)
-    image = _common.volume_image(volume, sampling).image
+    given = _common.volume_image(volume, sampling)
+    _common.check_volume(given, component, "volume")
+    image = given.image
     points_xyz = _xyz(vertices, "vertices")
+    if given.keep is not None:
+        _check_vertices(points_xyz, image)  # a vtkImageData's own frame: the filter's message, translated
     count = points_xyz.shape[0]
     surface = vtkPolyData()
     points = vtkPoints()
@@ -92,6 +134,8 @@ def isosurface_ambient_occlusion(volume, vertices, normals=None, *, sampling=Non
         normals_xyz = _xyz(normals, "normals", count)
         surface.GetPointData().SetNormals(_common.vtk_array(normals_xyz, "Normals"))
     light = _common.three(light_direction, "light_direction")
+    if shadows:
+        _check_light(light)
     iso = vtkIsosurfaceAmbientOcclusion()
     iso.SetController(None)
     iso.SetInputData(surface)
@@ -102,7 +146,7 @@ def isosurface_ambient_occlusion(volume, vertices, normals=None, *, sampling=Non
     if iso_value is not None:
         iso.SetQueryMode(vtkIsosurfaceAmbientOcclusion.ISO_VALUE)
         iso.SetIsoValue(_common.number(iso_value, "iso_value"))
-    iso.SetNumberOfLevels(int(levels))
+    iso.SetNumberOfLevels(_common.number(levels, "levels", integer=True))
     iso.SetStartAtHalfResolution(bool(start_at_half_resolution))
     iso.SetOffsetFactor(_common.number(offset_factor, "offset_factor"))
     iso.SetCombine(_common.choice(combine, _COMBINE, "combine"))
@@ -110,7 +154,8 @@ def isosurface_ambient_occlusion(volume, vertices, normals=None, *, sampling=Non
     iso.SetComputeShadows(bool(shadows))
     iso.SetLightDirection(light[2], light[1], light[0])
     iso.SetNumberOfThreads(_common.check_threads(threads))
-    output = _common.run(iso, progress, cuda_asked=backend_key == "cuda", label="isosurface_ambient_occlusion")
+    output = _common.run(iso, progress, cuda_asked=backend_key == "cuda", label="isosurface_ambient_occlusion",
+                         image=image, vertices=True)
     names = ["AmbientOcclusion"] + (["Shadow"] if shadows else [])
     results = _common.point_arrays(output, names, (count,), "vtkIsosurfaceAmbientOcclusion")
     return _common.finish(tuple(results) if shadows else results[0], output, return_info)
@@ -163,6 +208,8 @@ def shade(values, ao=None, *, variance=None, shadow=None, sampling=None, color_p
         keep.append(volume.keep)
         if ao is None and volume.keep is not None:
             raise TypeError("shade(volume, ao): give the ambient occlusion of the volume")
+        if volume.keep is not None:
+            _common.check_finite(volume.keep, "values", _common.IN_COLOURS)
     else:
         if ao is None:
             raise TypeError("shade(values, ao): give the ambient occlusion of the vertices")
@@ -175,22 +222,27 @@ def shade(values, ao=None, *, variance=None, shadow=None, sampling=None, color_p
         data.SetPoints(points)
         if values is not None:
             scalars_values = _per_vertex(values, "values", count)
+            _common.check_finite(scalars_values, "values", _common.IN_COLOURS)
             keep.append(scalars_values)
             data.GetPointData().SetScalars(_common.vtk_array(scalars_values, "Scalars"))
     point_data = data.GetPointData()
 
-    def add(array, name):
+    surface = output_name == "ShadedRGB"
+
+    def add(array, name, argument, read):
         if isinstance(array, bool) or array is None:
             return
         given = _common.readable(array, name)
         if given.shape != tuple(shape):
             raise ValueError("%s: expected the shape of the values %s, got %s" % (name, tuple(shape), given.shape))
+        if read:  # the filter refuses NaN in the arrays it reads; it names them by VTK's point id
+            _common.check_finite(given, argument, _common.IN_COLOURS)
         keep.append(given)
         point_data.AddArray(_common.vtk_array(given, name))
 
-    add(ao, "AmbientOcclusion")
-    add(variance, "Variance")
-    add(shadow, "Shadow")
+    add(ao, "AmbientOcclusion", "ao", True)
+    add(variance, "Variance", "variance", not surface)
+    add(shadow, "Shadow", "shadow", surface)
     shading = vtkAmbientOcclusionShading()
     shading.SetController(None)
     shading.SetInputData(data)
@@ -198,9 +250,9 @@ def shade(values, ao=None, *, variance=None, shadow=None, sampling=None, color_p
         shading.SetScalarsArrayName(str(scalars))
     shading.SetColorPreset(_common.choice(color_preset, _PRESETS, "color_preset"))
     if scalar_range is not None:
-        shading.SetScalarRange(*[_common.number(v, "scalar_range") for v in scalar_range])
+        shading.SetScalarRange(*_common.pair(scalar_range, "scalar_range"))
     if opacity_ramp is not None:
-        shading.SetOpacityRamp(*[_common.number(v, "opacity_ramp") for v in opacity_ramp])
+        shading.SetOpacityRamp(*_common.pair(opacity_ramp, "opacity_ramp"))
     shading.SetAmbientIntensity(_common.number(ambient_intensity, "ambient_intensity"))
     shading.SetGamma(_common.number(gamma, "gamma"))
     shading.SetModulateOpacity(variance is not None and variance is not False)
@@ -211,6 +263,7 @@ def shade(values, ao=None, *, variance=None, shadow=None, sampling=None, color_p
         shading.SetOpacityTransferFunction(
             _common.opacity_function(opacity_transfer_function, "opacity_transfer_function"))
     shading.SetNumberOfThreads(_common.check_threads(threads))
-    output = _common.run(shading, progress, cuda_asked=backend_key == "cuda", label="shade")
+    output = _common.run(shading, progress, cuda_asked=backend_key == "cuda", label="shade",
+                         image=None if surface else data, vertices=surface)
     (colours,) = _common.point_arrays(output, [output_name], shape, "vtkAmbientOcclusionShading")
     return _common.finish(colours, output, return_info)

@@ -7,8 +7,6 @@ as scipy.ndimage takes it, or vtkImageData (their spacing, origin and direction 
 import collections
 import warnings
 
-import numpy as np
-
 from . import _common
 from .VolumetricAOFilters import vtkOcclusionSweeping, vtkVarianceOcclusionMap, vtkVolumetricAmbientOcclusion
 
@@ -114,6 +112,7 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
     erf_key = _common.choice(erf, _ERF, "erf")
     backend_key = _common.check_backend(backend)
     volume = _volume(array, sampling, spacing, origin)
+    _common.check_volume(volume, component, "array")
     ao = vtkVolumetricAmbientOcclusion()
     ao.SetController(None)  # this process's array is the whole volume
     ao.SetInputData(volume.image)
@@ -124,19 +123,19 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
         ao.SetOpacityFunction(function)
     ao.SetRadius(_common.number(radius, "radius"))
     ao.SetRadiusUnits(vtkVolumetricAmbientOcclusion.WORLD if world_radius else vtkVolumetricAmbientOcclusion.VOXELS)
-    ao.SetNumberOfBins(int(number_of_bins))
+    ao.SetNumberOfBins(_common.number(number_of_bins, "number_of_bins", integer=True))
     ao.SetNumberOfThreads(_common.check_threads(threads))
     ao.SetComputeVariance(bool(variance))
     ao.SetErfApproximation(erf_key)
     ao.SetBackend(_BACKEND[backend_key])
-    ao.SetDevice(int(device))
+    ao.SetDevice(_common.number(device, "device", integer=True))
     if iso_value is not None:
         ao.SetQueryMode(vtkVolumetricAmbientOcclusion.ISO_VALUE)
         ao.SetIsoValue(_common.number(iso_value, "iso_value"))
     elif query_smoothing is not None:
         ao.SetQueryMode(vtkVolumetricAmbientOcclusion.SMOOTHED_VALUE)
         ao.SetQuerySmoothing(_common.number(query_smoothing, "query_smoothing"))
-    output = _common.run(ao, progress, label="ambient_occlusion")
+    output = _common.run(ao, progress, label="ambient_occlusion", image=volume.image)
     names = ["AmbientOcclusion"] + (["Variance"] if variance else [])
     results = _common.point_arrays(output, names, volume.shape, "vtkVolumetricAmbientOcclusion")
     return _common.finish(tuple(results) if variance else results[0], output, return_info, reported=True)
@@ -185,6 +184,7 @@ def occlusion_sweeping(array, iso_value, spacing=None, inside_is_above=True, ite
     """
     backend_key = _common.check_backend(backend)
     volume = _volume(array, sampling, spacing, origin)
+    _common.check_volume(volume, component, "array")
     sweep = vtkOcclusionSweeping()
     sweep.SetController(None)
     sweep.SetInputData(volume.image)
@@ -192,19 +192,17 @@ def occlusion_sweeping(array, iso_value, spacing=None, inside_is_above=True, ite
     _common.set_component(sweep, component)
     sweep.SetIsoValue(_common.number(iso_value, "iso_value"))
     sweep.SetInsideIsAbove(bool(inside_is_above))
-    sweep.SetNumberOfIterations(int(iterations))
+    sweep.SetNumberOfIterations(_common.number(iterations, "iterations", integer=True))
     sweep.SetConvergenceTolerance(_common.number(tolerance, "tolerance"))
     sweep.SetUseGeometryTerm(bool(geometry_term))
     if octant_mask is not None:
-        mask = [int(bool(m)) for m in np.asarray(octant_mask).reshape(-1)]
-        if len(mask) != 8:
-            raise ValueError("octant_mask: 8 flags (Table 1 order), got %d" % len(mask))
-        sweep.SetOctantMask(*mask)
+        sweep.SetOctantMask(*_common.flags(octant_mask, "octant_mask (Table 1 order)", 8))
     sweep.SetGamma(_common.number(gamma, "gamma"))
     sweep.SetOpacity(_common.number(opacity, "opacity"))
     sweep.SetOutputOctantVisibility(bool(octant_visibility))
     sweep.SetNumberOfThreads(_common.check_threads(threads))
-    output = _common.run(sweep, progress, cuda_asked=backend_key == "cuda", label="occlusion_sweeping")
+    output = _common.run(sweep, progress, cuda_asked=backend_key == "cuda", label="occlusion_sweeping",
+                         image=volume.image)
     names = ["AmbientOcclusion", "SignedDistance"] + (["OctantVisibility"] if octant_visibility else [])
     results = _common.point_arrays(output, names, volume.shape, "vtkOcclusionSweeping")
     return _common.finish(tuple(results), output, return_info)
@@ -232,15 +230,17 @@ def variance_occlusion_map(volume, *, sampling=None, levels=4, start_at_half_res
     [((32, 24, 16), (2.0, 1.0, 1.0)), ((16, 12, 8), (4.0, 2.0, 2.0)), ((8, 6, 4), (8.0, 4.0, 4.0))]
     """
     backend_key = _common.check_backend(backend)
-    image = _common.volume_image(volume, sampling).image
+    given = _common.volume_image(volume, sampling)
+    _common.check_volume(given, component, "volume")
     pyramid = vtkVarianceOcclusionMap()
-    pyramid.SetInputData(image)
+    pyramid.SetInputData(given.image)
     _common.choose_scalars(pyramid, scalars)
     _common.set_component(pyramid, component)
-    pyramid.SetNumberOfLevels(int(levels))
+    pyramid.SetNumberOfLevels(_common.number(levels, "levels", integer=True))
     pyramid.SetStartAtHalfResolution(bool(start_at_half_resolution))
     pyramid.SetNumberOfThreads(_common.check_threads(threads))
-    output = _common.run(pyramid, progress, cuda_asked=backend_key == "cuda", label="variance_occlusion_map")
+    output = _common.run(pyramid, progress, cuda_asked=backend_key == "cuda", label="variance_occlusion_map",
+                         image=given.image)
     result = []
     for index in range(output.GetNumberOfBlocks()):
         level = output.GetBlock(index)
