@@ -7,6 +7,7 @@
 #include "vtkIsosurfaceAmbientOcclusion.h"
 #include "vtkVarianceOcclusionMap.h"
 
+#include "vtkCellArray.h"
 #include "vtkFloatArray.h"
 #include "vtkFlyingEdges3D.h"
 #include "vtkImageData.h"
@@ -369,12 +370,14 @@ TEST(IsosurfaceAmbientOcclusionFilter, RejectsBadInputWithAClearError)
     moved->GetPoints()->SetPoint(i, p);
   }
   ExpectRejected(moved, volume, none, "outside the volume");
-  // No normals, and a constant volume: no gradient either.
+  // No normals, a constant volume (no gradient either) and no polygons: nothing says
+  // which way the points face.
   vtkNew<vtkPolyData> bare;
   bare->DeepCopy(surface);
   bare->GetPointData()->Initialize();
+  bare->SetPolys(vtkNew<vtkCellArray>());
   auto flat = Slab(24, 100, 100); // all air
-  ExpectRejected(bare, flat, none, "no point normals");
+  ExpectRejected(bare, flat, none, "has no normal, the volume's gradient is zero there");
   ExpectRejected(
     surface, volume,
     [](vtkIsosurfaceAmbientOcclusion* f)
