@@ -9,12 +9,14 @@
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
 #include "vtkImageData.h"
+#include "vtkMatrix3x3.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkSmartPointer.h"
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 namespace vtkAmbientOcclusionCollectives
@@ -26,6 +28,11 @@ using vtkAmbientOcclusionExtents::CopyRequestedExtent;
 using vtkAmbientOcclusionExtents::EmptyExtent;
 using vtkAmbientOcclusionExtents::ExtentPoints;
 using vtkAmbientOcclusionExtents::IntersectExtents;
+
+struct Box
+{
+  int ext[6];
+};
 
 /// Copies the point arrays of `piece` (extent `pieceExt`, inside output's extent) into
 /// output's arrays of the same names, row by row.
@@ -59,16 +66,18 @@ void PasteExtent(vtkImageData* piece, const int pieceExt[6], vtkImageData* outpu
   }
 }
 
-/// `output` as the `wanted` extent of held's grid, with arrays like held's (their values
-/// not set) and held's field data; then the part of held that lies in it.
-void AllocateWanted(vtkImageData* held, const int wanted[6], vtkImageData* output)
+/// `output` as the `wanted` extent of `like`'s grid (origin, spacing and direction from
+/// `geometry`), with arrays like `like`'s (their values not set), its active scalars and
+/// its field data.
+void AllocateWanted(
+  vtkImageData* like, const double geometry[15], const int wanted[6], vtkImageData* output)
 {
   const vtkIdType points = ExtentPoints(wanted);
   output->SetExtent(const_cast<int*>(wanted));
-  output->SetOrigin(held->GetOrigin());
-  output->SetSpacing(held->GetSpacing());
-  output->SetDirectionMatrix(held->GetDirectionMatrix());
-  vtkPointData* from = held->GetPointData();
+  output->SetOrigin(geometry);
+  output->SetSpacing(geometry + 3);
+  output->SetDirectionMatrix(geometry + 6);
+  vtkPointData* from = like->GetPointData();
   for (int a = 0; a < from->GetNumberOfArrays(); ++a)
   {
     vtkDataArray* array = from->GetArray(a);
@@ -84,15 +93,75 @@ void AllocateWanted(vtkImageData* held, const int wanted[6], vtkImageData* outpu
   }
   if (from->GetScalars())
     output->GetPointData()->SetActiveScalars(from->GetScalars()->GetName());
-  output->GetFieldData()->ShallowCopy(held->GetFieldData());
+  output->GetFieldData()->ShallowCopy(like->GetFieldData());
+}
+
+/// The parts of `box` outside `hole`, as at most six boxes appended to `parts`.
+void Subtract(const Box& box, const int hole[6], std::vector<Box>& parts)
+{
   int common[6];
-  if (IntersectExtents(held->GetExtent(), wanted, common))
+  if (!IntersectExtents(box.ext, hole, common))
   {
-    vtkNew<vtkImageData> own;
-    CopyRequestedExtent(held, own, common);
-    PasteExtent(own, common, output);
+    parts.push_back(box);
+    return;
+  }
+  Box rest = box;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (rest.ext[2 * a] < common[2 * a])
+    {
+      Box below = rest;
+      below.ext[2 * a + 1] = common[2 * a] - 1;
+      parts.push_back(below);
+      rest.ext[2 * a] = common[2 * a];
+    }
+    if (rest.ext[2 * a + 1] > common[2 * a + 1])
+    {
+      Box above = rest;
+      above.ext[2 * a] = common[2 * a + 1] + 1;
+      parts.push_back(above);
+      rest.ext[2 * a + 1] = common[2 * a + 1];
+    }
   }
 }
+
+} // namespace
+
+std::vector<Transfer> PlanTransfers(
+  const std::vector<int>& held, const std::vector<int>& wanted, bool& complete)
+{
+  const int ranks = static_cast<int>(held.size() / 6);
+  std::vector<Transfer> plan;
+  complete = true;
+  for (int to = 0; to < ranks; ++to)
+  {
+    std::vector<Box> remaining;
+    if (!EmptyExtent(&wanted[6 * to]))
+      remaining.push_back(Box{ { wanted[6 * to], wanted[6 * to + 1], wanted[6 * to + 2],
+        wanted[6 * to + 3], wanted[6 * to + 4], wanted[6 * to + 5] } });
+    // Its own block first (no message), then the others' in rank order.
+    for (int k = -1; k < ranks && !remaining.empty(); ++k)
+    {
+      const int from = k < 0 ? to : k;
+      if ((k >= 0 && from == to) || EmptyExtent(&held[6 * from]))
+        continue;
+      std::vector<Box> next;
+      for (const Box& box : remaining)
+      {
+        Transfer part{ from, to, {} };
+        if (IntersectExtents(box.ext, &held[6 * from], part.ext))
+          plan.push_back(part);
+        Subtract(box, &held[6 * from], next);
+      }
+      remaining.swap(next);
+    }
+    complete = complete && remaining.empty();
+  }
+  return plan;
+}
+
+namespace
+{
 
 /// Per process: where its floats start in an all-gathered buffer, and how many it sent.
 struct GatheredLayout
@@ -134,47 +203,72 @@ void GlobalRange(vtkMultiProcessController* controller, double range[2])
   controller->AllReduce(&local[1], &range[1], 1, vtkCommunicator::MAX_OP);
 }
 
-void RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
+bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
   const int wanted[6], vtkImageData* output)
 {
   const int ranks = controller->GetNumberOfProcesses(), rank = controller->GetLocalProcessId();
+  int heldExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  if (held->GetNumberOfPoints() > 0)
+    held->GetExtent(heldExtent);
   std::vector<int> heldExtents(6 * ranks), wantedExtents(6 * ranks);
-  controller->AllGather(held->GetExtent(), heldExtents.data(), 6);
+  controller->AllGather(heldExtent, heldExtents.data(), 6);
   controller->AllGather(wanted, wantedExtents.data(), 6);
+  // The grid from a process that holds voxels: a reader that does not split (MetaImage,
+  // NRRD) hands the others an empty image without one.
+  double geometry[15];
+  held->GetOrigin(geometry);
+  held->GetSpacing(geometry + 3);
+  std::copy(
+    held->GetDirectionMatrix()->GetData(), held->GetDirectionMatrix()->GetData() + 9, geometry + 6);
+  std::vector<double> geometries(15 * ranks);
+  controller->AllGather(geometry, geometries.data(), 15);
+  for (int r = 0; r < ranks; ++r)
+    if (!EmptyExtent(&heldExtents[6 * r]))
+    {
+      std::copy(&geometries[15 * r], &geometries[15 * r] + 15, geometry);
+      break;
+    }
 
   output->Initialize();
+  bool complete = true;
+  const std::vector<Transfer> plan = PlanTransfers(heldExtents, wantedExtents, complete);
+  if (!complete)
+    return false;
   const bool wantsSomething = !EmptyExtent(wanted);
-  if (wantsSomething)
-  {
-    AllocateWanted(held, wanted, output);
-  }
+  if (wantsSomething && !EmptyExtent(heldExtent))
+    AllocateWanted(held, geometry, wanted, output);
   // Pairs in one global order, the lower rank sending first: no two wait on each other.
   constexpr int kPieceTag = 7102;
   for (int a = 0; a < ranks; ++a)
-    for (int b = a + 1; b < ranks; ++b)
+    for (int b = a; b < ranks; ++b)
     {
       if (rank != a && rank != b)
         continue;
       const int other = rank == a ? b : a;
       auto send = [&]
       {
-        int part[6];
-        if (IntersectExtents(held->GetExtent(), &wantedExtents[6 * other], part))
-        {
-          vtkNew<vtkImageData> piece;
-          CopyRequestedExtent(held, piece, part);
-          controller->Send(piece.Get(), other, kPieceTag);
-        }
+        for (const Transfer& part : plan)
+          if (part.from == rank && part.to == other && other != rank)
+          {
+            vtkNew<vtkImageData> piece;
+            CopyRequestedExtent(held, piece, part.ext);
+            controller->Send(piece.Get(), other, kPieceTag);
+          }
       };
       auto receive = [&]
       {
-        int part[6];
-        if (wantsSomething && IntersectExtents(&heldExtents[6 * other], wanted, part))
-        {
-          vtkNew<vtkImageData> piece;
-          controller->Receive(piece.Get(), other, kPieceTag);
-          PasteExtent(piece, part, output); // the extent is known: the transport may not keep it
-        }
+        for (const Transfer& part : plan)
+          if (part.to == rank && part.from == other)
+          {
+            vtkNew<vtkImageData> piece;
+            if (other == rank)
+              CopyRequestedExtent(held, piece, part.ext);
+            else
+              controller->Receive(piece.Get(), other, kPieceTag);
+            if (output->GetNumberOfPoints() == 0)
+              AllocateWanted(piece, geometry, wanted, output);
+            PasteExtent(piece, part.ext, output); // the transport may not keep the extent
+          }
       };
       if (rank == a)
       {
@@ -187,6 +281,23 @@ void RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
         send();
       }
     }
+  return true;
+}
+
+vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageData* input,
+  const int needed[6], vtkImageData* fetched, std::string& error)
+{
+  int common[6];
+  const bool covered = EmptyExtent(needed) ||
+    (input->GetNumberOfPoints() > 0 && IntersectExtents(input->GetExtent(), needed, common) &&
+      std::equal(common, common + 6, needed));
+  if (GlobalMax(controller, covered ? 0.0 : 1.0) == 0.0)
+    return input;
+  if (RedistributeExtents(controller, input, needed, fetched))
+    return fetched;
+  error = "The processes' pieces of the input do not hold every voxel this filter needs: "
+          "give it a source that delivers the whole data set across the processes.";
+  return nullptr;
 }
 
 void GatherLevel(vtkMultiProcessController* controller, vtkImageData* part, vao::MomentLevel& level)

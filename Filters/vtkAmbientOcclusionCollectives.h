@@ -5,6 +5,9 @@
 #ifndef vtkAmbientOcclusionCollectives_h
 #define vtkAmbientOcclusionCollectives_h
 
+#include <string>
+#include <vector>
+
 class vtkImageData;
 class vtkMultiProcessController;
 namespace vao
@@ -23,11 +26,35 @@ double GlobalMax(vtkMultiProcessController* controller, double value);
 void GlobalRange(vtkMultiProcessController* controller, double range[2]);
 
 /// Distributed data held as blocks to distributed data as requested: every process holds
-/// `held` (its block, any extent) and wants `wanted` (its requested extent, possibly
-/// empty); each receives the parts of the others' blocks that overlap what it wants.
-/// `output` gets the wanted extent with held's geometry and point arrays.
-void RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
+/// `held` (its block, any extent; empty on the processes of a reader that does not split)
+/// and wants `wanted` (an extent, possibly empty); each receives every voxel it wants
+/// once, from itself where it can, else from the lowest process that holds it. `output`
+/// gets the wanted extent with the holders' geometry and point arrays. False, with every
+/// output empty, when some wanted voxel is held by no process (the same on every process).
+bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
   const int wanted[6], vtkImageData* output);
+
+/// The image a process reads to compute its piece: `input` itself when every process's
+/// input covers the extent it needs (`needed`, possibly empty), as readers that split
+/// deliver it; else `fetched`, filled by RedistributeExtents from whatever the processes
+/// hold (a reader that does not split reads everything on one process). Costs one
+/// reduction when nothing is missing. nullptr, with `error`, when no process holds some
+/// needed voxel (the same on every process).
+vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageData* input,
+  const int needed[6], vtkImageData* fetched, std::string& error);
+
+/// One message of RedistributeExtents: the voxels `ext` from process `from` to `to`.
+struct Transfer
+{
+  int from, to;
+  int ext[6];
+};
+
+/// The messages that give each process r the extent wanted[6r..6r+5] from the blocks
+/// held[6r..6r+5] (its own first, then the others' in rank order, each voxel once);
+/// `complete` says whether every wanted voxel is held somewhere.
+std::vector<Transfer> PlanTransfers(
+  const std::vector<int>& held, const std::vector<int>& wanted, bool& complete);
 
 /// A pyramid level held in pieces, made whole on every process: each passes its piece
 /// (`part`: float arrays "Mean" and "Variance", its extent in the whole level's grid;

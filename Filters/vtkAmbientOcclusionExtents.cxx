@@ -1,6 +1,10 @@
 #include "vtkAmbientOcclusionExtents.h"
 #include "vtkAmbientOcclusionMemory.h"
 
+#include "vtkAlgorithm.h"
+#include "vtkExecutive.h"
+#include "vtkInformationExecutivePortKey.h"
+
 #include "vtkExtentTranslator.h"
 #include "vtkFieldData.h"
 #include "vtkImageData.h"
@@ -185,6 +189,36 @@ void RequestExactExtent(vtkInformation* info, const int extent[6])
   info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
   info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
   info->Set(vtkStreamingDemandDrivenPipeline::EXACT_EXTENT(), 1);
+}
+
+bool CanProduceSubExtent(vtkInformation* info)
+{
+  for (int depth = 0; info && depth < 1000; ++depth)
+  {
+    if (info->Has(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT()) &&
+      info->Get(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT()) != 0)
+      return true;
+    vtkExecutive* producer = nullptr;
+    int port = 0;
+    vtkExecutive::PRODUCER()->Get(info, producer, port);
+    vtkAlgorithm* algorithm = producer ? producer->GetAlgorithm() : nullptr;
+    if (!algorithm)
+      return true; // data without a pipeline behind it: nothing reads a file
+    if (algorithm->GetNumberOfInputPorts() == 0 || algorithm->GetNumberOfInputConnections(0) == 0)
+      return false; // a source that did not say it can
+    info = producer->GetInputInformation(0, 0);
+  }
+  return false;
+}
+
+void RequestPieceOfWhole(vtkInformation* info, int piece, int pieces)
+{
+  int whole[6];
+  info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), whole, 6);
+  info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), piece);
+  info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), pieces);
+  info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
 }
 
 void RequestWholeExtent(vtkInformation* info)

@@ -73,6 +73,19 @@ void RequestExactExtent(vtkInformation* inputInformation, const int extent[6]);
 /// Asks the input for its whole extent, as one piece (global algorithms).
 void RequestWholeExtent(vtkInformation* inputInformation);
 
+/// Whether the input can be asked for a sub-extent: the first algorithm upstream that says
+/// it can produce one (our filters, the XML readers, VTK's imaging filters) or, failing
+/// that, the source itself. A reader that does not split (ParaView's MetaImage, NRRD)
+/// cannot: asked for part of the volume as one piece it reads the file on every process
+/// (and VTK 9.2's MetaImage reader crashes on compressed data). Filters in between that
+/// pass extents along (a Calculator, a Programmable Filter) do not decide it.
+bool CanProduceSubExtent(vtkInformation* inputInformation);
+
+/// Asks the input for piece `piece` of `pieces` of its whole extent, without ghost levels:
+/// from a source that does not split, the whole volume on one process and nothing on the
+/// others, which then fetch what they need from it (CoverNeededExtent).
+void RequestPieceOfWhole(vtkInformation* inputInformation, int piece, int pieces);
+
 } // namespace vtkAmbientOcclusionExtents
 
 #endif

@@ -4,6 +4,7 @@
 #include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkAmbientOcclusionArrayInput.h"
+#include "vtkAmbientOcclusionCollectives.h"
 #include "vtkAmbientOcclusionExtents.h"
 
 #include "vao/Validation.h"
@@ -14,6 +15,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMultiProcessController.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
@@ -85,6 +87,14 @@ int vtkIsosurfaceAmbientOcclusion::RequestUpdateExtent(
   if (!this->IsDistributed())
   {
     Extents::RequestWholeExtent(volumeInfo);
+    return 1;
+  }
+  if (!Extents::CanProduceSubExtent(volumeInfo))
+  {
+    // A reader that does not split: read on one process, sent whole to the processes
+    // with surface points (ProduceOutput).
+    Extents::RequestPieceOfWhole(
+      volumeInfo, this->Controller->GetLocalProcessId(), this->Controller->GetNumberOfProcesses());
     return 1;
   }
   int whole[6], piece[6], ext[6];
@@ -251,7 +261,34 @@ int vtkIsosurfaceAmbientOcclusion::ProduceOutput(
   int whole[6];
   inputVector[1]->GetInformationObject(0)->Get(
     vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  const bool distributed = this->IsDistributed();
+  bool distributed = this->IsDistributed();
+  vtkNew<vtkImageData> fetched;
+  vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
+  if (distributed && !Extents::CanProduceSubExtent(inputVector[1]->GetInformationObject(0)))
+  {
+    // The volume's reader does not split: every process with surface points takes the
+    // whole volume from the one that read it, and shades its points as one process does.
+    if (!this->CheckParameters()) // the same answer on every process, before the collective
+    {
+      return 1;
+    }
+    const int none[6] = { 0, -1, 0, -1, 0, -1 };
+    std::string error;
+    volume = vtkAmbientOcclusionCollectives::CoverNeededExtent(
+      this->Controller, volume, surface->GetNumberOfPoints() > 0 ? whole : none, fetched, error);
+    if (!volume)
+    {
+      vtkErrorMacro(<< error);
+      return 1;
+    }
+    if (surface->GetNumberOfPoints() == 0)
+    {
+      output->ShallowCopy(surface);
+      return 1;
+    }
+    chosen = this->GetInputArrayToProcess(0, volume);
+    distributed = false;
+  }
   if (!distributed && !std::equal(whole, whole + 6, volume->GetExtent()))
   {
     // Happens when the surface is extracted from the same source output in pieces (MPI):
@@ -267,7 +304,6 @@ int vtkIsosurfaceAmbientOcclusion::ProduceOutput(
   }
   int piece[6];
   std::copy(whole, whole + 6, piece);
-  vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
   if (distributed ? !this->UpdateDistributedPyramid(volume, chosen, whole, piece)
                   : !this->UpdatePyramid(volume, chosen))
   {

@@ -207,9 +207,13 @@ int vtkOcclusionSweeping::RequestUpdateExtent(
   if (this->IsDistributed(whole))
   {
     int ext[6];
-    SlabInputExtent(
-      whole, this->Controller->GetLocalProcessId(), this->Controller->GetNumberOfProcesses(), ext);
-    vtkAmbientOcclusionExtents::RequestExactExtent(inInfo, ext);
+    const int rank = this->Controller->GetLocalProcessId(),
+              ranks = this->Controller->GetNumberOfProcesses();
+    SlabInputExtent(whole, rank, ranks, ext);
+    if (vtkAmbientOcclusionExtents::CanProduceSubExtent(inInfo))
+      vtkAmbientOcclusionExtents::RequestExactExtent(inInfo, ext);
+    else // RequestDistributedData fetches the slab from the process that read the file
+      vtkAmbientOcclusionExtents::RequestPieceOfWhole(inInfo, rank, ranks);
   }
   else
   {
@@ -401,9 +405,29 @@ int vtkOcclusionSweeping::SweepRounds(Slab& slab, int axis, double tolerance)
 int vtkOcclusionSweeping::RequestDistributedData(vtkImageData* input, vtkImageData* output,
   const int whole[6], const int outExt[6], vtkDataArray* chosen)
 {
+  vtkMultiProcessController* controller = this->Controller;
+  // The slab and its ghost layer, from the processes that hold it where the source did not
+  // deliver it (a reader that does not split reads everything on one process).
+  int expected[6];
+  SlabInputExtent(
+    whole, controller->GetLocalProcessId(), controller->GetNumberOfProcesses(), expected);
+  vtkNew<vtkImageData> fetched, cropped;
+  std::string fetchError;
+  input = vtkAmbientOcclusionCollectives::CoverNeededExtent(
+    controller, input, expected, fetched, fetchError);
+  if (!input)
+  {
+    vtkErrorMacro(<< fetchError); // the same on every process
+    return 1;
+  }
+  if (!std::equal(expected, expected + 6, input->GetExtent()))
+  {
+    vtkAmbientOcclusionExtents::CopyRequestedExtent(input, cropped, expected);
+    input = cropped;
+  }
+  chosen = this->GetInputArrayToProcess(0, input);
   // Every process checks its slab, then all agree: one that stopped alone would leave
   // the others waiting at the first exchange.
-  vtkMultiProcessController* controller = this->Controller;
   Slab slab;
   const std::string error = this->StartSlab(input, chosen, whole, slab);
   if (GlobalMax(controller, error.empty() ? 0.0 : 1.0) > 0.0)
@@ -443,6 +467,7 @@ int vtkOcclusionSweeping::RequestDistributedData(vtkImageData* input, vtkImageDa
   roundsArray->SetName("SweepingExchangeRounds");
   roundsArray->InsertNextValue(rounds);
   held->GetFieldData()->AddArray(roundsArray);
+  // The slabs tile the whole extent: every requested voxel is held.
   vtkAmbientOcclusionCollectives::RedistributeExtents(controller, held, outExt, output);
   this->UpdateProgress(1.0);
   return 1;

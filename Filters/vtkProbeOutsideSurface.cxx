@@ -1,6 +1,7 @@
 #include "vtkProbeOutsideSurface.h"
 
 #include "vtkAmbientOcclusionArrayInput.h"
+#include "vtkAmbientOcclusionCollectives.h"
 #include "vtkAmbientOcclusionExtents.h"
 #include "vtkAmbientOcclusionMemory.h"
 #include "vtkAmbientOcclusionRanges.h"
@@ -9,6 +10,7 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -147,6 +149,16 @@ int vtkProbeOutsideSurface::RequestUpdateExtent(
     Extents::RequestWholeExtent(volumeInfo);
     return 1;
   }
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  if (!Extents::CanProduceSubExtent(volumeInfo) && controller &&
+    controller->GetNumberOfProcesses() > 1)
+  {
+    // A reader that does not split: read on one process, sent whole to the processes with
+    // surface points (RequestData).
+    Extents::RequestPieceOfWhole(
+      volumeInfo, controller->GetLocalProcessId(), controller->GetNumberOfProcesses());
+    return 1;
+  }
   int whole[6], ext[6];
   double spacing[3] = { 1.0, 1.0, 1.0 };
   volumeInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
@@ -238,6 +250,29 @@ int vtkProbeOutsideSurface::RequestData(
   vtkPolyData* surface = vtkPolyData::GetData(inputVector[0], 0);
   vtkImageData* volume = vtkImageData::GetData(inputVector[1], 0);
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
+  vtkNew<vtkImageData> fetched;
+  vtkInformation* volumeInfo = inputVector[1]->GetInformationObject(0);
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  if (surface && volume && controller && controller->GetNumberOfProcesses() > 1 &&
+    outputVector->GetInformationObject(0)->Get(
+      vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()) > 1 &&
+    std::isfinite(this->Distance) && !Extents::CanProduceSubExtent(volumeInfo))
+  {
+    // The volume's reader does not split: every process with surface points takes it
+    // whole from the one that read it (collective, as RequestUpdateExtent asked).
+    int whole[6];
+    const int none[6] = { 0, -1, 0, -1, 0, -1 };
+    volumeInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+    std::string why;
+    volume = vtkAmbientOcclusionCollectives::CoverNeededExtent(
+      controller, volume, surface->GetNumberOfPoints() > 0 ? whole : none, fetched, why);
+    if (!volume)
+    {
+      vtkErrorMacro(<< why);
+      output->Initialize();
+      return 1;
+    }
+  }
   const std::string error = this->InputError(surface, volume);
   if (!error.empty())
   {

@@ -4,6 +4,7 @@
 #include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkAmbientOcclusionArrayInput.h"
+#include "vtkAmbientOcclusionCollectives.h"
 #include "vtkAmbientOcclusionExtents.h"
 #include "vtkAmbientOcclusionFrame.h"
 #include "vtkAmbientOcclusionPyramidImages.h"
@@ -15,6 +16,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMultiBlockDataSet.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -53,12 +55,34 @@ void vtkVarianceOcclusionMap::InputExtentOf(
 }
 
 //------------------------------------------------------------------------------
+namespace
+{
+/// The processes that share a volume read by a reader that does not split (it reads on one
+/// of them); nullptr in one process or from a source that splits.
+vtkMultiProcessController* SharedController(vtkInformation* inputInformation)
+{
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  return controller && controller->GetNumberOfProcesses() > 1 &&
+      !Extents::CanProduceSubExtent(inputInformation)
+    ? controller
+    : nullptr;
+}
+}
+
+//------------------------------------------------------------------------------
 int vtkVarianceOcclusionMap::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   // Each level voxel depends on the input within PyramidReach of it: a piece needs its
   // extent grown by that (aligned on the coarsest level's voxels), not the whole volume.
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  if (vtkMultiProcessController* controller = SharedController(inInfo))
+  {
+    // A reader that does not split: read on one process, fetched by ProduceOutput.
+    Extents::RequestPieceOfWhole(
+      inInfo, controller->GetLocalProcessId(), controller->GetNumberOfProcesses());
+    return 1;
+  }
   int whole[6], piece[6], ext[6];
   inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
   Extents::RequestedPiece(outputVector->GetInformationObject(0), whole, piece);
@@ -119,12 +143,35 @@ int vtkVarianceOcclusionMap::ProduceOutput(
   inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
   Extents::RequestedPiece(outInfo, whole, piece);
   const int levels = std::max(0, this->NumberOfLevels);
+  if (!Extents::EmptyExtent(piece))
+  {
+    this->InputExtentOf(whole, piece, expected);
+  }
+  vtkNew<vtkImageData> fetched;
+  if (vtkMultiProcessController* controller = SharedController(inInfo))
+  {
+    // Collective: every process, also one with an empty piece, takes part.
+    const int none[6] = { 0, -1, 0, -1, 0, -1 };
+    input = vtkAmbientOcclusionCollectives::CoverNeededExtent(
+      controller, input, Extents::EmptyExtent(piece) ? none : expected, fetched, error);
+    if (!input)
+    {
+      vtkErrorMacro(<< error);
+      return 1;
+    }
+    if (!Extents::EmptyExtent(piece) && !std::equal(expected, expected + 6, input->GetExtent()))
+    {
+      vtkNew<vtkImageData> cropped;
+      Extents::CopyRequestedExtent(input, cropped, expected);
+      fetched->ShallowCopy(cropped);
+      input = fetched;
+    }
+  }
   if (Extents::EmptyExtent(piece))
   {
     output->SetNumberOfBlocks(static_cast<unsigned int>(levels)); // an empty piece
     return 1;
   }
-  this->InputExtentOf(whole, piece, expected);
   if (input && !std::equal(expected, expected + 6, input->GetExtent()))
   {
     vtkErrorMacro(<< "The variance occlusion map of this piece needs the input extent "
@@ -137,7 +184,7 @@ int vtkVarianceOcclusionMap::ProduceOutput(
   vtkAmbientOcclusionArrayInput::ScalarVolume scalars;
   if (!input || !Extents::CheckWholeExtent(whole, error) ||
     !vtkAmbientOcclusionArrayInput::PrepareScalars(
-      this, this->GetInputArrayToProcess(0, inputVector), input, this->Component, scalars, error) ||
+      this, this->GetInputArrayToProcess(0, input), input, this->Component, scalars, error) ||
     !vtkAmbientOcclusionPyramidImages::BuildPyramid(scalars, input, this->Parameters(),
       vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads), pyramid, error))
   {

@@ -3,6 +3,7 @@
 #include "vtkAmbientOcclusionMemory.h"
 
 #include "vtkAmbientOcclusionArrayInput.h"
+#include "vtkAmbientOcclusionCollectives.h"
 #include "vtkAmbientOcclusionExtents.h"
 #include "vtkAmbientOcclusionOpacity.h"
 #include "vtkAmbientOcclusionRanges.h"
@@ -198,6 +199,16 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
 {
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  if (!vtkAmbientOcclusionExtents::CanProduceSubExtent(inInfo))
+  {
+    // A reader that does not split: all of it on one process, fetched from there by the
+    // others (NeededInput).
+    const bool shared = this->Controller && this->Controller->GetNumberOfProcesses() > 1;
+    vtkAmbientOcclusionExtents::RequestPieceOfWhole(inInfo,
+      shared ? this->Controller->GetLocalProcessId() : 0,
+      shared ? this->Controller->GetNumberOfProcesses() : 1);
+    return 1;
+  }
   if (this->Method == HISTOGRAM_CDF && !this->HistogramThresholds && !this->IsDistributed())
   {
     // One process: the thresholds need every voxel of the data set.
@@ -269,7 +280,13 @@ int vtkVolumetricAmbientOcclusion::ProduceOutput(
     vtkErrorMacro(<< error);
     return 1; // the whole extent is the same on every process
   }
-  const bool ok = this->ReadInput(input, inputVector, run);
+  vtkNew<vtkImageData> fetched;
+  input = this->NeededInput(input, inputVector, outputVector, run, fetched);
+  if (!input)
+  {
+    return 1; // the same on every process
+  }
+  const bool ok = this->ReadInput(input, run);
   // Collective in a distributed run: every process takes part, also one that failed above
   // (it says so, and every process then stops) or holds an empty piece.
   if (this->Method == HISTOGRAM_CDF && (ok || this->IsDistributed()) &&
@@ -286,8 +303,45 @@ int vtkVolumetricAmbientOcclusion::ProduceOutput(
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumetricAmbientOcclusion::ReadInput(
-  vtkImageData* input, vtkInformationVector** inputVector, Run& run)
+vtkImageData* vtkVolumetricAmbientOcclusion::NeededInput(vtkImageData* input,
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector, const Run& run,
+  vtkImageData* fetched)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  // Ranks that each run their own pipeline (one piece of a splitting source) share
+  // nothing: no collective.
+  if (!input || !this->Controller || this->Controller->GetNumberOfProcesses() < 2 ||
+    (outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()) < 2 &&
+      vtkAmbientOcclusionExtents::CanProduceSubExtent(inInfo)))
+  {
+    return input;
+  }
+  // The pipeline's spacing: an empty piece's image has none of its own.
+  double spacing[3] = { 1.0, 1.0, 1.0 };
+  if (inInfo->Has(vtkDataObject::SPACING()))
+  {
+    inInfo->Get(vtkDataObject::SPACING(), spacing);
+  }
+  int reach[3], needed[6];
+  this->ComputeReach(spacing, reach);
+  std::copy(run.outExt, run.outExt + 6, needed);
+  if (!vtkAmbientOcclusionExtents::EmptyExtent(needed))
+  {
+    vtkAmbientOcclusionExtents::GrowExtent(needed, reach, run.whole);
+  }
+  std::string error;
+  vtkImageData* covered = vtkAmbientOcclusionCollectives::CoverNeededExtent(
+    this->Controller, input, needed, fetched, error);
+  if (!covered)
+  {
+    vtkErrorMacro(<< error);
+  }
+  return covered;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumetricAmbientOcclusion::ReadInput(vtkImageData* input, Run& run)
 {
   // An empty piece of a distributed data set (e.g. MetaImage on rank > 0) has nothing
   // to compute, but still takes part in the thresholds of Histogram CDF.
@@ -298,8 +352,8 @@ bool vtkVolumetricAmbientOcclusion::ReadInput(
     return false;
   }
   std::string error;
-  if (!vtkAmbientOcclusionArrayInput::PrepareScalars(this,
-        this->GetInputArrayToProcess(0, inputVector), input, this->Component, run.scalars, error))
+  if (!vtkAmbientOcclusionArrayInput::PrepareScalars(
+        this, this->GetInputArrayToProcess(0, input), input, this->Component, run.scalars, error))
   {
     vtkErrorMacro(<< error);
     return false;

@@ -277,7 +277,12 @@ private:
   /// Checks this process's input against the request and reads its scalars (scanned for
   /// Histogram CDF's value range): false, with the error, when this process has nothing
   /// to compute (also an empty piece, which still takes part in the thresholds).
-  bool ReadInput(vtkImageData* input, vtkInformationVector** inputVector, Run& run);
+  bool ReadInput(vtkImageData* input, Run& run);
+  /// Under MPI, the input this process needs (its piece grown by the reach) where the
+  /// reader did not deliver it (a reader that does not split): fetched from the processes
+  /// that hold it into `fetched`. Collective; nullptr, with the error, when nobody holds it.
+  vtkImageData* NeededInput(vtkImageData* input, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector, const Run& run, vtkImageData* fetched);
   /// Runs the kernel on the requested extent into new output arrays, on the backend
   /// Compute chooses; false, with the kernel's error, when it fails.
   bool ComputeArrays(vtkImageData* input, Run& run);
