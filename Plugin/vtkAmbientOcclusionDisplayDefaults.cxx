@@ -1,4 +1,5 @@
 #include "vtkAmbientOcclusionDisplayDefaults.h"
+#include "vtkAmbientOcclusionOpacityFitting.h"
 
 #include "vtkDataObject.h"
 #include "vtkObjectFactory.h"
@@ -110,9 +111,14 @@ void vtkAmbientOcclusionDisplayDefaults::Install()
     return;
   }
   installed = true;
-  // Every session's proxy manager forwards its registrations to this one.
-  vtkNew<vtkAmbientOcclusionDisplayDefaults> observer;
-  vtkSMProxyManager::GetProxyManager()->AddObserver(vtkCommand::RegisterEvent, observer);
+  // Every session's proxy manager forwards its registrations and property changes to
+  // this one.
+  vtkSMProxyManager* manager = vtkSMProxyManager::GetProxyManager();
+  vtkNew<vtkAmbientOcclusionDisplayDefaults> display;
+  manager->AddObserver(vtkCommand::RegisterEvent, display);
+  vtkNew<vtkAmbientOcclusionOpacityFitting> fitting;
+  manager->AddObserver(vtkCommand::RegisterEvent, fitting);
+  manager->AddObserver(vtkCommand::PropertyModifiedEvent, fitting);
 }
 
 void vtkAmbientOcclusionDisplayDefaults::Execute(vtkObject*, unsigned long event, void* callData)

@@ -31,7 +31,8 @@ public:
   static vtkAmbientOcclusionDisplayDefaults* New();
   vtkBaseTypeMacro(vtkAmbientOcclusionDisplayDefaults, vtkCommand);
 
-  /// Observe the proxy manager of this process, once, if it has one.
+  /// Observe the proxy manager of this process, once, if it has one (this class and
+  /// vtkAmbientOcclusionOpacityFitting).
   static void Install();
 
   void Execute(vtkObject* caller, unsigned long event, void* callData) override;

@@ -121,9 +121,15 @@ def opacity_function(opacity, name="opacity"):
         return opacity
     if hasattr(opacity, "GetClientSideObject"):
         function = opacity.GetClientSideObject()
-        if isinstance(function, vtkPiecewiseFunction):
-            return function
-        raise TypeError("%s: %r is not an opacity (piecewise) transfer function" % (name, opacity))
+        if not isinstance(function, vtkPiecewiseFunction):
+            raise TypeError("%s: %r is not an opacity (piecewise) transfer function" % (name, opacity))
+        if _untouched(opacity):
+            raise ValueError(
+                "%s: this opacity transfer function was never fitted to any data: ParaView makes it as a step "
+                "from 0 at 0 to 1 at 1, in the array's units, and fits it to the data's range when something is "
+                "coloured by the array. Fit it first, e.g. function.RescaleTransferFunction(volume.min(), "
+                "volume.max()), or pass (value, opacity) points" % name)
+        return function
     try:
         points = numbers(opacity, name)
     except TypeError:
@@ -144,6 +150,16 @@ def opacity_function(opacity, name="opacity"):
         else:
             function.AddPoint(row[0], row[1])
     return function
+
+
+def _untouched(proxy):
+    """Whether a ParaView opacity transfer function is the one ParaView made and never
+    fitted: points (0, 0) and (1, 1), its range never initialised."""
+    try:
+        return (int(proxy.GetPropertyValue("ScalarRangeInitialized")) == 0
+                and [float(v) for v in proxy.GetPropertyValue("Points")] == [0.0, 0.0, 0.5, 0.0, 1.0, 1.0, 0.5, 0.0])
+    except (AttributeError, TypeError, ValueError):
+        return False
 
 
 def three(value, name):
