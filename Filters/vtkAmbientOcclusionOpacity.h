@@ -13,7 +13,8 @@ class vtkPiecewiseFunction;
 namespace vtkAmbientOcclusionOpacity
 {
 
-/// The function's points, clamping and log scale (empty nodes for null).
+/// The function's points, clamping and log scale (empty nodes for null), and which segment
+/// a value on a node belongs to in the VTK this process runs with (VTK 9.2 and 9.3 differ).
 vao::OpacityFunction Nodes(vtkPiecewiseFunction* function);
 
 /// "" when the function is fit to use (vao::checkOpacityFunction), else the sentence for

@@ -204,3 +204,36 @@ TEST(TransferFunction, RefusesBadFunctions)
   for (float value : out)
     ASSERT_EQ(value, -7.0f); // nothing written
 }
+
+TEST(TransferFunction, ValuesOnNodesFollowEitherVtkConvention)
+{
+  // Nodes with equal x inside and at the ends (ParaView's editor allows them), in the
+  // order VTK keeps them; the expected opacities are vtkPiecewiseFunction::GetValue's,
+  // recorded from VTK 9.2 (Debian 12) and VTK 9.3 (Debian 13). Off the nodes they agree; on
+  // a node 9.2 ends the segment that reaches it and 9.3 starts the one that leaves it.
+  vao::OpacityFunction f;
+  f.nodes = { { -10, 0.2, 0.5, 0 }, { 0, 0.3, 0.3, 0.6 }, { 0, 0.9, 0.6, 0.1 }, { 5, 0.5, 0.5, 0 },
+    { 5, 0.1, 0.5, 0 }, { 5, 0.6, 0.2, 0.8 }, { 20, 0.4, 0.5, 0 } };
+  const double x[] = { -10, 0, std::nextafter(0.0, -1.0), std::nextafter(0.0, 1.0), 2, 5,
+    std::nextafter(5.0, 0.0), std::nextafter(5.0, 10.0), 12, 20 };
+  struct Case
+  {
+    bool startSegments, clamping;
+    double expected[10];
+  };
+  const Case cases[] = {
+    { false, false, { 0.0, 0.3, 0.3, 0.9, 0.814952, 0.5, 0.5, 0.6, 0.400601, 0.4 } },
+    { false, true, { 0.2, 0.3, 0.3, 0.9, 0.814952, 0.5, 0.5, 0.6, 0.400601, 0.4 } },
+    { true, false, { 0.2, 0.9, 0.3, 0.9, 0.814952, 0.6, 0.5, 0.6, 0.400601, 0.0 } },
+    { true, true, { 0.2, 0.9, 0.3, 0.9, 0.814952, 0.6, 0.5, 0.6, 0.400601, 0.4 } },
+  };
+  for (const Case& c : cases)
+  {
+    f.nodesStartSegments = c.startSegments;
+    f.clamping = c.clamping;
+    for (int i = 0; i < 10; ++i)
+      EXPECT_NEAR(vao::evaluateOpacity(f, x[i]), c.expected[i], 1e-6)
+        << "x " << x[i] << ", nodes start segments " << c.startSegments << ", clamping "
+        << c.clamping;
+  }
+}

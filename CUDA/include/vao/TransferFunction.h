@@ -1,5 +1,5 @@
 // The opacity transfer function of the Transfer Function method (docs/methods.md section
-// 10): the nodes of a vtkPiecewiseFunction, without VTK, and its evaluation as VTK 9.2's
+// 10): the nodes of a vtkPiecewiseFunction, without VTK, and its evaluation as VTK's
 // vtkPiecewiseFunction::GetValue evaluates it, so that the openness follows the opacity the
 // user sees in ParaView's Color Map Editor.
 #pragma once
@@ -27,11 +27,17 @@ struct OpacityFunction
   std::vector<OpacityNode> nodes;
   bool clamping = true;
   bool logScale = false;
+  /// A value equal to a node's x: false, the end of the segment that reaches it (the first
+  /// node at x; on the first node, outside the nodes), as VTK 9.2 evaluates it; true, the
+  /// start of the segment that leaves it (the last node at x; on the last node, outside),
+  /// as VTK 9.3 and later do. Everywhere else the two agree.
+  bool nodesStartSegments = false;
 };
 
-/// alpha(x) as VTK 9.2's vtkPiecewiseFunction::GetValue(x) gives it: the first node at or
-/// beyond the value and the one before it bound the segment (a value on the first node
-/// counts as before the nodes, one on the last node as the end of the last segment);
+/// alpha(x) as vtkPiecewiseFunction::GetValue(x) gives it: the first node at or beyond the
+/// value and the one before it bound the segment (a value on the first node counts as
+/// before the nodes, one on the last node as the end of the last segment; the other way
+/// round with nodesStartSegments);
 /// within the segment the position is moved by the midpoint, then sharpness below 0.01
 /// interpolates linearly, above 0.99 steps at the midpoint and values between bend a
 /// Hermite curve, clamped to the two nodes' opacities. NaN where the log scale meets a

@@ -1,5 +1,6 @@
-// evaluateOpacity (vao/TransferFunction.h): VTK 9.2's piecewise-function evaluation written
-// without VTK. The tests compare it with vtkPiecewiseFunction::GetValue itself.
+// evaluateOpacity (vao/TransferFunction.h): VTK's piecewise-function evaluation written
+// without VTK, 9.2's or 9.3's convention on the nodes themselves. The tests compare it with
+// vtkPiecewiseFunction::GetValue itself.
 #include "vao/TransferFunction.h"
 
 #include <algorithm>
@@ -77,8 +78,13 @@ double evaluateOpacity(const OpacityFunction& f, double x)
   }
   // The segment is the first node at or beyond x and the one before it: a value on the
   // first node counts as before the nodes (0 without clamping), one on the last as its end.
-  const auto upper = std::lower_bound(nodes.begin(), nodes.end(), x,
-    [](const OpacityNode& node, double value) { return node.x < value; });
+  // Where nodes start segments, the first node beyond x and the one before it: a value on
+  // the first node starts the first segment, one on the last is beyond the nodes.
+  const auto upper = f.nodesStartSegments
+    ? std::upper_bound(nodes.begin(), nodes.end(), x,
+        [](double value, const OpacityNode& node) { return value < node.x; })
+    : std::lower_bound(nodes.begin(), nodes.end(), x,
+        [](const OpacityNode& node, double value) { return node.x < value; });
   if (upper == nodes.end())
   {
     return f.clamping ? nodes.back().y : 0.0;
