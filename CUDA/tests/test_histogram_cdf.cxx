@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
@@ -445,4 +446,37 @@ TEST(HistogramCdf, RowBinsCountTheThresholdsBelowEveryValue)
   for (int k = 0; k < 64; ++k)
     between.push_back(0.1 * k + 1e-12 * (k % 2 ? 1 : -1));
   expectRowBinsCountThresholds(probeValues<float>(between, 7), between);
+}
+
+TEST(HistogramCdf, ReportsProgressEverySliceAndCancels)
+{
+  // A small volume has as few tiles as threads: progress goes by output slice, so that a
+  // caller sees at least one report every 1/nz of the work from its own thread.
+  const vao::Index3 dims = { 30, 28, 40 };
+  auto v = randomVolume<std::int16_t>(dims, -1000, 1000, 61);
+  const auto view = viewOf(v, dims);
+  vao::AmbientOcclusionParameters p;
+  p.method = vao::Method::HistogramCdf;
+  p.radius = { 3, 3, 3 };
+  ASSERT_TRUE(vao::volumeThresholds(view, 64, p.thresholds).ok);
+  std::vector<float> out(view.voxelCount());
+  std::vector<double> progress;
+  vao::Execution execution;
+  execution.threads = 1;
+  execution.progress = [&](double fraction) { progress.push_back(fraction); };
+  ASSERT_TRUE(vao::computeAmbientOcclusion(
+    view, vao::Region::whole(view), p, { out.data(), nullptr }, execution)
+                .ok);
+  ASSERT_GE(progress.size(), static_cast<size_t>(dims[2]));
+  EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
+  double largestStep = progress.front();
+  for (size_t i = 1; i < progress.size(); ++i)
+    largestStep = std::max(largestStep, progress[i] - progress[i - 1]);
+  EXPECT_LE(largestStep, 1.0 / dims[2] + 1e-12);
+  EXPECT_DOUBLE_EQ(progress.back(), 1.0);
+  execution.abortRequested = [] { return true; };
+  const vao::Status status = vao::computeAmbientOcclusion(
+    view, vao::Region::whole(view), p, { out.data(), nullptr }, execution);
+  EXPECT_FALSE(status.ok);
+  EXPECT_TRUE(status.aborted);
 }

@@ -110,8 +110,9 @@ public:
   }
 
   /// Output columns [x0, x0 + nx) x [y0, y0 + ny) (volume coordinates), slices [z0, z1).
+  /// Outputs the tile's slices z0 .. z1 - 1, each one a unit of `progress`.
   void compute(std::int64_t x0, std::int64_t nx, std::int64_t y0, std::int64_t ny, std::int64_t z0,
-    std::int64_t z1)
+    std::int64_t z1, ChunkProgress& progress)
   {
     const Index3& dims = this->Volume.dims;
     const Radius& r = this->Job.radius;
@@ -138,6 +139,8 @@ public:
         this->moveSlice(entering < dims[2] ? entering : -1, leaving);
       }
       this->outputSlice(y0, ny, z);
+      if (!progress.advance())
+        return;
     }
   }
 
@@ -392,8 +395,10 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
   const TilePlan& plan = job.plan;
   const std::int64_t units = plan.units();
   const int threads = resolveThreadCount(execution.threads);
-  return parallelFor(units, static_cast<int>(std::min<std::int64_t>(units, 1 << 20)), threads,
-    execution,
+  // Progress by output slice: a small volume has as few units as threads.
+  const std::int64_t slices = units / plan.zParts * region.size[2];
+  return parallelFor(
+    units, static_cast<int>(std::min<std::int64_t>(units, 1 << 20)), threads, execution,
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
     {
       TileHistograms<T, L, W, Fixed> state(volume, job, bin);
@@ -406,10 +411,10 @@ bool computeTiles(const TypedVolume<T>& volume, const HistogramJob& job, const E
         const std::int64_t z0 = region.begin[2] + region.size[2] * part / plan.zParts;
         const std::int64_t z1 = region.begin[2] + region.size[2] * (part + 1) / plan.zParts;
         state.compute(x0, std::min(plan.sideX, region.begin[0] + region.size[0] - x0), y0,
-          std::min(plan.sideY, region.begin[1] + region.size[1] - y0), z0, z1);
-        progress.advance();
+          std::min(plan.sideY, region.begin[1] + region.size[1] - y0), z0, z1, progress);
       }
-    });
+    },
+    slices);
 }
 
 } // namespace
