@@ -54,7 +54,8 @@ body.UpdatePipeline()
 volumetric = {}
 for method in ["Gaussian CDF", "Histogram CDF", "CDF Reconstruction"]:
     volumetric[method] = measure("Volumetric AO, " + method,
-                                 lambda: VolumetricAmbientOcclusion(Input=body, Method=method, Radius=10))
+                                 lambda: VolumetricAmbientOcclusion(Input=body, Method=method, Radius=10,
+                                                                    QueryMode="Voxel Value"))
 try:
     from vtkmodules.util.numpy_support import vtk_to_numpy
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -72,7 +73,7 @@ try:
     for repeat in range(5):
         once = seconds(lambda: statistics(volume, 10))
         for m in volumetric:
-            proxy = VolumetricAmbientOcclusion(Input=body, Method=m, Radius=10)
+            proxy = VolumetricAmbientOcclusion(Input=body, Method=m, Radius=10, QueryMode="Voxel Value")
             rounds[m].append(once / seconds(proxy.UpdatePipeline))
             Delete(proxy)
     print("  round by round (5 rounds, scipy then each method): %s"

@@ -39,7 +39,7 @@ ratios = []
 for repeat in range(ROUNDS):
     for method in times:
         extra = {"OpacityFunction": opacity} if method == "Transfer Function" else {}
-        proxy = VolumetricAmbientOcclusion(Input=body, Method=method, Radius=10, **extra)
+        proxy = VolumetricAmbientOcclusion(Input=body, Method=method, Radius=10, QueryMode="Voxel Value", **extra)
         times[method].append(seconds(proxy.UpdatePipeline))
         Delete(proxy)
     ratios.append(times["Transfer Function"][-1] / times["Gaussian CDF"][-1])

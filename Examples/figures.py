@@ -192,7 +192,7 @@ def accuracy(source, array, tag, spacing):
     panels = []
     for i, method in enumerate(["Exact Box", "Gaussian CDF", "Histogram CDF"]):
         t0 = time.time()
-        ao = VolumetricAmbientOcclusion(Input=source, Method=method, Radius=10)
+        ao = VolumetricAmbientOcclusion(Input=source, Method=method, Radius=10, QueryMode="Voxel Value")
         ao.Scalars = ["POINTS", array]
         shaded = AmbientOcclusionShading(Input=ao, **SHADING_ARGS)
         shaded.Scalars = ["POINTS", array]
@@ -217,7 +217,7 @@ def transfer_function(source, array, tag, spacing):
     panels = []
     for i, method in enumerate(["Histogram CDF", "Transfer Function"]):
         t0 = time.time()
-        ao = VolumetricAmbientOcclusion(Input=source, Method=method, Radius=10)
+        ao = VolumetricAmbientOcclusion(Input=source, Method=method, Radius=10, QueryMode="Voxel Value")
         ao.Scalars = ["POINTS", array]
         if method == "Transfer Function":
             ao.OpacityFunction = tissue
@@ -242,7 +242,7 @@ def ruiz(source, array, tag, spacing):
     for i, (text, method) in enumerate(methods):
         t0 = time.time()
         ao = VolumetricAmbientOcclusion(Input=source, Method=method or "Gaussian CDF", Radius=10,
-                                        ComputeVariance=1)
+                                        QueryMode="Voxel Value", ComputeVariance=1)
         ao.Scalars = ["POINTS", array]
         if method is None:
             ones = Calculator(Input=ao, ResultArrayName="Open", Function="1", ResultArrayType="Float")

@@ -31,7 +31,7 @@ current = extent_logger(reader, target + ".local")
 stages = [("Gaussian CDF", 10, "GaussianCDF"), ("CDF Reconstruction", 5, "CDFReconstruction"),
           ("Chebyshev", 7, "Chebyshev"), ("Exact Box", 2, "ExactBox")]
 for method, radius, name in stages:
-    current = VolumetricAmbientOcclusion(Input=current, Method=method, Radius=radius,
+    current = VolumetricAmbientOcclusion(Input=current, Method=method, Radius=radius, QueryMode="Voxel Value",
                                          OutputArrayName=name, ComputeVariance=(name == "GaussianCDF"))
     current.Scalars = ["POINTS", "MetaImage"]
 # Occlusion sweeping is global: each rank sweeps a slab (plus one ghost layer) and the
@@ -46,7 +46,7 @@ SaveData(target, proxy=current, **XML_OPTIONS)
 # A local filter asked directly for the writer's pieces (ParaView's decomposition of the
 # output, with ghost levels grown by the radius): each rank needs its piece + 10 voxels.
 direct = VolumetricAmbientOcclusion(Input=extent_logger(reader, target + ".piece"), Method="Gaussian CDF", Radius=10,
-                                    OutputArrayName="Direct")
+                                    QueryMode="Voxel Value", OutputArrayName="Direct")
 direct.Scalars = ["POINTS", "MetaImage"]
 SaveData(target[:-len(".pvti")] + "_direct.pvti", proxy=direct, **XML_OPTIONS)
 
@@ -54,7 +54,7 @@ SaveData(target[:-len(".pvti")] + "_direct.pvti", proxy=direct, **XML_OPTIONS)
 # histograms of their pieces, so each still needs only its piece grown by the radii
 # (5 + the smoothed query's window of 6 = 11 voxels).
 histogram = VolumetricAmbientOcclusion(Input=extent_logger(reader, target + ".histogram"), Method="Histogram CDF",
-                                       Radius=5, OutputArrayName="Histogram")
+                                       Radius=5, QueryMode="Voxel Value", OutputArrayName="Histogram")
 histogram.Scalars = ["POINTS", "MetaImage"]
 smoothed = VolumetricAmbientOcclusion(Input=histogram, Method="Histogram CDF", Radius=3, NumberOfBins=40,
                                       QueryMode="Smoothed Voxel Value", QuerySmoothing=2.0,
