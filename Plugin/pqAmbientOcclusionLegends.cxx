@@ -56,6 +56,9 @@ void pqAmbientOcclusionLegends::hideUnmappedLegends()
     {
       continue;
     }
-    vtkSMPVRepresentationProxy::SetScalarBarVisibility(proxy, view->getProxy(), false);
+    if (auto* coloured = vtkSMPVRepresentationProxy::SafeDownCast(proxy))
+    {
+      coloured->SetScalarBarVisibility(view->getProxy(), false);
+    }
   }
 }

@@ -174,9 +174,10 @@ void vtkAmbientOcclusionDisplayDefaults::Apply(vtkSMProxy* representation)
     return;
   }
   const std::string array = ArrayToColour(*display, producer, input.GetOutputPort());
-  if (array.empty() ||
-    !vtkSMPVRepresentationProxy::SetScalarColoring(
-      representation, array.c_str(), vtkDataObject::POINT))
+  // The member functions: ParaView 5.13 has no static SetScalarColoring.
+  auto* coloured = vtkSMPVRepresentationProxy::SafeDownCast(representation);
+  if (array.empty() || !coloured ||
+    !coloured->SetScalarColoring(array.c_str(), vtkDataObject::POINT))
   {
     return;
   }
