@@ -19,6 +19,9 @@ try:
         if xml_name not in by_xml:
             raise RuntimeError('the GUI did not create %s' % xml_name)
     vao = by_xml['VolumetricAmbientOcclusion']
+    # Applied with its defaults on the shipped CT head, opened before it.
+    if vao.Input.GetXMLName() != 'MetaImageReader':
+        raise RuntimeError('Volumetric AO was applied on %s, not on the CT head' % vao.Input.GetXMLName())
     # The filter ran when Apply was pressed: its output carries the openness array.
     info = vao.PointData['AmbientOcclusion']
     lo, hi = info.GetRange()
@@ -74,6 +77,22 @@ try:
     SaveScreenshot(png, view, ImageResolution=[800, 600])
     if not os.path.isfile(png) or os.path.getsize(png) == 0:
         raise RuntimeError('no screenshot written to %s' % png)
+    # What the view shows: the grey slice of the AO fills the middle of the view, with
+    # many grey levels (an Outline or a one-colour slice would have a handful).
+    from vtkmodules.vtkIOImage import vtkPNGReader
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    reader = vtkPNGReader()
+    reader.SetFileName(png)
+    reader.Update()
+    w, h, _ = reader.GetOutput().GetDimensions()
+    rgb = vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars()).reshape(h, w, -1)[:, :, :3]
+    middle = rgb[h // 3:2 * h // 3, w // 3:2 * w // 3].astype(int)
+    grey = (middle[:, :, 0] == middle[:, :, 1]) & (middle[:, :, 1] == middle[:, :, 2])
+    levels = len(set(middle[grey][:, 0].tolist()))
+    lines.append('the middle of the view: %.0f%% grey pixels, %d grey levels' % (100.0 * grey.mean(), levels))
+    if grey.mean() < 0.9 or levels < 32:
+        raise RuntimeError('the view does not show a grey AO slice (%.0f%% grey, %d levels)'
+                           % (100.0 * grey.mean(), levels))
     lines.append('screenshot %s' % png)
     lines.append('VAO_GUI_OK')
 except Exception:
