@@ -1,6 +1,7 @@
 #include "vtkAmbientOcclusionDisplayDefaults.h"
 #include "vtkAmbientOcclusionOpacityFitting.h"
 
+#include "vtkAmbientOcclusionFilterTable.h"
 #include "vtkDataObject.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVDataInformation.h"
@@ -39,20 +40,9 @@ const Display Displays[] = {
   { "AmbientOcclusionShading", nullptr, { "ShadedRGBA", "ShadedRGB" }, true },
 };
 
-const Display* DisplayOf(vtkSMProxy* producer)
+const Display* DisplayOf(vtkSMProxy* proxy)
 {
-  if (!producer || !producer->GetXMLGroup() || std::strcmp(producer->GetXMLGroup(), "filters") != 0)
-  {
-    return nullptr;
-  }
-  for (const Display& display : Displays)
-  {
-    if (std::strcmp(producer->GetXMLName(), display.Filter) == 0)
-    {
-      return &display;
-    }
-  }
-  return nullptr;
+  return vtkAmbientOcclusionFilterEntry(Displays, proxy);
 }
 
 /// The array of `display` that the producer's output has, or "".

@@ -1,5 +1,6 @@
 #include "vtkAmbientOcclusionOpacityFitting.h"
 
+#include "vtkAmbientOcclusionFilterTable.h"
 #include "vtkDataObject.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkObjectFactory.h"
@@ -34,18 +35,7 @@ const Reader Readers[] = {
 
 const Reader* ReaderOf(vtkSMProxy* proxy)
 {
-  if (!proxy || !proxy->GetXMLGroup() || std::strcmp(proxy->GetXMLGroup(), "filters") != 0)
-  {
-    return nullptr;
-  }
-  for (const Reader& reader : Readers)
-  {
-    if (std::strcmp(proxy->GetXMLName(), reader.Filter) == 0)
-    {
-      return &reader;
-    }
-  }
-  return nullptr;
+  return vtkAmbientOcclusionFilterEntry(Readers, proxy);
 }
 
 /// ParaView's new opacity function: (0, 0) to (1, 1), never fitted to any data.
