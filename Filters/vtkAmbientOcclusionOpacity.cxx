@@ -4,26 +4,52 @@
 
 #include "vtkNew.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkVersionMacros.h"
 
 namespace vtkAmbientOcclusionOpacity
 {
 namespace
 {
 
-bool NodesStartSegments()
+/// How the VTK this process runs with evaluates a function where its versions differ,
+/// asked of VTK itself once (vao::OpacityFunction says what each flag means).
+struct Evaluation
 {
-  // VTK 9.3 changed which segment a value on a node belongs to; this process follows the
-  // VTK it runs with. Off the nodes the versions agree; on the first node without clamping
-  // 9.2 gives 0 (outside) and 9.3 the node's opacity.
-  static const bool starts = []
+  bool nodesStartSegments = false;
+  bool sharpSegmentsStep = true;
+};
+
+const Evaluation& VtkEvaluation()
+{
+  static const Evaluation evaluation = []
   {
-    vtkNew<vtkPiecewiseFunction> probe;
-    probe->ClampingOff();
-    probe->AddPoint(0.0, 0.25);
-    probe->AddPoint(1.0, 0.75);
-    return probe->GetValue(0.0) != 0.0;
+    Evaluation e;
+    // On the first node without clamping VTK 9.2 gives 0 (outside), 9.3 the node's opacity.
+    vtkNew<vtkPiecewiseFunction> nodes;
+    nodes->ClampingOff();
+    nodes->AddPoint(0.0, 0.25);
+    nodes->AddPoint(1.0, 0.75);
+    e.nodesStartSegments = nodes->GetValue(0.0) != 0.0;
+    // Sharpness 1 below the midpoint: VTK 9.2 steps (0), 9.3 follows the Hermite curve.
+    vtkNew<vtkPiecewiseFunction> sharp;
+    sharp->AddPoint(0.0, 0.0, 0.5, 1.0);
+    sharp->AddPoint(1.0, 1.0);
+    e.sharpSegmentsStep = sharp->GetValue(0.49) == 0.0;
+    return e;
   }();
-  return starts;
+  return evaluation;
+}
+
+/// Whether VTK searches this function's nodes by interpolation (9.3 and later, for nearly
+/// evenly spaced nodes) rather than by bisection.
+bool InterpolationSearch(vtkPiecewiseFunction* function)
+{
+#if VTK_MAJOR_VERSION > 9 || (VTK_MAJOR_VERSION == 9 && VTK_MINOR_VERSION >= 3)
+  return function->GetAutomaticSearchMethod() == vtkPiecewiseFunction::INTERPOLATION_SEARCH;
+#else
+  (void)function;
+  return false;
+#endif
 }
 
 } // namespace
@@ -31,11 +57,13 @@ bool NodesStartSegments()
 vao::OpacityFunction Nodes(vtkPiecewiseFunction* function)
 {
   vao::OpacityFunction nodes;
-  nodes.nodesStartSegments = NodesStartSegments();
+  nodes.nodesStartSegments = VtkEvaluation().nodesStartSegments;
+  nodes.sharpSegmentsStep = VtkEvaluation().sharpSegmentsStep;
   if (!function)
   {
     return nodes;
   }
+  nodes.interpolationSearch = InterpolationSearch(function);
   nodes.clamping = function->GetClamping() != 0;
   nodes.logScale = function->GetUseLogScale();
   for (int i = 0; i < function->GetSize(); ++i)

@@ -237,3 +237,40 @@ TEST(TransferFunction, ValuesOnNodesFollowEitherVtkConvention)
         << c.clamping;
   }
 }
+
+TEST(TransferFunction, SharpSegmentsStepOrCurveAsEitherVtk)
+{
+  // Sharpness 1 from 0 to 10 (midpoint 0.5), then linear to 20: VTK 9.2 steps at the
+  // midpoint, VTK 9.3 follows the Hermite curve (GetValue's values from both).
+  vao::OpacityFunction f;
+  f.nodes = { { 0, 0.0, 0.5, 1.0 }, { 10, 1.0, 0.5, 0.0 }, { 20, 0.0, 0.5, 0.0 } };
+  const double x[] = { 1, 3, 4.9, 5, 5.1, 7, 9 };
+  const double step[] = { 0, 0, 0, 1, 1, 1, 1 };
+  const double curve[] = { 0.0, 1e-05, 0.352527, 0.5, 0.647473, 0.99999, 1.0 };
+  for (int i = 0; i < 7; ++i)
+  {
+    f.sharpSegmentsStep = true;
+    EXPECT_NEAR(vao::evaluateOpacity(f, x[i]), step[i], 1e-6) << x[i];
+    f.sharpSegmentsStep = false;
+    EXPECT_NEAR(vao::evaluateOpacity(f, x[i]), curve[i], 1e-6) << x[i];
+  }
+}
+
+TEST(TransferFunction, InterpolationSearchFindsEvenNodesSegments)
+{
+  // On evenly spaced nodes VTK 9.3's interpolation search finds the bisection's segment
+  // for any value between nodes (its quirks are on the nodes themselves).
+  vao::OpacityFunction f;
+  for (int i = 0; i <= 300; ++i)
+    f.nodes.push_back({ 0.25 * i, std::fmod(0.37 * i, 1.0), 0.5, 0.0 });
+  for (double x = -1.0; x < 76.0; x += 0.0123)
+  {
+    const bool onNode = std::fmod(x, 0.25) == 0.0;
+    if (onNode)
+      continue;
+    f.interpolationSearch = false;
+    const double bisection = vao::evaluateOpacity(f, x);
+    f.interpolationSearch = true;
+    EXPECT_DOUBLE_EQ(vao::evaluateOpacity(f, x), bisection) << x;
+  }
+}

@@ -3,6 +3,7 @@
 // function against Exact Box, re-execution when the function is edited, bad functions.
 #include "TestHelpers.h"
 #include "VolumetricTestSupport.h"
+#include "vtkAmbientOcclusionOpacity.h"
 
 #include "vtkVolumetricAmbientOcclusion.h"
 
@@ -36,19 +37,11 @@ using namespace vaotest;
 namespace
 {
 
-/// The library's description of a VTK function: its nodes, clamping and log scale.
+/// The module's description of a VTK function (nodes, clamping, log scale and how the VTK
+/// in use evaluates them), which the kernel evaluates.
 vao::OpacityFunction Nodes(vtkPiecewiseFunction* f)
 {
-  vao::OpacityFunction nodes;
-  nodes.clamping = f->GetClamping() != 0;
-  nodes.logScale = f->GetUseLogScale();
-  for (int i = 0; i < f->GetSize(); ++i)
-  {
-    double v[4];
-    f->GetNodeValue(i, v);
-    nodes.nodes.push_back({ v[0], v[1], v[2], v[3] });
-  }
-  return nodes;
+  return vtkAmbientOcclusionOpacity::Nodes(f);
 }
 
 /// A random function on [lo, hi]: 1 to 6 points, opacities anywhere in [0, 1] (not
@@ -182,6 +175,39 @@ TEST(TransferFunctionAO, OpacityIsVtkPiecewiseFunctionGetValue)
     }
   }
   EXPECT_LE(worst, 1e-12);
+}
+
+TEST(TransferFunctionAO, ManyEvenNodesAreEvaluatedAsVtkSearchesThem)
+{
+  // VTK 9.3 searches 10^4 or more evenly spaced nodes by interpolation, not bisection: a
+  // function sampled from a table (a measured opacity curve) has them.
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (bool clamping : { true, false })
+  {
+    vtkNew<vtkPiecewiseFunction> f;
+    f->SetClamping(clamping);
+    const int count = 12000;
+    std::vector<double> table(count);
+    for (double& y : table)
+      y = unit(rng);
+    f->BuildFunctionFromTable(-50.0, 70.0, count, table.data());
+    const vao::OpacityFunction nodes = Nodes(f);
+    double worst = 0.0;
+    for (int s = 0; s < 2000; ++s)
+    {
+      const double x = -55.0 + 130.0 * unit(rng);
+      worst = std::max(worst, std::abs(vao::evaluateOpacity(nodes, x) - f->GetValue(x)));
+    }
+    for (int i = 0; i < count; i += 97)
+    {
+      double node[4];
+      f->GetNodeValue(i, node);
+      worst =
+        std::max(worst, std::abs(vao::evaluateOpacity(nodes, node[0]) - f->GetValue(node[0])));
+    }
+    EXPECT_LE(worst, 1e-12) << "clamping " << clamping;
+  }
 }
 
 TEST(TransferFunctionAO, MatchesBruteForceOnEveryScalarType)

@@ -8,7 +8,7 @@ each in a fresh folder that holds `Data/` and `build/` as the repository root do
 - the C++ project (the blocks whose first line names a file under app/) with the sh block
   that builds and runs it, against the build tree and against an install.
 
-Usage: pvpython test_readme.py ROOT BUILD_DIR PLUGIN PVPYTHON PVBATCH MPIEXEC SITE_PACKAGES OUT_DIR"""
+Usage: pvpython test_readme.py ROOT BUILD_DIR PVPYTHON PVBATCH MPIEXEC SITE_PACKAGES OUT_DIR"""
 import os
 import re
 import shutil
@@ -18,26 +18,20 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from vao_test_utils import check, finish  # noqa: E402
 
-root, build, plugin, pvpython, pvbatch, mpiexec, site_packages, out_dir = sys.argv[1:9]
+root, build, pvpython, pvbatch, mpiexec, site_packages, out_dir = sys.argv[1:8]
 readme = open(os.path.join(root, "README.md")).read()
 blocks = re.findall(r"```(\w+)\n(.*?)```", readme, re.S)
-# The README names the plugin where Debian 12's ParaView puts it.
-README_PLUGIN = "build/lib/paraview-5.11/plugins/VolumetricAO/VolumetricAO.so"
 # Children get a clean MPI environment: a singleton's variables would confuse mpiexec.
 ENV = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "OPAL_"))}
 
 
 def folder(name, build_tree):
-    """A fresh folder laid out like the repository root: Data/, and build/ (or the README's
-    plugin path in it, for the pvpython block)."""
+    """A fresh folder laid out like the repository root: Data/, and build/ when given."""
     path = os.path.join(out_dir, "readme", name)
     shutil.rmtree(path, ignore_errors=True)
     os.makedirs(path)
     os.symlink(os.path.join(root, "Data"), os.path.join(path, "Data"))
-    if build_tree == "plugin":
-        os.makedirs(os.path.join(path, os.path.dirname(README_PLUGIN)))
-        os.symlink(plugin, os.path.join(path, README_PLUGIN))
-    elif build_tree:
+    if build_tree:
         os.symlink(build_tree, os.path.join(path, "build"))
     return path
 
@@ -73,7 +67,7 @@ scripts = [body for lang, body in blocks if lang == "python" and "paraview.simpl
 check(len(scripts) == 1, "README.md has one pvpython block", stop=True)
 runs = {}
 for ranks in (1, 2):
-    cwd = folder("pvpython_np%d" % ranks, "plugin")
+    cwd = folder("pvpython_np%d" % ranks, build)
     with open(os.path.join(cwd, "script.py"), "w") as f:
         f.write(scripts[0])
     command = [pvpython, "script.py"] if ranks == 1 else \

@@ -27,11 +27,19 @@ struct OpacityFunction
   std::vector<OpacityNode> nodes;
   bool clamping = true;
   bool logScale = false;
+  // How the VTK in use evaluates the function, where its versions differ (the defaults
+  // are VTK 9.2's; vtkAmbientOcclusionOpacity asks the VTK the filters run with).
   /// A value equal to a node's x: false, the end of the segment that reaches it (the first
   /// node at x; on the first node, outside the nodes), as VTK 9.2 evaluates it; true, the
   /// start of the segment that leaves it (the last node at x; on the last node, outside),
-  /// as VTK 9.3 and later do. Everywhere else the two agree.
+  /// as VTK 9.3 and later do.
   bool nodesStartSegments = false;
+  /// Sharpness above 0.99: true, a step at the midpoint (VTK 9.2); false, the Hermite curve
+  /// as for any other sharpness (VTK 9.3 and later).
+  bool sharpSegmentsStep = true;
+  /// The segment found by VTK 9.3's interpolation search, its quirks included, which VTK
+  /// uses for (about ten thousand or more) nearly evenly spaced nodes; else by bisection.
+  bool interpolationSearch = false;
 };
 
 /// alpha(x) as vtkPiecewiseFunction::GetValue(x) gives it: the first node at or beyond the
