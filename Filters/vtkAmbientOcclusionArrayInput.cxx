@@ -379,11 +379,12 @@ bool ReadSurfacePoints(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Fra
     surface, out.points, frame, volume, origin, spacing, out.normals, out.replacedNormals, error);
 }
 
-vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads)
+vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads, double from, double to)
 {
   vao::Execution execution;
   execution.threads = threads;
-  execution.progress = [algorithm](double p) { algorithm->UpdateProgress(p); };
+  execution.progress = [algorithm, from, to](double p)
+  { algorithm->UpdateProgress(from + (to - from) * p); };
   execution.abortRequested = [algorithm] { return algorithm->GetAbortExecute() != 0; };
   return execution;
 }

@@ -94,8 +94,10 @@ bool ReadSurfacePoints(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Fra
   const std::array<double, 3>& spacing, bool needed, SurfacePoints& out, std::string& error);
 
 /// The kernels' execution hooks for an algorithm: its progress, its abort flag, and
-/// `threads` (the filter's NumberOfThreads; 0: the kernels' default).
-vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads);
+/// `threads` (the filter's NumberOfThreads; 0: the kernels' default). The kernels' progress
+/// p is reported as from + (to - from) p, for a filter that runs them in stages.
+vao::Execution ExecutionOf(
+  vtkAlgorithm* algorithm, int threads, double from = 0.0, double to = 1.0);
 
 /// The error for a point array without one tuple for each of the data set's `points`
 /// (VTK does not keep the two equal: a script or a reader can attach any array, and a

@@ -41,6 +41,10 @@ using vtkAmbientOcclusionArrayInput::SurfacePoints;
 
 namespace
 {
+/// The part of the progress bar the pyramid's build takes; the surface's queries take
+/// the rest (a skipped build, from the cache, jumps over it).
+constexpr double kPyramidShare = 0.5;
+
 /// What a surface's AmbientOcclusion depends on besides the pyramid (its build count): the
 /// point and normal arrays (by identity and MTime, as for the volume), the point count and
 /// the query.
@@ -289,7 +293,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
   if (!Extents::CheckWholeExtent(volume->GetExtent(), error) ||
     !PrepareScalars(this, chosen, volume, this->Component, cache.scalars, error) ||
     !PyramidImages::BuildPyramid(cache.scalars, volume, this->PyramidRequest(),
-      ExecutionOf(this, this->NumberOfThreads), cache.surface, error))
+      ExecutionOf(this, this->NumberOfThreads, 0.0, kPyramidShare), cache.surface, error))
   {
     cache.surface.clear();
     if (!error.empty())
@@ -333,7 +337,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
     PrepareScalars(this, chosen, volume, this->Component, cache.scalars, error))
   {
     PyramidImages::BuildPyramid(cache.scalars, volume, this->PyramidRequest(),
-      ExecutionOf(this, this->NumberOfThreads), cache.levels, error);
+      ExecutionOf(this, this->NumberOfThreads, 0.0, kPyramidShare), cache.levels, error);
   }
   // Every process learns whether any failed before the coarsest level is shared.
   const bool failed = !error.empty() || (!empty && cache.levels.empty());
@@ -419,7 +423,7 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
 {
   Cache& cache = *this->Pyramid;
   const Sampling sampling{ cache.scalars.view, cache.origin, cache.spacing, this->Parameters(),
-    ExecutionOf(this, this->NumberOfThreads) };
+    ExecutionOf(this, this->NumberOfThreads, kPyramidShare, 1.0) };
   const SurfaceKey key(surface, sampling.parameters, this->PyramidBuilds);
   const bool newOcclusion = !cache.occlusion || !(cache.occlusionKey == key);
   const vtkAmbientOcclusionFrame::Frame& frame = cache.surfaceFrame; // PlaceSurface's

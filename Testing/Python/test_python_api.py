@@ -251,15 +251,39 @@ colours, info = volumetricao.shade(ran_before.GetOutput(), return_info=True)
 check(info == volumetricao.RunInfo("CPU", "CPU", None) and colours.shape == smooth.shape + (4,),
       "shade of a Volumetric AO output reports its own run, not the upstream filter's (%s)" % (info,))
 
-# Progress: a callable sees the fraction rise to 1; progress=True draws a bar on stderr.
-for name, call in (("ambient_occlusion", lambda p: volumetricao.ambient_occlusion(smooth, radius=3, progress=p)),
-                   ("occlusion_sweeping", lambda p: volumetricao.occlusion_sweeping(smooth, 0.0, progress=p)),
-                   ("variance_occlusion_map", lambda p: volumetricao.variance_occlusion_map(smooth, progress=p)),
-                   ("shade", lambda p: volumetricao.shade(smooth, np.ones_like(smooth), progress=p))):
-    seen = []
-    call(seen.append)
-    check(len(seen) >= 3 and seen == sorted(seen) and seen[-1] == 1.0,
-          "%s: progress callable called %d times, rising to 1" % (name, len(seen)))
+# Progress: a callable sees the fraction rise to 1, in steps of at most 5% on one thread
+# (there the steps depend on the work alone; across threads, on these runs of milliseconds,
+# on how the threads were scheduled: Benchmarks/progress_steps.py measures long runs);
+# progress=True draws a bar on stderr.
+steps = np.random.default_rng(5).normal(size=(48, 64, 80)).astype(np.float32)
+surface_points = np.stack(np.meshgrid(np.arange(24.0), np.linspace(8, 56, 40), np.arange(10.0, 70.0),
+                                      indexing="ij"), -1).reshape(-1, 3)
+surface_normals = np.tile([1.0, 0.0, 0.0], (len(surface_points), 1))
+for threads in (1, 0):
+    for name, call in (
+            ("ambient_occlusion", lambda p: volumetricao.ambient_occlusion(steps, radius=3, threads=threads,
+                                                                           progress=p)),
+            ("ambient_occlusion Gaussian CDF", lambda p: volumetricao.ambient_occlusion(
+                steps, radius=3, method="gaussian cdf", threads=threads, progress=p)),
+            ("ambient_occlusion smoothed", lambda p: volumetricao.ambient_occlusion(
+                steps, radius=3, query_smoothing=1.5, threads=threads, progress=p)),
+            ("ambient_occlusion Transfer Function", lambda p: volumetricao.ambient_occlusion(
+                steps, radius=3, method="transfer function", opacity=[(0, 0), (1, 1)], threads=threads,
+                progress=p)),
+            ("occlusion_sweeping", lambda p: volumetricao.occlusion_sweeping(steps, 0.0, threads=threads,
+                                                                             progress=p)),
+            ("variance_occlusion_map", lambda p: volumetricao.variance_occlusion_map(steps, threads=threads,
+                                                                                     progress=p)),
+            ("isosurface_ambient_occlusion", lambda p: volumetricao.isosurface_ambient_occlusion(
+                steps, surface_points, surface_normals, iso_value=0.0, threads=threads, progress=p)),
+            ("shade", lambda p: volumetricao.shade(steps, np.ones_like(steps), threads=threads, progress=p))):
+        seen = []
+        call(seen.append)
+        rises = [0.0] + seen
+        gap = max(b - a for a, b in zip(rises, rises[1:]))
+        check(len(seen) >= 3 and seen == sorted(seen) and seen[-1] == 1.0 and (gap <= 0.05 or not threads),
+              "%s, threads=%d: progress called %d times, rising to 1, largest step %.3f"
+              % (name, threads, len(seen), gap))
 bar = "import numpy as np, volumetricao\nvolumetricao.ambient_occlusion(np.ones((9, 9, 9)), radius=2, progress=True)\n"
 rc, out, err = run_python("import sys; sys.modules['tqdm'] = None\n" + bar)
 check(rc == 0 and "ambient_occlusion [####################] 100%" in err and "\x1b[" not in err,

@@ -1,6 +1,7 @@
 #include "cpu/common/Parallel.h"
 
 #include <algorithm>
+#include <chrono>
 #include <condition_variable>
 #include <cstdlib>
 #include <exception>
@@ -99,8 +100,9 @@ public:
   }
 
   /// task(member, team) for every member of a team of up to `wanted` threads, the caller
-  /// being member 0; a busy pool gives a team of one.
-  void run(int wanted, const Task& task)
+  /// being member 0; a busy pool gives a team of one. Once its own part is done, the
+  /// caller calls `waiting` every few milliseconds until the other members finish.
+  void run(int wanted, const Task& task, const std::function<void()>& waiting)
   {
     bool idle = false;
     // A forked child (Python's multiprocessing, say) has none of its parent's workers.
@@ -136,7 +138,21 @@ public:
       failure = std::current_exception();
     }
     std::unique_lock<std::mutex> lock(this->Mutex);
-    this->Finished.wait(lock, [this] { return this->Pending == 0; });
+    while (!this->Finished.wait_for(
+      lock, std::chrono::milliseconds(5), [this] { return this->Pending == 0; }))
+    {
+      lock.unlock();
+      try
+      {
+        waiting();
+      }
+      catch (...)
+      {
+        // The members still use `task`: the caller waits for them before it rethrows.
+        failure = failure ? failure : std::current_exception();
+      }
+      lock.lock();
+    }
     this->Job = nullptr;
     if (!failure)
     {
@@ -264,6 +280,20 @@ Execution stageExecution(const Execution& execution, double from, double to)
   return stage;
 }
 
+Execution pyramidStageExecution(const Execution& execution, int first, int last, int levels)
+{
+  double before = 0.0, within = 0.0, total = 0.0, weight = 1.0;
+  for (int l = 0; l < levels; ++l, weight /= 8.0)
+  {
+    total += weight;
+    if (l < first)
+      before += weight;
+    else if (l <= last)
+      within += weight;
+  }
+  return stageExecution(execution, before / total, (before + within) / total);
+}
+
 LoopControl::LoopControl(const Execution& execution, std::int64_t totalWork)
   : Exec(execution)
   , Total(std::max<std::int64_t>(totalWork, 1))
@@ -297,7 +327,8 @@ bool parallelFor(std::int64_t n, int chunks, int threads, const Execution& execu
   }
   chunks = static_cast<int>(std::max<std::int64_t>(1, std::min<std::int64_t>(chunks, n)));
   const int wanted = std::max(1, std::min(resolveThreadCount(threads), chunks));
-  WorkerPool::shared().run(wanted,
+  WorkerPool::shared().run(
+    wanted,
     [&](int member, int team)
     {
       ChunkProgress progress(control, member == 0);
@@ -313,7 +344,9 @@ bool parallelFor(std::int64_t n, int chunks, int threads, const Execution& execu
         control.stop();
         throw;
       }
-    });
+    },
+    // The other members' work still moves the progress, and an abort still stops them.
+    [&control] { control.advance(0, true); });
   return !control.stopped();
 }
 
@@ -328,8 +361,9 @@ bool parallelRanges(std::int64_t n, const Execution& execution,
   const std::function<void(std::int64_t begin, std::int64_t end)>& body)
 {
   const int threads = detail::resolveThreadCount(execution.threads);
-  // Enough chunks for progress to move and for uneven chunks to even out.
-  const std::int64_t chunks = std::max<std::int64_t>(1, std::min<std::int64_t>(n, 16 * threads));
+  // Enough chunks for progress to move in steps under 5% (the caller reports the team's
+  // work after each of its chunks) and for uneven chunks to even out.
+  const std::int64_t chunks = std::max<std::int64_t>(1, std::min<std::int64_t>(n, 32 * threads));
   return detail::parallelFor(n, static_cast<int>(chunks), threads, execution,
     [&](std::int64_t begin, std::int64_t end, detail::ChunkProgress& progress)
     {

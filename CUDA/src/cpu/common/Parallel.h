@@ -52,6 +52,11 @@ std::int64_t workerThreadsStarted();
 /// stage of a multi-stage computation.
 Execution stageExecution(const Execution& execution, double from, double to);
 
+/// The stage of a pyramid of `levels` levels that builds levels `first` to `last`, each
+/// level an eighth of the one before it: its share of the progress is its share of the
+/// work, so that the coarse levels do not take most of the bar while costing little.
+Execution pyramidStageExecution(const Execution& execution, int first, int last, int levels);
+
 /// Shared by the chunks of one loop: how far it is and whether it must stop.
 class LoopControl
 {

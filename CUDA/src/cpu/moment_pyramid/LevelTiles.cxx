@@ -351,8 +351,7 @@ bool PyramidTiles::buildMarked(const Execution& execution)
 {
   for (int l = 0; l < this->count(); ++l)
   {
-    const double width = 1.0 / this->count();
-    if (!this->levels[l]->buildMarked(stageExecution(execution, l * width, (l + 1) * width)))
+    if (!this->levels[l]->buildMarked(pyramidStageExecution(execution, l, l, this->count())))
       return false;
   }
   return true;

@@ -38,22 +38,20 @@ Status buildPyramid(const VolumeView& volume, const std::array<double, 3>& origi
   std::vector<MomentLevel> result = std::move(pyramid);
   pyramid.clear();
   result.resize(static_cast<std::size_t>(levels));
-  const double stageWidth = 1.0 / levels;
   const bool firstDone = detail::dispatchScalarType(volume.type,
     [&](auto tag)
     {
       using T = decltype(tag);
       const RawSource<T> source{ detail::TypedVolume<T>(volume), shift };
       return blurDecimate(source, setup.firstStep, shift, result[0],
-        detail::stageExecution(execution, 0.0, stageWidth), threads);
+        detail::pyramidStageExecution(execution, 0, 0, levels), threads);
     });
   if (!firstDone)
   {
     return Status::cancelled();
   }
   if (!blurCoarserLevels(result, 1, shift, threads,
-        [&](int l)
-        { return detail::stageExecution(execution, l * stageWidth, (l + 1) * stageWidth); }))
+        [&](int l) { return detail::pyramidStageExecution(execution, l, l, levels); }))
   {
     return Status::cancelled();
   }

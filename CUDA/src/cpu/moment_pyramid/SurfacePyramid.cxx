@@ -165,7 +165,6 @@ Status buildSurfaceLevels(const VolumeView& volume, const std::array<double, 3>&
   result[0].dims = keptDims(volume.dims, setup.firstStep);
   if (levels >= 2)
     result[1].dims = keptDims(result[0].dims, 2);
-  const double stageWidth = 1.0 / std::max(1, levels - 1);
   if (levels >= 3)
   {
     const bool done = dispatchScalarType(volume.type,
@@ -174,7 +173,7 @@ Status buildSurfaceLevels(const VolumeView& volume, const std::array<double, 3>&
         using T = decltype(tag);
         const RawSource<T> raw{ TypedVolume<T>(volume), shift };
         return blurThroughStreamedLevels(raw, setup.firstStep, shift, result[2],
-          stageExecution(execution, 0.0, 2 * stageWidth), threads);
+          pyramidStageExecution(execution, 0, 2, levels), threads);
       });
     if (!done)
     {
@@ -182,7 +181,7 @@ Status buildSurfaceLevels(const VolumeView& volume, const std::array<double, 3>&
     }
   }
   if (!blurCoarserLevels(result, 3, shift, threads,
-        [&](int l) { return stageExecution(execution, (l - 1) * stageWidth, l * stageWidth); }))
+        [&](int l) { return pyramidStageExecution(execution, l, l, levels); }))
   {
     return Status::cancelled();
   }

@@ -104,6 +104,7 @@ bool forEachBatch(const P* points, const P* normals, const PointRange& range,
           return;
         }
       }
+      progress.advance((end - begin) % kProgressBatches);
     });
 }
 
