@@ -21,6 +21,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
+#include "vtkMatrix3x3.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
@@ -31,6 +32,7 @@
 #include "vtkStringArray.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -40,7 +42,7 @@ namespace
 {
 
 const char* const MethodNames[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box",
-  "Exact Sphere", "Histogram CDF", "Transfer Function" };
+  "Exact Sphere", "Histogram CDF", "Transfer Function", "Exact Rays" };
 const char* const QueryModeNames[] = { "Voxel Value", "Iso Value", "Smoothed Voxel Value" };
 
 vao::Method KernelMethod(int method)
@@ -59,6 +61,8 @@ vao::Method KernelMethod(int method)
       return vao::Method::HistogramCdf;
     case vtkVolumetricAmbientOcclusion::TRANSFER_FUNCTION:
       return vao::Method::TransferFunction;
+    case vtkVolumetricAmbientOcclusion::EXACT_RAYS:
+      return vao::Method::ExactRays;
     case vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF:
     default: // CheckParameters rejects any other value
       return vao::Method::GaussianCdf;
@@ -121,6 +125,12 @@ vtkVolumetricAmbientOcclusion::vtkVolumetricAmbientOcclusion()
 //------------------------------------------------------------------------------
 void vtkVolumetricAmbientOcclusion::ComputeVoxelRadius(const double spacing[3], int radius[3]) const
 {
+  if (this->Method == EXACT_RAYS)
+  {
+    const std::array<int, 3> reach = vao::rayReach(this->Rays(spacing));
+    std::copy(reach.begin(), reach.end(), radius);
+    return;
+  }
   for (int a = 0; a < 3; ++a)
   {
     double voxels = this->Radius;
@@ -157,7 +167,7 @@ vtkMultiProcessController* vtkVolumetricAmbientOcclusion::GetController() const
 void vtkVolumetricAmbientOcclusion::ComputeReach(const double spacing[3], int reach[3]) const
 {
   this->ComputeVoxelRadius(spacing, reach);
-  if (this->QueryMode == SMOOTHED_VALUE && this->Method != TRANSFER_FUNCTION)
+  if (this->QueryMode == SMOOTHED_VALUE && !this->UsesOpacityFunction())
   {
     const int window = vao::querySmoothingHalfWidth(this->QuerySmoothing);
     for (int a = 0; a < 3; ++a)
@@ -175,12 +185,24 @@ vao::AmbientOcclusionParameters vtkVolumetricAmbientOcclusion::Parameters(const 
   parameters.isoValue = this->IsoValue;
   parameters.erfMode = KernelErfMode(this->ErfApproximation);
   parameters.querySmoothing = this->QuerySmoothing;
-  if (this->Method == TRANSFER_FUNCTION)
+  if (this->UsesOpacityFunction())
   {
     parameters.queryMode = vao::QueryMode::VoxelValue; // the opacity has no query
     parameters.opacity = vtkAmbientOcclusionOpacity::Nodes(this->OpacityFunction);
   }
   return parameters;
+}
+
+//------------------------------------------------------------------------------
+vao::RayParameters vtkVolumetricAmbientOcclusion::Rays(const double spacing[3]) const
+{
+  vao::RayParameters rays;
+  rays.spacing = { spacing[0], spacing[1], spacing[2] };
+  const double smallest = std::min({ spacing[0], spacing[1], spacing[2] });
+  rays.radius = this->RadiusUnits == WORLD ? this->Radius : this->Radius * smallest;
+  rays.opacityUnitDistance = this->OpacityUnitDistance;
+  rays.rayCount = this->RayCount;
+  return rays;
 }
 
 //------------------------------------------------------------------------------
@@ -387,6 +409,12 @@ bool vtkVolumetricAmbientOcclusion::ComputeArrays(vtkImageData* input, Run& run)
   run.variance = this->ComputeVariance ? NewFloatArray("Variance", region.voxelCount()) : nullptr;
   run.parameters = this->Parameters(run.radius);
   run.parameters.thresholds = std::move(run.thresholds);
+  if (this->Method == EXACT_RAYS)
+  {
+    run.parameters.rays = this->Rays(input->GetSpacing());
+    const double* d = input->GetDirectionMatrix()->GetData();
+    std::copy(d, d + 9, run.parameters.rays.direction.begin());
+  }
   const vao::Status status = this->Compute(run.scalars.view, region, run.parameters,
     { run.openness->GetPointer(0), run.variance ? run.variance->GetPointer(0) : nullptr,
       &run.range });
@@ -460,6 +488,7 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
   // value as the query.
   const char* cpuOnly = parameters.method == vao::Method::TransferFunction
     ? "The Transfer Function method runs"
+    : parameters.method == vao::Method::ExactRays           ? "The Exact Rays method runs"
     : parameters.queryMode == vao::QueryMode::SmoothedValue ? "The smoothed query runs"
                                                             : nullptr;
   bool onDevice = this->ChooseCuda(cpuOnly,
@@ -519,10 +548,12 @@ bool vtkVolumetricAmbientOcclusion::ChooseCuda(
 void vtkVolumetricAmbientOcclusion::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  const bool knownMethod = this->Method >= CDF_RECONSTRUCTION && this->Method <= TRANSFER_FUNCTION;
+  const bool knownMethod = this->Method >= CDF_RECONSTRUCTION && this->Method <= EXACT_RAYS;
   const bool knownQuery = this->QueryMode >= VOXEL_VALUE && this->QueryMode <= SMOOTHED_VALUE;
   os << indent << "Method: " << (knownMethod ? MethodNames[this->Method] : "(invalid)") << "\n";
   os << indent << "NumberOfBins: " << this->NumberOfBins << "\n";
+  os << indent << "RayCount: " << this->RayCount << "\n";
+  os << indent << "OpacityUnitDistance: " << this->OpacityUnitDistance << "\n";
   os << indent << "Radius: " << this->Radius << (this->RadiusUnits == WORLD ? " world" : " voxels")
      << "\n";
   os << indent << "QueryMode: " << (knownQuery ? QueryModeNames[this->QueryMode] : "(invalid)")

@@ -60,6 +60,7 @@ namespace vao
 {
 struct AmbientOcclusionOutput;
 struct AmbientOcclusionParameters;
+struct RayParameters;
 struct Region;
 struct Status;
 struct ValueScan;
@@ -81,7 +82,8 @@ public:
     EXACT_BOX = 3,
     EXACT_SPHERE = 4,
     HISTOGRAM_CDF = 5,
-    TRANSFER_FUNCTION = 6
+    TRANSFER_FUNCTION = 6,
+    EXACT_RAYS = 7
   };
   enum RadiusUnitsType
   {
@@ -114,7 +116,9 @@ public:
 
   ///@{
   /// TRANSFER_FUNCTION: the opacity whose box mean occludes (openness = 1 - the mean
-  /// opacity of the box), evaluated as vtkPiecewiseFunction::GetValue does. In ParaView,
+  /// opacity of the box); EXACT_RAYS: the opacity the rays pass through (openness = the
+  /// mean transmittance of RayCount rays of length Radius). Evaluated as
+  /// vtkPiecewiseFunction::GetValue does. In ParaView,
   /// the opacity transfer function of an array (GetOpacityTransferFunction): the filter's
   /// modification time includes the function's, so editing it re-executes the filter.
   void SetOpacityFunction(vtkPiecewiseFunction* opacity);
@@ -123,6 +127,21 @@ public:
 
   /// Includes the opacity function's modification time.
   vtkMTimeType GetMTime() override;
+
+  ///@{
+  /// EXACT_RAYS: the rays per voxel, along a Fibonacci sphere of directions (default 128,
+  /// at most 65536).
+  vtkSetMacro(RayCount, int);
+  vtkGetMacro(RayCount, int);
+  ///@}
+
+  ///@{
+  /// EXACT_RAYS: the length, in world units, over which a voxel's opacity is the opacity
+  /// function's value (a volume property's Scalar Opacity Unit Distance); 0 (default) for
+  /// the smallest spacing.
+  vtkSetMacro(OpacityUnitDistance, double);
+  vtkGetMacro(OpacityUnitDistance, double);
+  ///@}
 
   ///@{
   /// Radius of the box (the paper's kernel radius), in voxels or world units (default 10).
@@ -235,8 +254,12 @@ public:
   vtkGetCharFromStdStringMacro(OutputArrayName);
   ///@}
 
-  /// Radius in voxels per axis for a given spacing (RadiusUnits applied).
+  /// Radius in voxels per axis for a given spacing (RadiusUnits applied); for EXACT_RAYS,
+  /// the voxels a ray of that radius reaches along each axis (rounded up).
   void ComputeVoxelRadius(const double spacing[3], int radius[3]) const;
+
+  /// True for the methods that read the opacity function (TRANSFER_FUNCTION, EXACT_RAYS).
+  bool UsesOpacityFunction() const;
 
 protected:
   vtkVolumetricAmbientOcclusion();
@@ -253,6 +276,8 @@ protected:
   double IsoValue = 0.0;
   double QuerySmoothing = 1.0;
   int NumberOfBins = 64;
+  int RayCount = 128;
+  double OpacityUnitDistance = 0.0;
   vtkSmartPointer<vtkMultiProcessController> Controller;
   vtkSmartPointer<vtkDataArray> HistogramThresholds;
   vtkSmartPointer<vtkPiecewiseFunction> OpacityFunction;
@@ -296,6 +321,8 @@ private:
   bool CheckParameters();
   /// The kernel's parameters for a radius in voxels (CheckParameters passed).
   vao::AmbientOcclusionParameters Parameters(const int radius[3]) const;
+  /// EXACT_RAYS: the rays for voxels of this spacing (the identity direction matrix).
+  vao::RayParameters Rays(const double spacing[3]) const;
   /// Half-widths in voxels of what a voxel's result reads: the radius, and the smoothed
   /// query's window when it is used.
   void ComputeReach(const double spacing[3], int reach[3]) const;

@@ -29,7 +29,13 @@ vtkMTimeType vtkVolumetricAmbientOcclusion::GetMTime()
   // An edited function (a point moved, a midpoint changed) re-executes the filter; the
   // other methods do not read it.
   const vtkMTimeType own = this->Superclass::GetMTime();
-  return this->Method == TRANSFER_FUNCTION && this->OpacityFunction
+  return this->UsesOpacityFunction() && this->OpacityFunction
     ? std::max(own, this->OpacityFunction->GetMTime())
     : own;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumetricAmbientOcclusion::UsesOpacityFunction() const
+{
+  return this->Method == TRANSFER_FUNCTION || this->Method == EXACT_RAYS;
 }

@@ -19,18 +19,20 @@
 namespace
 {
 
-/// The filters that read an opacity function, the property that holds it, and the method
+/// The filters that read an opacity function, the property that holds it, and the methods
 /// (if any) that must be chosen for it to be read.
 struct Reader
 {
   const char* Filter;
   const char* FunctionProperty;
-  int Method; ///< -1: always read
+  int FirstMethod; ///< -1: always read
+  int LastMethod;
 };
 
 const Reader Readers[] = {
-  { "VolumetricAmbientOcclusion", "OpacityFunction", 6 },
-  { "AmbientOcclusionShading", "OpacityTransferFunction", -1 },
+  // Transfer Function and Exact Rays
+  { "VolumetricAmbientOcclusion", "OpacityFunction", 6, 7 },
+  { "AmbientOcclusionShading", "OpacityTransferFunction", -1, -1 },
 };
 
 const Reader* ReaderOf(vtkSMProxy* proxy)
@@ -90,7 +92,9 @@ void vtkAmbientOcclusionOpacityFitting::Fit(vtkSMProxy* filter)
 {
   const Reader* reader = ReaderOf(filter);
   if (!reader || !filter->GetProperty(reader->FunctionProperty) ||
-    (reader->Method >= 0 && vtkSMPropertyHelper(filter, "Method").GetAsInt() != reader->Method))
+    (reader->FirstMethod >= 0 &&
+      (vtkSMPropertyHelper(filter, "Method").GetAsInt() < reader->FirstMethod ||
+        vtkSMPropertyHelper(filter, "Method").GetAsInt() > reader->LastMethod)))
   {
     return;
   }

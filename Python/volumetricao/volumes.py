@@ -18,7 +18,11 @@ _METHODS = {
     "exact box": vtkVolumetricAmbientOcclusion.EXACT_BOX,
     "exact sphere": vtkVolumetricAmbientOcclusion.EXACT_SPHERE,
     "transfer function": vtkVolumetricAmbientOcclusion.TRANSFER_FUNCTION,
+    "exact rays": vtkVolumetricAmbientOcclusion.EXACT_RAYS,
 }
+# The methods that read an opacity function.
+_OPACITY_METHODS = {vtkVolumetricAmbientOcclusion.TRANSFER_FUNCTION: "transfer function",
+                    vtkVolumetricAmbientOcclusion.EXACT_RAYS: "exact rays"}
 _ERF = {"exact": vtkVolumetricAmbientOcclusion.ERF_EXACT, "winitzki": vtkVolumetricAmbientOcclusion.ERF_WINITZKI}
 _BACKEND = {"auto": vtkVolumetricAmbientOcclusion.BACKEND_AUTO, "cpu": vtkVolumetricAmbientOcclusion.BACKEND_CPU,
             "cuda": vtkVolumetricAmbientOcclusion.BACKEND_CUDA}
@@ -46,7 +50,8 @@ def _volume(array, sampling, spacing, origin):
 def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", world_radius=False,
                       iso_value=None, query_smoothing=None, number_of_bins=64, variance=False, threads=0,
                       origin=None, *, sampling=None, component=None, scalars=None, erf="exact", backend="auto",
-                      device=-1, opacity=None, progress=False, return_info=False):
+                      device=-1, opacity=None, ray_count=128, opacity_unit_distance=None, progress=False,
+                      return_info=False):
     """Per-voxel ambient occlusion (openness in [0, 1], 1 = open) of a volume: the
     Volumetric Ambient Occlusion filter (``vtkVolumetricAmbientOcclusion``).
 
@@ -54,13 +59,15 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
         [z, y, x, c] with ``component``), or a vtkImageData (or an algorithm whose output
         is one; then ``scalars`` names its point array, default the active scalars).
     sampling: the voxel size per array axis (z, y, x), or one value for all (default 1);
-        it matters only with ``world_radius``. ``spacing`` (x, y, z) is its deprecated form.
+        it matters with ``world_radius`` and for the rays. ``spacing`` (x, y, z) is its deprecated form.
     radius: half-width of the box, in voxels (in the units of ``sampling`` with
         ``world_radius=True``).
     method: "Histogram CDF" (default, nearly exact), "Gaussian CDF", "CDF Reconstruction",
-        "Chebyshev", "Exact Box", "Exact Sphere" (case and underscores do not matter), or
-        "Transfer Function": 1 - the box's mean opacity, with ``opacity``.
-    opacity: the opacity transfer function of method="transfer function": a
+        "Chebyshev", "Exact Box", "Exact Sphere" (case and underscores do not matter),
+        "Transfer Function": 1 - the box's mean opacity, with ``opacity``, or "Exact Rays":
+        the ambient occlusion a ray tracer shows through ``opacity``, the mean transmittance
+        of ``ray_count`` rays of length ``radius`` (in voxels: times the smallest sampling).
+    opacity: the opacity transfer function of methods "transfer function" and "exact rays": a
         vtkPiecewiseFunction, ParaView's ``GetOpacityTransferFunction(array)``, or points
         ((N, 2) value and opacity, (N, 4) with midpoint and sharpness, as VTK takes them).
     iso_value: compare with this value instead of each voxel's own.
@@ -69,6 +76,9 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
     number_of_bins: Histogram CDF's thresholds (2..1024).
     variance: also return the box's intensity variance.
     erf: "exact" or "winitzki" (Gaussian CDF's error function).
+    ray_count: "exact rays": the rays per voxel (1..65536), spread over a Fibonacci sphere.
+    opacity_unit_distance: "exact rays": the length (units of ``sampling``) over which a
+        voxel stops the fraction of light ``opacity`` gives; default the smallest sampling.
     backend: "auto" (CUDA for large extents and the exact methods when a device is present),
         "cpu" or "cuda" (falls back to the CPU with a VolumetricAOWarning); device: the
         CUDA device (-1: the process's rank on its node modulo the devices).
@@ -104,10 +114,14 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
     True
     """
     chosen = _common.choice(method, _METHODS, "method")
-    if chosen == vtkVolumetricAmbientOcclusion.TRANSFER_FUNCTION and opacity is None:
-        raise ValueError('method="transfer function" needs opacity: points (value, opacity) or a vtkPiecewiseFunction')
-    if chosen != vtkVolumetricAmbientOcclusion.TRANSFER_FUNCTION and opacity is not None:
-        raise ValueError('opacity is used by method="transfer function" only')
+    if chosen in _OPACITY_METHODS and opacity is None:
+        raise ValueError('method="%s" needs opacity: points (value, opacity) or a vtkPiecewiseFunction'
+                         % _OPACITY_METHODS[chosen])
+    if chosen not in _OPACITY_METHODS and opacity is not None:
+        raise ValueError('opacity is used by methods "transfer function" and "exact rays" only')
+    rays = chosen == vtkVolumetricAmbientOcclusion.EXACT_RAYS
+    if not rays and (ray_count != 128 or opacity_unit_distance is not None):
+        raise ValueError('ray_count and opacity_unit_distance are used by method="exact rays" only')
     function = None if opacity is None else _common.opacity_function(opacity)
     erf_key = _common.choice(erf, _ERF, "erf")
     backend_key = _common.check_backend(backend)
@@ -124,6 +138,9 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
     ao.SetRadius(_common.number(radius, "radius"))
     ao.SetRadiusUnits(vtkVolumetricAmbientOcclusion.WORLD if world_radius else vtkVolumetricAmbientOcclusion.VOXELS)
     ao.SetNumberOfBins(_common.number(number_of_bins, "number_of_bins", integer=True))
+    ao.SetRayCount(_common.number(ray_count, "ray_count", integer=True))
+    if opacity_unit_distance is not None:
+        ao.SetOpacityUnitDistance(_common.number(opacity_unit_distance, "opacity_unit_distance"))
     ao.SetNumberOfThreads(_common.check_threads(threads))
     ao.SetComputeVariance(bool(variance))
     ao.SetErfApproximation(erf_key)

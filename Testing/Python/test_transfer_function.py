@@ -8,12 +8,19 @@ Each result is compared with the tests' own reference (vao_test_utils.opacity_op
 numpy box mean (cumulative sums, the box clipped to the volume) of the opacity from
 vtkPiecewiseFunction.GetValue itself.
 
-Usage: pvpython test_transfer_function.py PLUGIN
+Exact Rays through the same function follows its edits too, and equals the numpy function.
+
+Usage: pvpython test_transfer_function.py PLUGIN PACKAGE_DIR
 Prints "FAILED: ..." and exits non-zero on a failure."""
 import os
 import sys
 
 import numpy as np
+
+# The Python package (for the numpy function), imported before any of the plugin's client-side
+# objects is touched: Python would otherwise give their class the type of its wrapped base.
+sys.path.insert(0, sys.argv[2])
+import volumetricao  # noqa: E402
 from paraview.simple import *  # noqa: F401,F403 (and the plugin's proxies, loaded below)
 from paraview import servermanager
 from vtkmodules.util.numpy_support import vtk_to_numpy
@@ -83,5 +90,25 @@ shaded.UpdatePipeline()
 alpha = fetch(shaded, "ShadedRGBA")[..., 3]
 check(alpha[density > 400].min() > 0 and (alpha[density < 300] == 0).all(),
       "editing the opacity function re-shades (bone shown, soft tissue transparent)")
+
+# Exact Rays through the same function: an edit re-executes it, and ParaView's result is
+# the numpy function's (the package's own filter, given the same function) bit for bit.
+small = AmbientOcclusionHeadPhantom(Dimensions=[20, 20, 20])
+rays = VolumetricAmbientOcclusion(Input=small, Method="Exact Rays", Radius=2, RayCount=24, OpacityFunction=opacity)
+rays.Scalars = ["POINTS", "Density"]
+ray_runs = []
+rays.GetClientSideObject().AddObserver("StartEvent", lambda caller, event: ray_runs.append(1))
+small_density = fetch(small, "Density")
+spacing = servermanager.Fetch(small).GetSpacing()
+for step, points in enumerate([[-1000.0, 0.0, 0.5, 0.0, 300.0, 0.0, 0.5, 0.0, 400.0, 1.0, 0.5, 0.0],
+                               [-1000.0, 0.0, 0.5, 0.0, -100.0, 0.8, 0.2, 0.9, 250.0, 0.3, 0.5, 0.0]]):
+    opacity.Points = points
+    rays.UpdatePipeline()
+    got = fetch(rays, "AmbientOcclusion")
+    expected = volumetricao.ambient_occlusion(small_density, radius=2, method="exact rays", ray_count=24,
+                                              opacity=function, sampling=spacing[::-1])
+    check(len(ray_runs) == step + 1 and np.array_equal(got, expected) and got.min() < 0.9,
+          "Exact Rays, opacity %d: ran %d times, equals numpy's bit for bit (AO %.3f..%.3f)"
+          % (step + 1, len(ray_runs), got.min(), got.max()))
 
 finish("transfer-function AO follows the opacity transfer function")

@@ -66,12 +66,12 @@ def array_of(data_object, name):
 
 
 def read_image(path):
-    """Reads .vti / .pvti / .mha with VTK's own readers, serially."""
+    """Reads .vti / .pvti / .mha / .mhd with VTK's own readers, serially."""
     from vtkmodules.vtkIOXML import vtkXMLImageDataReader, vtkXMLPImageDataReader
     from vtkmodules.vtkIOImage import vtkMetaImageReader
     extension = os.path.splitext(path)[1].lower()
     reader = {".vti": vtkXMLImageDataReader, ".pvti": vtkXMLPImageDataReader,
-              ".mha": vtkMetaImageReader}[extension]()
+              ".mha": vtkMetaImageReader, ".mhd": vtkMetaImageReader}[extension]()
     reader.SetFileName(path)
     reader.Update()
     output = reader.GetOutput()

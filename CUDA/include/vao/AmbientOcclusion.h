@@ -8,6 +8,7 @@
 #pragma once
 
 #include "vao/Estimators.h"
+#include "vao/RayCasting.h"
 #include "vao/TransferFunction.h"
 
 #include <array>
@@ -95,8 +96,12 @@ struct AmbientOcclusionParameters
   // Histogram CDF: the ascending thresholds t_k, fixed from the whole data set's values
   // (vao/HistogramCdf.h), never from one piece's.
   std::vector<double> thresholds;
-  // Transfer Function: the opacity whose box mean occludes (checkOpacityFunction).
+  // Transfer Function, Exact Rays and Rays: the opacity (checkOpacityFunction).
   OpacityFunction opacity;
+  // Exact Rays and Rays: the rays' world frame (`radius` above is then their reach in
+  // voxels, rayReach, which the volume block must hold around the region where it is not
+  // the whole extent).
+  RayParameters rays;
 };
 
 /// The half-width in voxels of the smoothed query's window (ceil(3 sigma)): a piece of a

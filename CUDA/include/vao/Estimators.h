@@ -26,7 +26,14 @@ enum class Method : int
   ExactSphere = 4,
   HistogramCdf = 5,
   TransferFunction = 6, // 1 - the box's mean opacity (vao/TransferFunction.h)
+  ExactRays = 7,        // ray-cast AO through the opacity (vao/RayCasting.h), the reference
 };
+
+/// True for the methods that cast rays through the opacity (vao/RayCasting.h).
+VAO_HD bool isRayMethod(Method method)
+{
+  return method == Method::ExactRays;
+}
 
 enum class ErfMode : int
 {

@@ -43,6 +43,12 @@ Status checkHistogramThresholds(const std::vector<double>& thresholds);
 /// and sharpness finite; x ascending; opacity, midpoint and sharpness in [0, 1].
 Status checkOpacityFunction(const OpacityFunction& function);
 
+/// The rays of Exact Rays and Rays: radius, spacing and opacity unit distance finite and
+/// positive (the unit distance 0 for the smallest spacing); a finite direction matrix with
+/// unit columns at right angles; 1 <= rayCount <= kMaximumRayCount; and no more than 2^31
+/// samples per ray (R over half the smallest spacing).
+Status checkRayParameters(const RayParameters& rays);
+
 /// What one parallel pass over the values finds: the non-finite ones, and the range of
 /// the finite ones (0, 0 when there is none).
 struct ValueScan

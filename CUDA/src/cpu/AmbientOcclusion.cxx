@@ -6,6 +6,7 @@
 #include "cpu/common/ConcurrentRange.h"
 #include "cpu/exact_reference/ExactReference.h"
 #include "cpu/histogram_cdf/HistogramChannels.h"
+#include "cpu/ray_casting/ExactRays.h"
 #include "cpu/simd/CpuDispatch.h"
 #include "cpu/smoothed_query/SmoothedQuery.h"
 #include "cpu/transfer_function/TransferFunctionOpenness.h"
@@ -13,6 +14,7 @@
 
 #include "vao/Validation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -99,6 +101,11 @@ Status checkParameters(const AmbientOcclusionParameters& p)
   {
     return checkOpacityFunction(p.opacity);
   }
+  if (isRayMethod(p.method))
+  {
+    const Status opacity = checkOpacityFunction(p.opacity);
+    return opacity.ok ? checkRayParameters(p.rays) : opacity;
+  }
   return Status::success();
 }
 
@@ -119,6 +126,17 @@ Status validateRequest(const VolumeView& volume, const Region& region,
     status = validate(volume, region, parameters.radius);
     if (status.ok && !scalarTypeIsIntegral(volume.type))
       status = finiteStatus(scan = scanValues(volume));
+  }
+  if (status.ok && isRayMethod(parameters.method) && parameters.opacity.logScale)
+  {
+    // Interpolated values lie between the voxels' own: positive voxels and points keep
+    // every sample where the log scale is defined.
+    const double lowest = scalarTypeIsIntegral(volume.type) ? valueRange(volume)[0] : scan.minimum;
+    const bool positivePoints = std::all_of(parameters.opacity.nodes.begin(),
+      parameters.opacity.nodes.end(), [](const OpacityNode& node) { return node.x > 0.0; });
+    if (!(lowest > 0.0) || !positivePoints)
+      status = Status::failure("the opacity function is undefined at some of the values: its log "
+                               "scale needs values and points above 0");
   }
   if (status.ok && parameters.queryMode == QueryMode::SmoothedValue &&
     std::max(std::abs(scan.minimum), std::abs(scan.maximum)) > kLargestSmoothedMagnitude)
@@ -154,6 +172,10 @@ Status separateOpenness(const VolumeView& volume, const Region& region,
     return detail::computeTransferFunctionOpenness(
       volume, region, parameters.radius, parameters.opacity, openness, range, stage);
   }
+  if (parameters.method == Method::ExactRays)
+  {
+    return detail::computeExactRays(volume, region, parameters, openness, range, stage);
+  }
   return detail::computeExactOpenness(volume, region, parameters, q, openness, stage);
 }
 
@@ -174,7 +196,9 @@ Status ambientOcclusion(const VolumeView& volume, const Region& region,
     return status;
   }
   // Stages of the progress: the smoothed query, the openness, the variance.
-  const bool smoothed = parameters.queryMode == QueryMode::SmoothedValue;
+  // Transfer Function and the rays read the opacity, not a query.
+  const bool smoothed = parameters.queryMode == QueryMode::SmoothedValue &&
+    parameters.method != Method::TransferFunction && !isRayMethod(parameters.method);
   const bool separate = output.openness && !isSeparableMethod(parameters.method);
   const double queryEnd = smoothed ? 0.2 : 0.0;
   const double opennessEnd = separate ? (output.variance ? 0.9 : 1.0) : queryEnd;

@@ -261,6 +261,43 @@ Status checkOpacityFunction(const OpacityFunction& function)
   return Status::success();
 }
 
+Status checkRayParameters(const RayParameters& rays)
+{
+  std::ostringstream why;
+  if (!std::isfinite(rays.radius) || !(rays.radius > 0.0))
+    why << "the rays' radius must be finite and positive (got " << rays.radius << ")";
+  else if (!checkSpacing(rays.spacing).ok)
+    return checkSpacing(rays.spacing);
+  else if (!std::isfinite(rays.opacityUnitDistance) || rays.opacityUnitDistance < 0.0)
+    why << "the opacity unit distance must be finite and positive, or 0 for the smallest "
+           "spacing (got "
+        << rays.opacityUnitDistance << ")";
+  else if (rays.rayCount < 1 || rays.rayCount > kMaximumRayCount)
+    why << "the ray count must lie in [1, " << kMaximumRayCount << "] (got " << rays.rayCount
+        << ")";
+  if (!why.str().empty())
+    return Status::failure(why.str());
+  const std::array<double, 9>& d = rays.direction;
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
+    {
+      const double dot = d[i] * d[j] + d[3 + i] * d[3 + j] + d[6 + i] * d[6 + j];
+      if (!std::isfinite(dot) || std::abs(dot - (i == j ? 1.0 : 0.0)) > 1e-6)
+        return Status::failure("the direction matrix must be a rotation or reflection (unit "
+                               "columns at right angles), as vtkImageData's is");
+    }
+  }
+  const double smallest = std::min({ rays.spacing[0], rays.spacing[1], rays.spacing[2] });
+  if (!(rays.radius / (smallest / 2.0) <= 2147483647.0))
+  {
+    why << "the rays' radius " << rays.radius << " is more than 2^30 times the smallest spacing "
+        << smallest << ": use a smaller radius";
+    return Status::failure(why.str());
+  }
+  return Status::success();
+}
+
 Status finiteStatus(const ValueScan& scan)
 {
   return scan.nonFiniteCount > 0 ? Status::nonFinite(scan.nonFiniteCount, scan.firstNonFinite)
