@@ -6,7 +6,7 @@ under Xvfb, package xvfb):
     xvfb-run -a pvpython --force-offscreen-rendering Examples/figures.py PLUGIN OUTDIR [CT.mha] [--quick]
 
 For the generated head phantom (128^3; 64^3 with --quick) and, when CT.mha is given, for
-that CT head (int16 Hounsfield units), it writes six PNGs per data set, each a row of
+that CT head (int16 Hounsfield units), it writes seven PNGs per data set, each a row of
 panels seen from the front (the face looks towards -y, LPS; view up +z):
 
     ruiz_ambient_lighting_<data>.png    volume rendering: no AO, Chebyshev, CDF Reconstruction,
@@ -19,6 +19,9 @@ panels seen from the front (the face looks towards -y, LPS; view up +z):
     transfer_function_<data>.png        soft tissue shown, bone transparent: ambient light from
                                         the data's order (Histogram CDF) and from the opacity
                                         the rendering uses (Transfer Function), R = 10
+    rays_<data>.png                     the bone shown: ParaView's own (unlit) volume rendering,
+                                        then lit by Histogram CDF, Transfer Function and Exact
+                                        Rays through the bone's opacity (the AO a ray tracer shows)
     singh_sweeping_<data>.png           the skin coloured by occlusion sweeping: skylight, the
                                         upper four octants (overcast), one octant (a shadow)
     penner_bone_<data>.png              the bone: diffuse light only, isosurface AO, AO x shadow
@@ -230,6 +233,48 @@ def transfer_function(source, array, tag, spacing):
     combine(panels, os.path.join(out_dir, "transfer_function_%s.png" % tag))
 
 
+# The bone shown, soft tissue faint: ParaView's opacity points.
+BONE_OPACITY = [-1000.0, 0.0, 0.5, 0.0, 100.0, 0.0, 0.5, 0.0, 300.0, 0.15, 0.5, 0.0, 1200.0, 0.8, 0.5, 0.0]
+
+
+def rays(source, array, tag, spacing):
+    """The bone as ParaView renders it (no AO), then lit by the AO of the value order
+    (Histogram CDF), of the box's opacity (Transfer Function) and of the rays through the
+    opacity (Exact Rays): the last is what a ray tracer shows."""
+    bounds = bounds_of(source)
+    bone = GetOpacityTransferFunction(array)
+    bone.Points = BONE_OPACITY
+    colors = GetColorTransferFunction(array)
+    colors.ApplyPreset("Bone", True)
+    colors.AutomaticRescaleRangeMode = "Never"
+    colors.RescaleTransferFunction(-600.0, 1500.0)
+    hide_all()
+    display = Show(source, view)
+    display.SetRepresentationType("Volume")
+    ColorBy(display, ("POINTS", array))
+    display.ScalarOpacityUnitDistance = spacing
+    display.SetScalarBarVisibility(view, False)
+    label("ParaView, no AO")
+    front_camera(bounds)
+    panels = [grab(os.path.join(out_dir, "_panel0.png"))]
+    radius = 4 if quick else 6
+    for i, method in enumerate(["Histogram CDF", "Transfer Function", "Exact Rays"]):
+        t0 = time.time()
+        ao = VolumetricAmbientOcclusion(Input=source, Method=method, Radius=radius, QueryMode="Voxel Value")
+        ao.Scalars = ["POINTS", array]
+        if method != "Histogram CDF":
+            ao.OpacityFunction = bone
+        if method == "Exact Rays" and quick:
+            ao.RayCount = 16
+        shaded = AmbientOcclusionShading(Input=ao, OpacityTransferFunction=bone, ColorPreset="Bone",
+                                         ScalarRange=[-600.0, 1500.0])
+        shaded.Scalars = ["POINTS", array]
+        panels.append(render_rgba(shaded, "%s, R = %d" % (method, radius),
+                                  os.path.join(out_dir, "_panel%d.png" % (i + 1)), bounds, spacing))
+        print("  rays %-20s %.1f s" % (method, time.time() - t0))
+    combine(panels, os.path.join(out_dir, "rays_%s.png" % tag))
+
+
 def ruiz(source, array, tag, spacing):
     """Volume rendering lit by AO alone (Ruiz et al. Eq. 5): RGBA from Ambient Occlusion Shading."""
     bounds = bounds_of(source)
@@ -356,6 +401,7 @@ def figures(source, array, tag):
     ruiz(source, array, tag, spacing)
     accuracy(source, array, tag, spacing)
     transfer_function(source, array, tag, spacing)
+    rays(source, array, tag, spacing)
     singh(source, array, tag, spacing)
     penner(source, array, tag)
     print("%s: %.1f s" % (tag, time.time() - t0))

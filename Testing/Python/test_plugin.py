@@ -38,7 +38,7 @@ ao = VolumetricAmbientOcclusion(Input=wavelet)
 
 # Properties: names, defaults, enumeration texts, documentation.
 expected_enums = {
-    "Method": METHODS + ["Transfer Function"],  # the last needs an opacity function
+    "Method": METHODS + ["Transfer Function", "Exact Rays"],  # the last two need an opacity function
     "RadiusUnits": ["Voxels", "World"],
     "QueryMode": ["Voxel Value", "Iso Value", "Smoothed Voxel Value"],
     "ErfApproximation": ["Exact", "Winitzki"],
@@ -53,7 +53,7 @@ check(ao.QueryMode == "Smoothed Voxel Value", "QueryMode defaults to Smoothed Vo
 check(ao.OutputArrayName == "AmbientOcclusion", "OutputArrayName defaults to AmbientOcclusion")
 for name in ["Scalars", "Method", "NumberOfBins", "Radius", "RadiusUnits", "QueryMode", "IsoValue",
              "QuerySmoothing", "ErfApproximation", "ComputeVariance", "Backend", "Device", "OutputArrayName",
-             "Component", "NumberOfThreads"]:
+             "Component", "NumberOfThreads", "RayCount", "OpacityUnitDistance"]:
     prop = ao.GetProperty(name)
     check(prop is not None, "property %s exists" % name, stop=True)
     doc = prop.SMProperty.GetDocumentation()

@@ -53,7 +53,7 @@ namespace
 {
 
 /// sigma at index coordinates q of the block: the value interpolated trilinearly, then
-/// classified; 0 outside the block.
+/// classified; -1 outside the block (where sigma is 0).
 template <class T, class Extinction>
 double extinctionAt(const TypedVolume<T>& volume, const double q[3], const Extinction& extinction)
 {
@@ -64,7 +64,7 @@ double extinctionAt(const TypedVolume<T>& volume, const double q[3], const Extin
   {
     const std::int64_t n = volume.dims[a];
     if (!(q[a] >= 0.0 && q[a] <= static_cast<double>(n - 1)))
-      return 0.0;
+      return -1.0;
     // The last cell's far corner belongs to it, so that f stays in [0, 1].
     i0[a] = std::min(static_cast<std::int64_t>(q[a]), std::max<std::int64_t>(n - 2, 0));
     f[a] = q[a] - static_cast<double>(i0[a]);
@@ -133,7 +133,11 @@ bool castRays(const VolumeView& view, const Region& region,
               const double t = static_cast<double>(k) + 0.5;
               const double q[3] = { origin[0] + t * move[0], origin[1] + t * move[1],
                 origin[2] + t * move[2] };
-              depth += extinctionAt(volume, q, extinction);
+              const double sigma = extinctionAt(volume, q, extinction);
+              // The block is convex and the ray starts inside it: once out, out for good.
+              if (sigma < 0.0)
+                break;
+              depth += sigma;
             }
             transmitted += std::exp(-dt * depth);
           }
