@@ -244,14 +244,15 @@ def rays(source, array, tag, spacing):
     bounds = bounds_of(source)
     bone = GetOpacityTransferFunction(array)
     bone.Points = BONE_OPACITY
-    colors = GetColorTransferFunction(array)
-    colors.ApplyPreset("Bone", True)
-    colors.AutomaticRescaleRangeMode = "Never"
-    colors.RescaleTransferFunction(-600.0, 1500.0)
     hide_all()
     display = Show(source, view)
     display.SetRepresentationType("Volume")
     ColorBy(display, ("POINTS", array))
+    # ParaView's counterpart of the Shading's "Bone" colours.
+    colors = GetColorTransferFunction(array)
+    colors.ApplyPreset("bone_Matlab", True)
+    colors.AutomaticRescaleRangeMode = "Never"
+    colors.RescaleTransferFunction(-600.0, 1500.0)
     display.ScalarOpacityUnitDistance = spacing
     display.SetScalarBarVisibility(view, False)
     label("ParaView, no AO")
