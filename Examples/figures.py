@@ -6,7 +6,7 @@ under Xvfb, package xvfb):
     xvfb-run -a pvpython --force-offscreen-rendering Examples/figures.py PLUGIN OUTDIR [CT.mha] [--quick]
 
 For the generated head phantom (128^3; 64^3 with --quick) and, when CT.mha is given, for
-that CT head (int16 Hounsfield units), it writes seven PNGs per data set, each a row of
+that CT head (int16 Hounsfield units), it writes eight PNGs per data set, each a row of
 panels seen from the front (the face looks towards -y, LPS; view up +z):
 
     ruiz_ambient_lighting_<data>.png    volume rendering: no AO, Chebyshev, CDF Reconstruction,
@@ -22,6 +22,10 @@ panels seen from the front (the face looks towards -y, LPS; view up +z):
     rays_<data>.png                     the bone shown: ParaView's own (unlit) volume rendering,
                                         then lit by Histogram CDF, Transfer Function and Exact
                                         Rays through the bone's opacity (the AO a ray tracer shows)
+    apply_<data>.png                    what Apply shows with every default (as Show() in
+                                        pvpython): Volumetric AO and Occlusion Sweeping (iso -300)
+                                        as a Slice, the Shading as a Volume, Isosurface AO on a
+                                        bone Contour (400) and Probe Outside Surface on the skin
     singh_sweeping_<data>.png           the skin coloured by occlusion sweeping: skylight, the
                                         upper four octants (overcast), one octant (a shadow)
     penner_bone_<data>.png              the bone: diffuse light only, isosurface AO, AO x shadow
@@ -276,6 +280,34 @@ def rays(source, array, tag, spacing):
     combine(panels, os.path.join(out_dir, "rays_%s.png" % tag))
 
 
+def apply_defaults(source, array, tag):
+    """Each filter as Apply (or Show() in pvpython) displays it, every property at its default,
+    in a fresh camera as the GUI resets it."""
+    panels = []
+    ao = VolumetricAmbientOcclusion(Input=source)
+    sweep = OcclusionSweeping(Input=source, IsoValue=SKIN_HU)
+    shading = AmbientOcclusionShading(Input=ao)
+    bone = Contour(Input=source, ContourBy=["POINTS", array], Isosurfaces=[BONE_HU], ComputeNormals=1)
+    iso = IsosurfaceAmbientOcclusion(Input=bone, Volume=source)
+    skin = Contour(Input=source, ContourBy=["POINTS", array], Isosurfaces=[SKIN_HU], ComputeNormals=1)
+    probe = ProbeOutsideSurface(Input=skin, Volume=sweep)
+    for i, (proxy, text) in enumerate([(ao, "Volumetric AO"), (sweep, "Occlusion Sweeping"),
+                                       (shading, "AO Shading"), (iso, "Isosurface AO"),
+                                       (probe, "Probe Outside Surface")]):
+        t0 = time.time()
+        hide_all()
+        Show(proxy, view)
+        # A new view's camera: looking down -z, y up.
+        view.CameraPosition = [0.0, 0.0, 1.0]
+        view.CameraFocalPoint = [0.0, 0.0, 0.0]
+        view.CameraViewUp = [0.0, 1.0, 0.0]
+        view.ResetCamera()
+        label(text)
+        panels.append(grab(os.path.join(out_dir, "_panel%d.png" % i)))
+        print("  apply %-22s %.1f s" % (text, time.time() - t0))
+    combine(panels, os.path.join(out_dir, "apply_%s.png" % tag))
+
+
 def ruiz(source, array, tag, spacing):
     """Volume rendering lit by AO alone (Ruiz et al. Eq. 5): RGBA from Ambient Occlusion Shading."""
     bounds = bounds_of(source)
@@ -399,6 +431,7 @@ def figures(source, array, tag):
                   for i in range(3))
     print("%s: %d x %d x %d voxels, spacing %.2f mm" % (tag, extent[1] - extent[0] + 1, extent[3] - extent[2] + 1,
                                                         extent[5] - extent[4] + 1, spacing))
+    apply_defaults(source, array, tag)
     ruiz(source, array, tag, spacing)
     accuracy(source, array, tag, spacing)
     transfer_function(source, array, tag, spacing)
