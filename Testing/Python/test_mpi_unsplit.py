@@ -1,7 +1,8 @@
-"""Under MPI, the volume filters on a reader that does not split (MetaImage: the whole
-volume on rank 0, an empty image on the others) give the serial numbers: each rank fetches
-its piece and halo from the rank that holds it. Runs mpi_unsplit_run.py with pvbatch
-serially and on 2 and 3 ranks, and compares every array of every result.
+"""Under MPI, the volume filters on a reader that does not split (MetaImage and NRRD: the
+whole volume on rank 0, an empty image on the others) give the serial numbers: each rank
+fetches its piece and halo from the rank that holds it. Runs mpi_unsplit_run.py with
+pvbatch serially and on 2 and 3 ranks (the CT head as MetaImage), serially and on 2 ranks
+(the same voxels as a detached NRRD header), and compares every array of every result.
 Usage: pvpython test_mpi_unsplit.py PLUGIN DATA_DIR OUT PVBATCH MPIEXEC"""
 import os
 import subprocess
@@ -21,8 +22,22 @@ ARRAYS = {"histogram": ["AmbientOcclusion"], "gaussian": ["AmbientOcclusion", "V
 TOLERANCE = {"sweeping": 1e-4}
 
 
-def run(ranks):
-    prefix = os.path.join(out_dir, "unsplit_np%d" % ranks)
+def nrrd_copy(path):
+    """The MetaImage's voxels as raw int16 with a detached NRRD header; its path."""
+    image = read_image(path)
+    values = array_of(image, image.GetPointData().GetScalars().GetName()).astype("<i2")
+    raw = os.path.join(out_dir, "unsplit_ct.raw")
+    values.tofile(raw)
+    header = os.path.join(out_dir, "unsplit_ct.nhdr")
+    with open(header, "w") as f:
+        f.write("NRRD0004\ntype: short\ndimension: 3\nsizes: %d %d %d\nspacings: %r %r %r\n"
+                "encoding: raw\nendian: little\ndata file: unsplit_ct.raw\n"
+                % (image.GetDimensions() + image.GetSpacing()))
+    return header
+
+
+def run(ranks, volume=volume, label=""):
+    prefix = os.path.join(out_dir, "unsplit%s_np%d" % (label, ranks))
     command = [pvbatch, os.path.join(here, "mpi_unsplit_run.py"), plugin, volume, prefix]
     if ranks > 1:
         command = [mpiexec, "--allow-run-as-root", "--oversubscribe", "-np", str(ranks)] + command
@@ -37,8 +52,8 @@ def run(ranks):
 
 
 serial = run(1)
-for ranks in (2, 3):
-    distributed = run(ranks)
+nrrd = nrrd_copy(volume)
+for ranks, distributed in ((2, run(2)), (3, run(3)), (2, run(2, nrrd, "_nrrd"))):
     for name, arrays in ARRAYS.items():
         expected = read_image("%s_%s.pvti" % (serial, name))
         got = read_image("%s_%s.pvti" % (distributed, name))
@@ -46,6 +61,6 @@ for ranks in (2, 3):
         for array in arrays:
             a, b = array_of(expected, array), array_of(got, array)
             worst = float(np.abs(a - b).max()) if a.shape == b.shape else float("inf")
-            check(worst <= TOLERANCE.get(name, 0.0), "%s %s on %d ranks equals serial (max |diff| %g)"
-                  % (name, array, ranks, worst))
+            check(worst <= TOLERANCE.get(name, 0.0), "%s %s on %d ranks%s equals serial (max |diff| %g)"
+                  % (name, array, ranks, " from NRRD" if "nrrd" in distributed else "", worst))
 finish("the volume filters on an unsplit reader equal serial on 2 and 3 ranks")
