@@ -65,6 +65,7 @@ def methods(crop, sampling, points, radius):
     yield "Gaussian CDF", volumetricao.ambient_occlusion(crop, method="gaussian cdf", **common)
     yield "Transfer Function", volumetricao.ambient_occlusion(crop, method="transfer function", opacity=points,
                                                               **common)
+    yield "Rays", volumetricao.ambient_occlusion(crop, method="rays", opacity=points, sampling=sampling, **common)
 
 
 rows = []

@@ -42,7 +42,7 @@ namespace
 {
 
 const char* const MethodNames[] = { "CDF Reconstruction", "Gaussian CDF", "Chebyshev", "Exact Box",
-  "Exact Sphere", "Histogram CDF", "Transfer Function", "Exact Rays" };
+  "Exact Sphere", "Histogram CDF", "Transfer Function", "Exact Rays", "Rays" };
 const char* const QueryModeNames[] = { "Voxel Value", "Iso Value", "Smoothed Voxel Value" };
 
 vao::Method KernelMethod(int method)
@@ -63,6 +63,8 @@ vao::Method KernelMethod(int method)
       return vao::Method::TransferFunction;
     case vtkVolumetricAmbientOcclusion::EXACT_RAYS:
       return vao::Method::ExactRays;
+    case vtkVolumetricAmbientOcclusion::RAYS:
+      return vao::Method::Rays;
     case vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF:
     default: // CheckParameters rejects any other value
       return vao::Method::GaussianCdf;
@@ -125,9 +127,11 @@ vtkVolumetricAmbientOcclusion::vtkVolumetricAmbientOcclusion()
 //------------------------------------------------------------------------------
 void vtkVolumetricAmbientOcclusion::ComputeVoxelRadius(const double spacing[3], int radius[3]) const
 {
-  if (this->Method == EXACT_RAYS)
+  if (this->CastsRays())
   {
-    const std::array<int, 3> reach = vao::rayReach(this->Rays(spacing));
+    const std::array<int, 3> reach = this->Method == RAYS
+      ? vao::rayEstimateReach(this->Rays(spacing))
+      : vao::rayReach(this->Rays(spacing));
     std::copy(reach.begin(), reach.end(), radius);
     return;
   }
@@ -409,7 +413,7 @@ bool vtkVolumetricAmbientOcclusion::ComputeArrays(vtkImageData* input, Run& run)
   run.variance = this->ComputeVariance ? NewFloatArray("Variance", region.voxelCount()) : nullptr;
   run.parameters = this->Parameters(run.radius);
   run.parameters.thresholds = std::move(run.thresholds);
-  if (this->Method == EXACT_RAYS)
+  if (this->CastsRays())
   {
     run.parameters.rays = this->Rays(input->GetSpacing());
     const double* d = input->GetDirectionMatrix()->GetData();
@@ -489,6 +493,7 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
   const char* cpuOnly = parameters.method == vao::Method::TransferFunction
     ? "The Transfer Function method runs"
     : parameters.method == vao::Method::ExactRays           ? "The Exact Rays method runs"
+    : parameters.method == vao::Method::Rays                ? "The Rays method runs"
     : parameters.queryMode == vao::QueryMode::SmoothedValue ? "The smoothed query runs"
                                                             : nullptr;
   bool onDevice = this->ChooseCuda(cpuOnly,
@@ -548,7 +553,7 @@ bool vtkVolumetricAmbientOcclusion::ChooseCuda(
 void vtkVolumetricAmbientOcclusion::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  const bool knownMethod = this->Method >= CDF_RECONSTRUCTION && this->Method <= EXACT_RAYS;
+  const bool knownMethod = this->Method >= CDF_RECONSTRUCTION && this->Method <= RAYS;
   const bool knownQuery = this->QueryMode >= VOXEL_VALUE && this->QueryMode <= SMOOTHED_VALUE;
   os << indent << "Method: " << (knownMethod ? MethodNames[this->Method] : "(invalid)") << "\n";
   os << indent << "NumberOfBins: " << this->NumberOfBins << "\n";

@@ -30,12 +30,15 @@ bool vtkVolumetricAmbientOcclusion::CheckParameters()
     : vao::Status::success();
   if (!std::isfinite(this->Radius) || this->Radius < 0.0)
     why << "Radius must be a finite, non-negative number (got " << this->Radius << ").";
-  else if (this->Method < CDF_RECONSTRUCTION || this->Method > EXACT_RAYS)
+  else if (this->Method < CDF_RECONSTRUCTION || this->Method > RAYS)
     why << "Unknown Method " << this->Method
         << " (0 CDF Reconstruction, 1 Gaussian CDF, 2 Chebyshev, 3 Exact Box, 4 Exact Sphere, 5 "
-           "Histogram CDF, 6 Transfer Function, 7 Exact Rays).";
+           "Histogram CDF, 6 Transfer Function, 7 Exact Rays, 8 Rays).";
   else if (this->UsesOpacityFunction() && !this->OpacityFunction)
-    why << "Method " << (this->Method == EXACT_RAYS ? "Exact Rays" : "Transfer Function")
+    why << "Method "
+        << (this->Method == EXACT_RAYS ? "Exact Rays"
+               : this->Method == RAYS  ? "Rays"
+                                       : "Transfer Function")
         << " needs an opacity function (OpacityFunction): in ParaView "
            "the opacity transfer function of an array (GetOpacityTransferFunction), in VTK a "
            "vtkPiecewiseFunction.";
@@ -45,7 +48,7 @@ bool vtkVolumetricAmbientOcclusion::CheckParameters()
     (this->RayCount < 1 || this->RayCount > vao::kMaximumRayCount))
     why << "RayCount must lie in [1, " << vao::kMaximumRayCount << "] (got " << this->RayCount
         << ").";
-  else if (this->Method == EXACT_RAYS &&
+  else if (this->CastsRays() &&
     !(std::isfinite(this->OpacityUnitDistance) && this->OpacityUnitDistance >= 0.0))
     why << "OpacityUnitDistance must be finite and positive, or 0 for the smallest spacing (got "
         << this->OpacityUnitDistance << ").";
@@ -111,24 +114,24 @@ bool vtkVolumetricAmbientOcclusion::CheckVoxelRadius(
   const int wholeDims[3] = { whole[1] - whole[0] + 1, whole[3] - whole[2] + 1,
     whole[5] - whole[4] + 1 };
   const double* h = input->GetSpacing();
-  if ((this->RadiusUnits == WORLD || this->Method == EXACT_RAYS) &&
+  if ((this->RadiusUnits == WORLD || this->CastsRays()) &&
     !(std::isfinite(h[0]) && h[0] > 0.0 && std::isfinite(h[1]) && h[1] > 0.0 &&
       std::isfinite(h[2]) && h[2] > 0.0))
   {
-    vtkErrorMacro(<< (this->Method == EXACT_RAYS ? "Rays run in world space: they need"
-                                                 : "A radius in world units needs")
+    vtkErrorMacro(<< (this->CastsRays() ? "Rays run in world space: they need"
+                                        : "A radius in world units needs")
                   << " a finite, positive spacing on every axis; the input's is " << h[0] << ", "
                   << h[1] << ", " << h[2] << ". Fix the spacing (e.g. with Change Spacing)"
-                  << (this->Method == EXACT_RAYS ? "." : " or give the radius in voxels."));
+                  << (this->CastsRays() ? "." : " or give the radius in voxels."));
     return false;
   }
   this->ComputeVoxelRadius(h, radius);
-  if (this->Method == EXACT_RAYS)
+  if (this->CastsRays())
   {
     // A ray may run beyond the volume (open sky there): any positive radius is a result.
     const vao::Status rays = vao::checkRayParameters(this->Rays(h));
     if (!rays.ok)
-      vtkErrorMacro(<< "Exact Rays: " << rays.message << ".");
+      vtkErrorMacro(<< (this->Method == RAYS ? "Rays: " : "Exact Rays: ") << rays.message << ".");
     return rays.ok;
   }
   if (radius[0] == 0 && radius[1] == 0 && radius[2] == 0)

@@ -37,5 +37,11 @@ vtkMTimeType vtkVolumetricAmbientOcclusion::GetMTime()
 //------------------------------------------------------------------------------
 bool vtkVolumetricAmbientOcclusion::UsesOpacityFunction() const
 {
-  return this->Method == TRANSFER_FUNCTION || this->Method == EXACT_RAYS;
+  return this->Method == TRANSFER_FUNCTION || this->CastsRays();
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumetricAmbientOcclusion::CastsRays() const
+{
+  return this->Method == EXACT_RAYS || this->Method == RAYS;
 }

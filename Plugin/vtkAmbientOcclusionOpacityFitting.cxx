@@ -30,8 +30,8 @@ struct Reader
 };
 
 const Reader Readers[] = {
-  // Transfer Function and Exact Rays
-  { "VolumetricAmbientOcclusion", "OpacityFunction", 6, 7 },
+  // Transfer Function, Exact Rays and Rays
+  { "VolumetricAmbientOcclusion", "OpacityFunction", 6, 8 },
   { "AmbientOcclusionShading", "OpacityTransferFunction", -1, -1 },
 };
 

@@ -19,10 +19,12 @@ _METHODS = {
     "exact sphere": vtkVolumetricAmbientOcclusion.EXACT_SPHERE,
     "transfer function": vtkVolumetricAmbientOcclusion.TRANSFER_FUNCTION,
     "exact rays": vtkVolumetricAmbientOcclusion.EXACT_RAYS,
+    "rays": vtkVolumetricAmbientOcclusion.RAYS,
 }
 # The methods that read an opacity function.
 _OPACITY_METHODS = {vtkVolumetricAmbientOcclusion.TRANSFER_FUNCTION: "transfer function",
-                    vtkVolumetricAmbientOcclusion.EXACT_RAYS: "exact rays"}
+                    vtkVolumetricAmbientOcclusion.EXACT_RAYS: "exact rays",
+                    vtkVolumetricAmbientOcclusion.RAYS: "rays"}
 _ERF = {"exact": vtkVolumetricAmbientOcclusion.ERF_EXACT, "winitzki": vtkVolumetricAmbientOcclusion.ERF_WINITZKI}
 _BACKEND = {"auto": vtkVolumetricAmbientOcclusion.BACKEND_AUTO, "cpu": vtkVolumetricAmbientOcclusion.BACKEND_CPU,
             "cuda": vtkVolumetricAmbientOcclusion.BACKEND_CUDA}
@@ -66,8 +68,9 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
         "Chebyshev", "Exact Box", "Exact Sphere" (case and underscores do not matter),
         "Transfer Function": 1 - the box's mean opacity, with ``opacity``, or "Exact Rays":
         the ambient occlusion a ray tracer shows through ``opacity``, the mean transmittance
-        of ``ray_count`` rays of length ``radius`` (in voxels: times the smallest sampling).
-    opacity: the opacity transfer function of methods "transfer function" and "exact rays": a
+        of ``ray_count`` rays of length ``radius`` (in voxels: times the smallest sampling), or
+        "Rays": the same AO estimated at a cost that grows like log(radius).
+    opacity: the opacity transfer function of methods "transfer function", "exact rays" and "rays": a
         vtkPiecewiseFunction, ParaView's ``GetOpacityTransferFunction(array)``, or points
         ((N, 2) value and opacity, (N, 4) with midpoint and sharpness, as VTK takes them).
     iso_value: compare with this value instead of each voxel's own.
@@ -77,7 +80,7 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
     variance: also return the box's intensity variance.
     erf: "exact" or "winitzki" (Gaussian CDF's error function).
     ray_count: "exact rays": the rays per voxel (1..65536), spread over a Fibonacci sphere.
-    opacity_unit_distance: "exact rays": the length (units of ``sampling``) over which a
+    opacity_unit_distance: "exact rays" and "rays": the length (units of ``sampling``) over which a
         voxel stops the fraction of light ``opacity`` gives; default the smallest sampling.
     backend: "auto" (CUDA for large extents and the exact methods when a device is present),
         "cpu" or "cuda" (falls back to the CPU with a VolumetricAOWarning); device: the
@@ -118,10 +121,12 @@ def ambient_occlusion(array, spacing=None, radius=10.0, method="Histogram CDF", 
         raise ValueError('method="%s" needs opacity: points (value, opacity) or a vtkPiecewiseFunction'
                          % _OPACITY_METHODS[chosen])
     if chosen not in _OPACITY_METHODS and opacity is not None:
-        raise ValueError('opacity is used by methods "transfer function" and "exact rays" only')
-    rays = chosen == vtkVolumetricAmbientOcclusion.EXACT_RAYS
-    if not rays and (ray_count != 128 or opacity_unit_distance is not None):
-        raise ValueError('ray_count and opacity_unit_distance are used by method="exact rays" only')
+        raise ValueError('opacity is used by methods "transfer function", "exact rays" and "rays" only')
+    if chosen != vtkVolumetricAmbientOcclusion.EXACT_RAYS and ray_count != 128:
+        raise ValueError('ray_count is used by method="exact rays" only')
+    rays = chosen in (vtkVolumetricAmbientOcclusion.EXACT_RAYS, vtkVolumetricAmbientOcclusion.RAYS)
+    if not rays and opacity_unit_distance is not None:
+        raise ValueError('opacity_unit_distance is used by methods "exact rays" and "rays" only')
     function = None if opacity is None else _common.opacity_function(opacity)
     erf_key = _common.choice(erf, _ERF, "erf")
     backend_key = _common.check_backend(backend)

@@ -67,8 +67,9 @@ reference = {name: array_of(serial, name) for name in names}
 serial_histogram = read_image(serial_target[:-len(".pvti")] + "_histogram.pvti")
 serial_tf = read_image(serial_target[:-len(".pvti")] + "_tf.pvti")
 serial_rays = read_image(serial_target[:-len(".pvti")] + "_rays.pvti")
+serial_fast = read_image(serial_target[:-len(".pvti")] + "_fastrays.pvti")
 for data, name in ((serial_histogram, "Histogram"), (serial_histogram, "HistogramSmoothed"),
-                   (serial_tf, "TransferFunction"), (serial_rays, "ExactRays")):
+                   (serial_tf, "TransferFunction"), (serial_rays, "ExactRays"), (serial_fast, "Rays")):
     reference[name] = array_of(data, name)
     check(reference[name].size == 128 * 128 * 136 and reference[name].std() > 0.05, "serial %s is a real field" % name)
 for name in names:
@@ -95,7 +96,8 @@ for input_path in (source, partitioned):
         extents = [tuple(int(v) for v in p.get("Extent").split()) for p in pieces]
         check(len(extents) == ranks, "%s np %d wrote %d pieces %s" % (kind, ranks, len(extents), extents))
         received = {(label, rank): logged_extent("%s.%s" % (target, label), rank)
-                    for label in ("local", "sweeping", "piece", "histogram", "tf", "rays") for rank in range(ranks)}
+                    for label in ("local", "sweeping", "piece", "histogram", "tf", "rays", "fastrays")
+                    for rank in range(ranks)}
         for rank, piece in enumerate(extents):
             slab = received.get(("sweeping", rank))
             thickness = max(slab[2 * a + 1] - slab[2 * a] + 1 for a in range(3) if slab[2 * a:2 * a + 2] !=
@@ -138,6 +140,9 @@ for input_path in (source, partitioned):
         difference = np.abs(array_of(read_image(rays_target), "ExactRays") - reference["ExactRays"]).max()
         check(difference == 0.0, "%s np %d: Exact Rays equals serial (max difference %.3g)"
               % (kind, ranks, difference))
+        fast_target = pieces_received("_fastrays.pvti", "fastrays", 4, "Rays")
+        difference = np.abs(array_of(read_image(fast_target), "Rays") - reference["Rays"]).max()
+        check(difference == 0.0, "%s np %d: Rays equals serial (max difference %.3g)" % (kind, ranks, difference))
         difference = np.abs(array_of(read_image(direct_target), "Direct") - reference["GaussianCDF"]).max()
         check(difference == 0.0, "%s np %d: Volumetric AO of the pieces equals serial (max difference %.3g)"
               % (kind, ranks, difference))

@@ -38,7 +38,7 @@ ao = VolumetricAmbientOcclusion(Input=wavelet)
 
 # Properties: names, defaults, enumeration texts, documentation.
 expected_enums = {
-    "Method": METHODS + ["Transfer Function", "Exact Rays"],  # the last two need an opacity function
+    "Method": METHODS + ["Transfer Function", "Exact Rays", "Rays"],  # the last three need an opacity function
     "RadiusUnits": ["Voxels", "World"],
     "QueryMode": ["Voxel Value", "Iso Value", "Smoothed Voxel Value"],
     "ErfApproximation": ["Exact", "Winitzki"],

@@ -111,4 +111,20 @@ for step, points in enumerate([[-1000.0, 0.0, 0.5, 0.0, 300.0, 0.0, 0.5, 0.0, 40
           "Exact Rays, opacity %d: ran %d times, equals numpy's bit for bit (AO %.3f..%.3f)"
           % (step + 1, len(ray_runs), got.min(), got.max()))
 
+# Rays likewise.
+fast = VolumetricAmbientOcclusion(Input=small, Method="Rays", Radius=3, OpacityFunction=opacity)
+fast.Scalars = ["POINTS", "Density"]
+fast_runs = []
+fast.GetClientSideObject().AddObserver("StartEvent", lambda caller, event: fast_runs.append(1))
+for step, points in enumerate([[-1000.0, 0.0, 0.5, 0.0, 300.0, 0.0, 0.5, 0.0, 400.0, 1.0, 0.5, 0.0],
+                               [-1000.0, 0.0, 0.5, 0.0, -100.0, 0.8, 0.2, 0.9, 250.0, 0.3, 0.5, 0.0]]):
+    opacity.Points = points
+    fast.UpdatePipeline()
+    got = fetch(fast, "AmbientOcclusion")
+    expected = volumetricao.ambient_occlusion(small_density, radius=3, method="rays", opacity=function,
+                                              sampling=spacing[::-1])
+    check(len(fast_runs) == step + 1 and np.array_equal(got, expected) and got.min() < 0.9,
+          "Rays, opacity %d: ran %d times, equals numpy's bit for bit (AO %.3f..%.3f)"
+          % (step + 1, len(fast_runs), got.min(), got.max()))
+
 finish("transfer-function AO follows the opacity transfer function")

@@ -27,12 +27,13 @@ enum class Method : int
   HistogramCdf = 5,
   TransferFunction = 6, // 1 - the box's mean opacity (vao/TransferFunction.h)
   ExactRays = 7,        // ray-cast AO through the opacity (vao/RayCasting.h), the reference
+  Rays = 8,             // an estimate of ExactRays' AO whose cost grows like log R
 };
 
 /// True for the methods that cast rays through the opacity (vao/RayCasting.h).
 VAO_HD bool isRayMethod(Method method)
 {
-  return method == Method::ExactRays;
+  return method == Method::ExactRays || method == Method::Rays;
 }
 
 enum class ErfMode : int

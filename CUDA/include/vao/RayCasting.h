@@ -1,6 +1,7 @@
 // The ray-cast ambient occlusion of a volume seen through its opacity transfer function
 // (docs/methods.md section 11): what a ray tracer shows as the ambient occlusion of a
-// semi-transparent volume. Exact Rays casts the rays; Rays estimates the same quantity.
+// semi-transparent volume. Exact Rays casts the rays; Rays estimates the same quantity
+// from 26 cones around the lattice directions (docs/methods.md section 12).
 #pragma once
 
 #include <array>
@@ -22,7 +23,7 @@ struct RayParameters
   /// u: the opacity alpha(v) is that of a segment of this length (world units); 0, the
   /// smallest spacing (a volume property's Scalar Opacity Unit Distance convention).
   double opacityUnitDistance = 0.0;
-  /// n: the rays per voxel, along the Fibonacci sphere of n points (Exact Rays).
+  /// n: the rays per voxel, along the Fibonacci sphere of n points (Exact Rays only).
   int rayCount = 128;
 };
 
@@ -33,5 +34,9 @@ constexpr int kMaximumRayCount = 65536;
 /// the interpolation's second voxel included. A piece grown by this reach, clipped to the
 /// whole extent, gives its voxels the serial result.
 std::array<int, 3> rayReach(const RayParameters& rays);
+
+/// The same for Rays: its cones' lattice points and the blur they read (a little more than
+/// rayReach).
+std::array<int, 3> rayEstimateReach(const RayParameters& rays);
 
 } // namespace vao

@@ -7,6 +7,7 @@
 #include "cpu/exact_reference/ExactReference.h"
 #include "cpu/histogram_cdf/HistogramChannels.h"
 #include "cpu/ray_casting/ExactRays.h"
+#include "cpu/ray_casting/RayEstimate.h"
 #include "cpu/simd/CpuDispatch.h"
 #include "cpu/smoothed_query/SmoothedQuery.h"
 #include "cpu/transfer_function/TransferFunctionOpenness.h"
@@ -175,6 +176,10 @@ Status separateOpenness(const VolumeView& volume, const Region& region,
   if (parameters.method == Method::ExactRays)
   {
     return detail::computeExactRays(volume, region, parameters, openness, range, stage);
+  }
+  if (parameters.method == Method::Rays)
+  {
+    return detail::computeRays(volume, region, parameters, openness, range, stage);
   }
   return detail::computeExactOpenness(volume, region, parameters, q, openness, stage);
 }

@@ -55,5 +55,19 @@ private:
   std::atomic<bool> Finite{ true };
 };
 
+/// Runs pass(seen), `seen` keeping the range of what the pass writes (null when `range` is
+/// null, so that nothing is kept): Status::cancelled when the pass returns false, else
+/// success with that range in `range`.
+template <class Pass>
+Status keepingOutputRange(OutputRange* range, Pass&& pass)
+{
+  ConcurrentRange seen;
+  if (!pass(range ? &seen : nullptr))
+    return Status::cancelled();
+  if (range)
+    *range = seen.result();
+  return Status::success();
+}
+
 } // namespace detail
 } // namespace vao

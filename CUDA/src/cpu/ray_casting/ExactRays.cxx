@@ -157,18 +157,13 @@ Status computeExactRays(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, float* openness, OutputRange* range,
   const Execution& execution)
 {
-  ConcurrentRange seen;
-  const bool done = dispatchScalarType(volume.type,
-    [&](auto tag)
+  return keepingOutputRange(range,
+    [&](ConcurrentRange* seen)
     {
-      return castRays<decltype(tag)>(
-        volume, region, parameters, openness, range ? &seen : nullptr, execution);
+      return dispatchScalarType(volume.type,
+        [&](auto tag)
+        { return castRays<decltype(tag)>(volume, region, parameters, openness, seen, execution); });
     });
-  if (!done)
-    return Status::cancelled();
-  if (range)
-    *range = seen.result();
-  return Status::success();
 }
 
 } // namespace detail
