@@ -20,8 +20,9 @@ panels seen from the front (the face looks towards -y, LPS; view up +z):
                                         the data's order (Histogram CDF) and from the opacity
                                         the rendering uses (Transfer Function), R = 10
     rays_<data>.png                     the bone shown: ParaView's own (unlit) volume rendering,
-                                        then lit by Histogram CDF, Transfer Function and Exact
-                                        Rays through the bone's opacity (the AO a ray tracer shows)
+                                        then lit by Histogram CDF, Transfer Function, Rays and
+                                        Exact Rays through the bone's opacity (the AO a ray
+                                        tracer shows)
     apply_<data>.png                    what Apply shows with every default (as Show() in
                                         pvpython): Volumetric AO and Occlusion Sweeping (iso -300)
                                         as a Slice, the Shading as a Volume, Isosurface AO on a
@@ -244,7 +245,7 @@ BONE_OPACITY = [-1000.0, 0.0, 0.5, 0.0, 100.0, 0.0, 0.5, 0.0, 300.0, 0.15, 0.5, 
 def rays(source, array, tag, spacing):
     """The bone as ParaView renders it (no AO), then lit by the AO of the value order
     (Histogram CDF), of the box's opacity (Transfer Function) and of the rays through the
-    opacity (Exact Rays): the last is what a ray tracer shows."""
+    opacity (Rays, and Exact Rays: what a ray tracer shows)."""
     bounds = bounds_of(source)
     bone = GetOpacityTransferFunction(array)
     bone.Points = BONE_OPACITY
@@ -263,7 +264,7 @@ def rays(source, array, tag, spacing):
     front_camera(bounds)
     panels = [grab(os.path.join(out_dir, "_panel0.png"))]
     radius = 4 if quick else 6
-    for i, method in enumerate(["Histogram CDF", "Transfer Function", "Exact Rays"]):
+    for i, method in enumerate(["Histogram CDF", "Transfer Function", "Rays", "Exact Rays"]):
         t0 = time.time()
         ao = VolumetricAmbientOcclusion(Input=source, Method=method, Radius=radius, QueryMode="Voxel Value")
         ao.Scalars = ["POINTS", array]
