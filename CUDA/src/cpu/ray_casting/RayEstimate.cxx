@@ -178,18 +178,6 @@ NearPlace placeOf(
   return place;
 }
 
-/// Whether the sample of voxel p lies in the block, [0, n - 1] on every axis.
-inline bool inside(const NearPlace& place, const std::int64_t p[3], const Index3& n)
-{
-  for (int a = 0; a < 3; ++a)
-  {
-    const std::int64_t c = p[a] + place.corner[a];
-    if (c < 0 || c + (place.between[a] ? 1 : 0) > n[a] - 1)
-      return false;
-  }
-  return true;
-}
-
 /// Float grids of the block grown by `pad` cells on each side (zero there).
 struct PaddedGrid
 {
@@ -372,53 +360,81 @@ bool estimate(const VolumeView& view, const Region& region,
     stageExecution(execution, 0.3, 1.0),
     [&](std::int64_t begin, std::int64_t end, ChunkProgress& progress)
     {
+      // A row at a time, cone by cone: each sample's reads are then contiguous along x.
+      std::vector<double> nearDepth(static_cast<std::size_t>(nx));
+      std::vector<double> farDepth(static_cast<std::size_t>(nx));
+      std::vector<double> ao(static_cast<std::size_t>(nx));
+      const std::int64_t x0 = region.begin[0];
       for (std::int64_t row = begin; row < end; ++row)
       {
         const std::int64_t y = region.begin[1] + row % region.size[1];
         const std::int64_t z = region.begin[2] + row / region.size[1];
+        const T* rowStart = volume.data + volume.index(x0, y, z) * volume.stride;
+        const std::int64_t cellStart = grid.index(x0, y, z);
+        std::fill(ao.begin(), ao.end(), 0.0);
+        for (std::size_t c = 0; c < plan.cones.size(); ++c)
+        {
+          const LatticeCone& cone = plan.cones[c];
+          std::fill(nearDepth.begin(), nearDepth.end(), 0.0);
+          for (const NearPlace& place : nearPlaces[c])
+          {
+            // The sample lies in the block: along y and z for the whole row, along x
+            // for the voxels [from, to).
+            const std::int64_t cy = y + place.corner[1], cz = z + place.corner[2];
+            if (cy < 0 || cy + (place.between[1] ? 1 : 0) > n[1] - 1 || cz < 0 ||
+              cz + (place.between[2] ? 1 : 0) > n[2] - 1)
+              continue;
+            const std::int64_t from = std::max<std::int64_t>(0, -place.corner[0] - x0);
+            const std::int64_t to =
+              std::min<std::int64_t>(nx, n[0] - (place.between[0] ? 1 : 0) - place.corner[0] - x0);
+            for (std::int64_t i = from; i < to; ++i)
+            {
+              const T* at = rowStart + i * volume.stride;
+              double value = 0.0;
+              for (int k = 0; k < place.count; ++k)
+                value += place.weights[static_cast<std::size_t>(k)] *
+                  static_cast<double>(at[place.reads[static_cast<std::size_t>(k)]]);
+              nearDepth[static_cast<std::size_t>(i)] += place.length * sigma(value);
+            }
+          }
+          std::fill(farDepth.begin(), farDepth.end(), 0.0);
+          for (std::size_t f = 0; f < cone.far.size(); ++f)
+          {
+            const FarSample& sample = cone.far[f];
+            const std::int64_t qy = y + std::int64_t(sample.step) * cone.step[1];
+            const std::int64_t qz = z + std::int64_t(sample.step) * cone.step[2];
+            const std::int64_t dx = std::int64_t(sample.step) * cone.step[0];
+            if (!grid.holds(0, qy, qz))
+              continue;
+            const std::int64_t from = std::max<std::int64_t>(0, -grid.pad[0] - dx - x0);
+            const std::int64_t to = std::min<std::int64_t>(nx, n[0] + grid.pad[0] - dx - x0);
+            const float* level =
+              levels[static_cast<std::size_t>(sample.level)].data() + cellStart + farOffsets[c][f];
+            for (std::int64_t i = from; i < to; ++i)
+              farDepth[static_cast<std::size_t>(i)] += sample.length * level[i];
+          }
+          // A cone along the volume's face, from a voxel on it: its lattice line stays
+          // inside while half of the cone leaves into open sky.
+          int faces = 0;
+          if (cone.step[1] == 0 && (y == 0 || y == n[1] - 1))
+            ++faces;
+          if (cone.step[2] == 0 && (z == 0 || z == n[2] - 1))
+            ++faces;
+          for (std::int64_t i = 0; i < nx; ++i)
+          {
+            const double g = 1.0 + farDepth[static_cast<std::size_t>(i)] / kFarGamma;
+            double transmitted =
+              std::exp(-nearDepth[static_cast<std::size_t>(i)]) / ((g * g) * (g * g));
+            const bool xFace = cone.step[0] == 0 && (x0 + i == 0 || x0 + i == n[0] - 1);
+            for (int k = 0; k < faces + (xFace ? 1 : 0); ++k)
+              transmitted = 0.5 * (1.0 + transmitted);
+            ao[static_cast<std::size_t>(i)] += cone.weight * transmitted;
+          }
+        }
         float* out = openness + row * nx;
         for (std::int64_t i = 0; i < nx; ++i)
-        {
-          const std::int64_t p[3] = { region.begin[0] + i, y, z };
-          const T* at = volume.data + volume.index(p[0], p[1], p[2]) * volume.stride;
-          const std::int64_t cell = grid.index(p[0], p[1], p[2]);
-          double ao = 0.0;
-          for (std::size_t c = 0; c < plan.cones.size(); ++c)
-          {
-            const LatticeCone& cone = plan.cones[c];
-            double nearDepth = 0.0;
-            for (const NearPlace& place : nearPlaces[c])
-              if (inside(place, p, n))
-              {
-                double value = 0.0;
-                for (int k = 0; k < place.count; ++k)
-                  value += place.weights[static_cast<std::size_t>(k)] *
-                    static_cast<double>(at[place.reads[static_cast<std::size_t>(k)]]);
-                nearDepth += place.length * sigma(value);
-              }
-            double farDepth = 0.0;
-            for (std::size_t f = 0; f < cone.far.size(); ++f)
-            {
-              const FarSample& sample = cone.far[f];
-              const std::int64_t q[3] = { p[0] + std::int64_t(sample.step) * cone.step[0],
-                p[1] + std::int64_t(sample.step) * cone.step[1],
-                p[2] + std::int64_t(sample.step) * cone.step[2] };
-              if (grid.holds(q[0], q[1], q[2]))
-                farDepth += sample.length *
-                  levels[static_cast<std::size_t>(sample.level)]
-                        [static_cast<std::size_t>(cell + farOffsets[c][f])];
-            }
-            const double g = 1.0 + farDepth / kFarGamma;
-            double transmitted = std::exp(-nearDepth) / ((g * g) * (g * g));
-            // A cone along the volume's face, from a voxel on it: its lattice line stays
-            // inside while half of the cone leaves into open sky.
-            for (int a = 0; a < 3; ++a)
-              if (cone.step[a] == 0 && (p[a] == 0 || p[a] == n[a] - 1))
-                transmitted = 0.5 * (1.0 + transmitted);
-            ao += cone.weight * transmitted;
-          }
-          out[i] = static_cast<float>(std::min(1.0, std::max(0.0, ao)));
-        }
+          out[i] =
+            static_cast<float>(std::min(1.0, std::max(0.0, ao[static_cast<std::size_t>(i)])));
         if (seen)
           seen->add(out, nx);
         if (!progress.advance())
