@@ -1,11 +1,13 @@
-"""Transfer Function AO against the Gaussian CDF, in one pvpython process, and the time to
-follow an edit of the opacity transfer function:
+"""Transfer Function AO, Rays and Exact Rays against the Gaussian CDF, in one pvpython
+process, and the time to follow an edit of the opacity transfer function:
 
 - Volumetric AO, R = 10, on the generated 256x256x415 int16 phantom: the Gaussian CDF and
   the Transfer Function method run one after the other in each round (this machine's
   speed drifts within minutes; a round mostly does not), 5 rounds, the median ratio;
 - a 128^3 phantom, R = 10: the opacity's points edited (as the Color Map Editor does), then
-  UpdatePipeline; the time of that update, which re-executes the filter only.
+  UpdatePipeline; the time of that update, which re-executes the filter only;
+- the 128^3 phantom, R = 10, the same opacity: Rays and the Gaussian CDF alternating in 3
+  rounds (the median ratio), and Exact Rays (128 rays) on 4 of its slices, extrapolated.
 
     pvpython Benchmarks/pvpython_transfer_function.py "$(cat build/VolumetricAOPluginPath.txt)"
 """
@@ -60,3 +62,21 @@ for repeat in range(10):
     edits.append(seconds(ao.UpdatePipeline))
 print("128^3 int16, R = 10, an opacity edit then UpdatePipeline (10 edits): median %.1f ms, best %.1f ms"
       % (median(edits) * 1e3, min(edits) * 1e3))
+
+# The rays through the same opacity, against the Gaussian CDF on the same volume.
+rays_times, gaussian_times, ray_ratios = [], [], []
+for repeat in range(3):
+    for method, store in (("Gaussian CDF", gaussian_times), ("Rays", rays_times)):
+        extra = {"OpacityFunction": opacity} if method == "Rays" else {}
+        proxy = VolumetricAmbientOcclusion(Input=small, Method=method, Radius=10, QueryMode="Voxel Value", **extra)
+        store.append(seconds(proxy.UpdatePipeline))
+        Delete(proxy)
+    ray_ratios.append(rays_times[-1] / gaussian_times[-1])
+print("128^3 int16, R = 10: Gaussian CDF median %.0f ms, Rays median %.0f ms; Rays / Gaussian CDF median %.0fx"
+      % (median(gaussian_times) * 1e3, median(rays_times) * 1e3, median(ray_ratios)))
+slab = ExtractSubset(Input=small, VOI=[0, 127, 0, 127, 62, 65])
+exact = VolumetricAmbientOcclusion(Input=slab, Method="Exact Rays", Radius=10, OpacityFunction=opacity)
+slab.UpdatePipeline()
+exact_seconds = seconds(exact.UpdatePipeline) * 128 / 4
+print("  Exact Rays (128 rays), 4 slices extrapolated to 128^3: %.1f s, %.0fx the Gaussian CDF"
+      % (exact_seconds, exact_seconds / median(gaussian_times)))
