@@ -205,7 +205,8 @@ vao::RayParameters vtkVolumetricAmbientOcclusion::Rays(const double spacing[3]) 
   const double smallest = std::min({ spacing[0], spacing[1], spacing[2] });
   rays.radius = this->RadiusUnits == WORLD ? this->Radius : this->Radius * smallest;
   rays.opacityUnitDistance = this->OpacityUnitDistance;
-  rays.rayCount = this->RayCount;
+  if (this->Method == EXACT_RAYS)
+    rays.rayCount = this->RayCount; // Rays casts none: its cones are fixed
   return rays;
 }
 
