@@ -6,8 +6,8 @@
 #include "TestVolumes.h"
 
 #include "VolumeAccess.h"
-#include "cuda/box_statistics/FusedStatistics.h"
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/FusedStatistics.h"
+#include "cuda/common/Pipeline.h"
 #include "cuda/common/SlabPlan.h"
 
 #include "vao/AmbientOcclusion.h"

@@ -1,4 +1,4 @@
-// The device's fused statistics pass (src/cuda/box_statistics/FusedStatistics.h) and its slab
+// The device's fused statistics pass (src/cuda/common/FusedStatistics.h) and its slab
 // schedule (src/cuda/common/SlabPlan.h) run on the host: the same block code as the GPU's, each
 // phase as a loop, the chunks arriving in the schedule's order into poisoned device memory. They
 // are checked against the separate passes (bit for bit where the sums are exact), against

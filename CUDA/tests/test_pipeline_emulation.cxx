@@ -1,4 +1,4 @@
-// The GPU pipeline (src/cuda/box_statistics/Pipeline.h) run on the host: every kernel's per-thread
+// The GPU pipeline (src/cuda/common/Pipeline.h) run on the host: every kernel's per-thread
 // code in a loop, the transposes as plain loops. It checks the indexing, layouts, segments and van
 // Herk blocks of the CUDA backend against the CPU library on machines without a GPU; test_cuda.cxx
 // checks the real device where there is one.
@@ -6,7 +6,7 @@
 
 #include "cpu/exact_reference/ExactReference.h"
 #include "cpu/moment_pyramid/PyramidPlan.h"
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/Pipeline.h"
 #include "cuda/exact_reference/ExactPipeline.h"
 #include "cuda/histogram_cdf/HistogramPipeline.h"
 #include "cuda/moment_pyramid/PyramidPipeline.h"

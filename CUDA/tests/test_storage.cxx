@@ -1,6 +1,7 @@
 // The storage of the large arrays (vao/Storage.h): uninitialised arrays that keep their
 // block, hand it over, refuse sizes they cannot hold, and ask Linux for huge pages; and
 // the outputs' blocks, kept for the next block of their size.
+#include "cpu/common/SparseStorage.h"
 #include "vao/Storage.h"
 
 #include <gtest/gtest.h>

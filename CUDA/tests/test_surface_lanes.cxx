@@ -2,8 +2,8 @@
 // volume half a voxel inside (AO) and level 0's mean there (shadows), on each vector tier,
 // against the scalar definitions (RawSampler.h, trilinearSample) and against a trilinear
 // value written here from its definition. Also the ray bounds of the shadow march.
-#include "cpu/surface_queries/RayBounds.h"
-#include "cpu/surface_queries/SurfaceLanes.h"
+#include "cpu/moment_pyramid/RayBounds.h"
+#include "cpu/moment_pyramid/SurfaceLanes.h"
 
 #include <gtest/gtest.h>
 

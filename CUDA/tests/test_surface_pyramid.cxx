@@ -24,7 +24,7 @@ TEST(SurfacePyramid, TilesHoldTheWholeLevelsVoxels)
     std::vector<vao::MomentLevel> whole;
     ASSERT_TRUE(vao::buildMomentPyramid(f.view(), f.origin, f.spacing, p, whole).ok);
     vao::SurfacePyramid surface = surfacePyramidOf(f, p);
-    vao::detail::PyramidTiles& tiles = *vao::SurfacePyramidAccess::tiles(surface);
+    vao::PyramidTiles& tiles = *vao::SurfacePyramidAccess::tiles(surface);
     ASSERT_EQ(tiles.count(), 2);
     for (int l = 0; l < 2; ++l)
     {
@@ -276,14 +276,13 @@ TEST(SurfacePyramid, SweepsInSlabsHoldingLittleMoreThanItKeeps)
   EXPECT_LT(held(streamed), reached / 2);
 
   vao::SurfacePyramid half = surfacePyramidOf(f, pp);
-  const std::size_t kept =
-    static_cast<std::size_t>(reached / 2) * vao::detail::PyramidTiles::kTileBytes;
+  const std::size_t kept = static_cast<std::size_t>(reached / 2) * vao::PyramidTiles::kTileBytes;
   half.setKeptTileBytes(kept);
   EXPECT_EQ(half.keptTileBytes(), kept);
   ASSERT_TRUE(
     vao::surfaceShadow(half, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
   EXPECT_EQ(shadow, expectedShadow);
-  EXPECT_LE(static_cast<std::size_t>(held(half)) * vao::detail::PyramidTiles::kTileBytes, kept);
+  EXPECT_LE(static_cast<std::size_t>(held(half)) * vao::PyramidTiles::kTileBytes, kept);
   const std::int64_t first = made(half);
   ASSERT_TRUE(
     vao::surfaceShadow(half, points.data(), normals.data(), n, light, {}, shadow.data()).ok);

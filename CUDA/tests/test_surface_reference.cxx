@@ -4,8 +4,8 @@
 // volume (no flat neighbourhood, so the flat rule never decides), anisotropic spacing, an
 // origin off zero, unnormalised normals, and point counts around the lane width of the
 // implementation. Also the lanes' vector path against their plain loop.
-#include "cpu/surface_queries/RayBounds.h"
-#include "cpu/surface_queries/SurfaceLanes.h"
+#include "cpu/moment_pyramid/RayBounds.h"
+#include "cpu/moment_pyramid/SurfaceLanes.h"
 #include "vao/VarianceOcclusionMap.h"
 
 #include <gtest/gtest.h>

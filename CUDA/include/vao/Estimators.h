@@ -1,7 +1,7 @@
 // The openness estimators of docs/methods.md, written once for host and device.
 //
 // Every function here is a pure formula on the statistics of one neighbourhood, so the
-// CPU path and the CUDA kernels (src/cuda/box_statistics/Pipeline.h) include this header and call
+// CPU path and the CUDA kernels (src/cuda/common/Pipeline.h) include this header and call
 // the same code. Openness O = P(v <= q) over the neighbourhood: 1 = fully open, 0 = fully occluded.
 #pragma once
 
@@ -192,7 +192,7 @@ VAO_HD double opennessGaussianCdf(double query, const NeighbourhoodStats& s, Erf
 /// opennessChebyshev given the flat rule's rounding spread (flatRoundingSpread of the
 /// rounding variance): callers that query one set of sums many times take the square root
 /// once. Both answers are formed and one is kept, as the AVX2 form of the surface queries
-/// (src/cpu/surface_queries/SurfaceLanes.h) does with masks; the bound's 0/0 on a flat box is not
+/// (src/cpu/moment_pyramid/SurfaceLanes.h) does with masks; the bound's 0/0 on a flat box is not
 /// kept.
 VAO_HD double opennessChebyshevWithin(
   double query, double mean, double variance, double roundingVariance, double roundingSpread)

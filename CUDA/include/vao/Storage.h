@@ -38,25 +38,6 @@ void recycleStorage(void* block) noexcept;
 std::size_t keptStorageBytes() noexcept;
 void releaseKeptStorage() noexcept;
 
-namespace detail
-{
-/// Sets the most bytes recycleStorage keeps (by default an eighth of the physical memory),
-/// giving back the oldest kept blocks beyond it, and returns the limit it replaces.
-std::size_t setKeptStorageLimit(std::size_t bytes) noexcept;
-
-/// A zero-filled reservation of `bytes` whose 4 KiB pages take memory only once written
-/// (nullptr when it cannot be had): for data kept sparsely at fixed places, such as the
-/// tiles of a level built on demand. Never backed by huge pages, which would fill in 2 MiB
-/// around each page written. Freed with freeSparseStorage(block, bytes).
-void* allocateSparseStorage(std::size_t bytes);
-void freeSparseStorage(void* block, std::size_t bytes) noexcept;
-/// Backs [at, at + bytes) of a sparse reservation (page aligned) before it is written, in
-/// one call instead of a fault per page where the system can (Linux 5.14 and later).
-/// False when the system has no memory left for them (writing them would bring the
-/// out-of-memory killer): the caller fails cleanly instead.
-bool prepareSparseStorage(void* at, std::size_t bytes) noexcept;
-} // namespace detail
-
 /// An array of T in storage. resize leaves the elements uninitialised: the kernels write
 /// every one, in parallel, so a fresh array is first touched by the threads that fill it
 /// instead of by one serial zero-fill. release() hands the block to a new owner (a VTK

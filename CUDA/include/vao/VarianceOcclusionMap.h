@@ -136,10 +136,7 @@ Status surfaceShadow(const std::vector<MomentLevel>& pyramid, const float* point
   const float* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
   const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution = {});
 
-namespace detail
-{
-class PyramidTiles;
-}
+class PyramidTiles; // levels 0 and 1 of a SurfacePyramid, in tiles (the kernel's own)
 
 /// A moment pyramid for the surface queries that holds levels 0 and 1 only where they
 /// sample them. Those levels (96% of a whole pyramid's bytes) are kept in tiles of 8^3
@@ -180,7 +177,7 @@ public:
 private:
   friend struct SurfacePyramidAccess; // the builder's and the queries' way in
   std::vector<MomentLevel> Levels;
-  std::unique_ptr<detail::PyramidTiles> Tiles;
+  std::unique_ptr<PyramidTiles> Tiles;
 };
 
 /// The pyramid of buildMomentPyramid (same checks, levels 2 and up the same), levels 0

@@ -3,6 +3,7 @@
 // exact references; with the voxel's value, the iso value or the smoothed query as q.
 #include "cpu/box_statistics/BoxEngine.h"
 #include "cpu/box_statistics/EstimatorRows.h"
+#include "cpu/box_statistics/TransferFunctionOpenness.h"
 #include "cpu/common/ConcurrentRange.h"
 #include "cpu/exact_reference/ExactReference.h"
 #include "cpu/histogram_cdf/HistogramChannels.h"
@@ -10,7 +11,6 @@
 #include "cpu/ray_casting/RayEstimate.h"
 #include "cpu/simd/CpuDispatch.h"
 #include "cpu/smoothed_query/SmoothedQuery.h"
-#include "cpu/transfer_function/TransferFunctionOpenness.h"
 #include "vao/Storage.h"
 
 #include "vao/Validation.h"

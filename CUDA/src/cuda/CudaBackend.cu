@@ -10,7 +10,7 @@
 #include "cpu/exact_reference/ExactReference.h"
 #include "cpu/moment_pyramid/PyramidPlan.h"
 #include "cuda/CudaExecutor.h"
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/Pipeline.h"
 #include "cuda/common/SlabTransfers.h"
 #include "cuda/exact_reference/ExactPipeline.h"
 #include "cuda/histogram_cdf/HistogramPipeline.h"

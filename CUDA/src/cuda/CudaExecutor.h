@@ -3,9 +3,9 @@
 // passes on the device with optional timing.
 #pragma once
 
-#include "cuda/box_statistics/FusedStatistics.h"
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/FusedStatistics.h"
 #include "cuda/common/PinnedStaging.h"
+#include "cuda/common/Pipeline.h"
 
 #include "vao/Cuda.h"
 

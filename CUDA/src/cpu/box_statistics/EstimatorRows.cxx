@@ -7,7 +7,7 @@
 // Everything else rounds as the scalar formulas (this file has no fused multiply-adds).
 #include "cpu/box_statistics/EstimatorRows.h"
 
-#include "cpu/box_statistics/EstimatorLanes.h"
+#include "cpu/simd/EstimatorLanes.h"
 
 namespace vao
 {

@@ -5,7 +5,7 @@
 // has no fused multiply-adds, though here they could not change an exact product).
 #include "cpu/box_statistics/MomentRows.h"
 
-#include "cpu/box_statistics/EstimatorLanes.h"
+#include "cpu/simd/EstimatorLanes.h"
 
 namespace vao
 {

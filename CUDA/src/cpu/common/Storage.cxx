@@ -1,7 +1,7 @@
 // Storage of the large arrays: blocks aligned to 2 MiB and advised to use transparent huge
 // pages, the outputs' blocks kept for the next output of their size, and sparse
 // reservations backed page by page (see vao/Storage.h).
-#include "vao/Storage.h"
+#include "cpu/common/SparseStorage.h"
 
 #include <cerrno>
 #include <cstddef>

@@ -1,6 +1,6 @@
 // The tiled levels of a SurfacePyramid (LevelTiles.h): marking, and building the tiles
 // marked with the blur of the whole levels (PyramidBlur.h).
-#include "vao/Storage.h"
+#include "cpu/common/SparseStorage.h"
 
 #include "cpu/moment_pyramid/LevelTiles.h"
 #include "cpu/moment_pyramid/PyramidBlur.h"
@@ -347,11 +347,14 @@ bool LevelTiles::build(const std::vector<TileRun>& runs, const Execution& execut
     });
 }
 
+} // namespace detail
+
 bool PyramidTiles::buildMarked(const Execution& execution)
 {
   for (int l = 0; l < this->count(); ++l)
   {
-    if (!this->levels[l]->buildMarked(pyramidStageExecution(execution, l, l, this->count())))
+    if (!this->levels[l]->buildMarked(
+          detail::pyramidStageExecution(execution, l, l, this->count())))
       return false;
   }
   return true;
@@ -384,7 +387,7 @@ void PyramidTiles::releaseBehind(bool up)
   for (std::size_t l = 0; l < this->levels.size(); ++l)
   {
     // From the farthest layer behind to the farthest one marked (none: every layer).
-    LevelTiles& level = *this->levels[l];
+    detail::LevelTiles& level = *this->levels[l];
     const std::int64_t top = level.layerCount() - 1;
     const bool marked = level.highestMarked() >= 0;
     const std::int64_t layers = !marked ? top + 1
@@ -395,5 +398,4 @@ void PyramidTiles::releaseBehind(bool up)
   }
 }
 
-} // namespace detail
 } // namespace vao

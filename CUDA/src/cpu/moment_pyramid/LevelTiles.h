@@ -20,7 +20,7 @@
 
 #include "vao/VarianceOcclusionMap.h"
 
-#include "cpu/surface_queries/LevelGrid.h"
+#include "cpu/moment_pyramid/LevelGrid.h"
 
 #include <algorithm>
 #include <atomic>
@@ -198,14 +198,16 @@ private:
   LevelGrid Grid;
 };
 
+} // namespace detail
+
 /// The tiled levels of a SurfacePyramid (levels 0 and 1, as many as it has).
 class PyramidTiles
 {
 public:
   static constexpr int kLevels = 2;
-  static constexpr std::size_t kTileBytes = kTileFloats * sizeof(float);
-  std::unique_ptr<TilePool> pool; // the levels' tiles, declared first: it outlives them
-  std::vector<std::unique_ptr<LevelTiles>> levels;
+  static constexpr std::size_t kTileBytes = detail::kTileFloats * sizeof(float);
+  std::unique_ptr<detail::TilePool> pool; // the levels' tiles, declared first: it outlives them
+  std::vector<std::unique_ptr<detail::LevelTiles>> levels;
   /// The built tiles' memory a query keeps (SurfaceWalk.h): past it, it releases the
   /// layers its sweep has left behind.
   std::size_t keptBytes = static_cast<std::size_t>(-1);
@@ -215,7 +217,7 @@ public:
   bool upward = true;
 
   /// Level l's tiles, or nullptr when level l is whole.
-  LevelTiles* at(int l) const
+  detail::LevelTiles* at(int l) const
   {
     return l >= 0 && l < static_cast<int>(this->levels.size()) ? this->levels[l].get() : nullptr;
   }
@@ -235,7 +237,6 @@ public:
   void releaseBehind(bool up);
 };
 
-} // namespace detail
 } // namespace vao
 
 namespace vao
@@ -244,9 +245,6 @@ namespace vao
 struct SurfacePyramidAccess
 {
   static std::vector<MomentLevel>& levels(SurfacePyramid& pyramid) { return pyramid.Levels; }
-  static std::unique_ptr<detail::PyramidTiles>& tiles(SurfacePyramid& pyramid)
-  {
-    return pyramid.Tiles;
-  }
+  static std::unique_ptr<PyramidTiles>& tiles(SurfacePyramid& pyramid) { return pyramid.Tiles; }
 };
 } // namespace vao

@@ -10,8 +10,8 @@
 // take its target from its parameter.
 #pragma once
 
-#include "cpu/box_statistics/ErfPieces.h"
 #include "cpu/simd/CpuDispatch.h"
+#include "cpu/simd/ErfPieces.h"
 
 #if VAO_HAVE_AVX2_TARGET && defined(VAO_HAVE_LIBMVEC)
 #define VAO_VECTOR_MATH 1 // glibc's vector erf, exp and log (libmvec)

@@ -2,7 +2,7 @@
 // CUDA backend's headers include it).
 #pragma once
 
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/Pipeline.h"
 
 #include <cuda_runtime.h>
 

@@ -6,7 +6,7 @@
 // i computes; the tests check the plan on the host.
 #pragma once
 
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/Pipeline.h"
 
 #include <vector>
 

@@ -7,7 +7,7 @@
 #pragma once
 
 #include "cuda/CudaExecutor.h"
-#include "cuda/box_statistics/FusedStatistics.h"
+#include "cuda/common/FusedStatistics.h"
 #include "cuda/common/SlabPlan.h"
 
 #include "VolumeAccess.h"

@@ -10,7 +10,7 @@
 // one launch stays short (progress and Abort between them, no display watchdog).
 #pragma once
 
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/Pipeline.h"
 
 #include <cstdint>
 #include <vector>

@@ -9,8 +9,8 @@
 // rounds (one fused pass each, or three).
 #pragma once
 
-#include "cuda/box_statistics/FusedStatistics.h"
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/FusedStatistics.h"
+#include "cuda/common/Pipeline.h"
 
 namespace vao
 {

@@ -10,7 +10,7 @@
 
 #include "BlurTaps.h"
 #include "cpu/moment_pyramid/PyramidPlan.h"
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/Pipeline.h"
 
 #include <vector>
 

@@ -5,8 +5,8 @@
 #include "vao/VarianceOcclusionMap.h"
 
 #include "cpu/moment_pyramid/LevelTiles.h"
-#include "cpu/surface_queries/RayBounds.h"
-#include "cpu/surface_queries/SurfaceLanes.h"
+#include "cpu/moment_pyramid/RayBounds.h"
+#include "cpu/moment_pyramid/SurfaceLanes.h"
 
 #include <array>
 #include <vector>

@@ -6,11 +6,11 @@
 #include "VolumeAccess.h"
 #include "cpu/common/Parallel.h"
 #include "cpu/moment_pyramid/LevelTiles.h"
-#include "cpu/surface_queries/PreparedPyramid.h"
-#include "cpu/surface_queries/SurfaceBatches.h"
-#include "cpu/surface_queries/SurfaceChecks.h"
-#include "cpu/surface_queries/SurfaceLanes.h"
-#include "cpu/surface_queries/SurfaceWalk.h"
+#include "cpu/moment_pyramid/PreparedPyramid.h"
+#include "cpu/moment_pyramid/SurfaceBatches.h"
+#include "cpu/moment_pyramid/SurfaceChecks.h"
+#include "cpu/moment_pyramid/SurfaceLanes.h"
+#include "cpu/moment_pyramid/SurfaceWalk.h"
 
 #include <algorithm>
 #include <cmath>
@@ -149,7 +149,7 @@ void batchMarch(const PreparedPyramid& pyramid, const MarchBounds& bounds,
 /// withOcclusion and withShadow check their arguments, prepare the levels and return
 /// run(mark, sample), or the error. `tiles`: a SurfacePyramid's tiled levels, or null.
 template <class P, class Run>
-Status withOcclusion(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles,
+Status withOcclusion(const std::vector<MomentLevel>& pyramid, PyramidTiles* tiles,
   const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const P* points, const P* normals, std::int64_t count,
   const SurfaceOcclusionParameters& parameters, float* out, Run&& run)
@@ -174,7 +174,7 @@ Status withOcclusion(const std::vector<MomentLevel>& pyramid, detail::PyramidTil
   }
   const double h = std::min(spacing[0], std::min(spacing[1], spacing[2]));
   // The tiled levels' samples: at p + k r_l n (batchOcclusion's positions).
-  const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t)
+  const auto mark = [&](const PointLanes& lanes, PyramidTiles& t)
   {
     for (int l = 0; l < std::min(levels, t.count()); ++l)
     {
@@ -219,10 +219,9 @@ Status withOcclusion(const std::vector<MomentLevel>& pyramid, detail::PyramidTil
 }
 
 template <class P, class Run>
-Status withShadow(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles* tiles,
-  const P* points, const P* normals, std::int64_t count,
-  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
-  float* out, Run&& run)
+Status withShadow(const std::vector<MomentLevel>& pyramid, PyramidTiles* tiles, const P* points,
+  const P* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* out, Run&& run)
 {
   int levels = 0;
   Status status = detail::checkQuery(
@@ -250,7 +249,7 @@ Status withShadow(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles*
   PreparedPyramid prepared(pyramid, levels, tiles);
   const std::vector<detail::MarchStep> schedule =
     detail::marchSchedule(prepared.kernelRadius.data(), levels, 2.0 * bounds.diagonal());
-  const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t)
+  const auto mark = [&](const PointLanes& lanes, PyramidTiles& t)
   {
     for (int k = 0; k < lanes.used; ++k)
     {
@@ -293,7 +292,7 @@ Status withShadow(const std::vector<MomentLevel>& pyramid, detail::PyramidTiles*
 
 /// run(mark, sample) of withOcclusion or withShadow: the sweep of the points.
 template <class P>
-auto sweepWith(detail::PyramidTiles* tiles, const P* points, const P* normals, std::int64_t count,
+auto sweepWith(PyramidTiles* tiles, const P* points, const P* normals, std::int64_t count,
   const Execution& execution)
 {
   return [=, &execution](auto& mark, auto& sample)
@@ -309,7 +308,7 @@ auto sweepWith(detail::PyramidTiles* tiles, const P* points, const P* normals, s
 const char* const kQueryBuffers = "the surface query's buffers (tiles, cell and ray bounds)";
 
 template <class P>
-Status guardedOcclusion(const std::vector<MomentLevel>& levels, detail::PyramidTiles* tiles,
+Status guardedOcclusion(const std::vector<MomentLevel>& levels, PyramidTiles* tiles,
   const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const P* points, const P* normals, std::int64_t count,
   const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
@@ -323,10 +322,9 @@ Status guardedOcclusion(const std::vector<MomentLevel>& levels, detail::PyramidT
 }
 
 template <class P>
-Status guardedShadow(const std::vector<MomentLevel>& levels, detail::PyramidTiles* tiles,
-  const P* points, const P* normals, std::int64_t count,
-  const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
-  float* out, const Execution& execution)
+Status guardedShadow(const std::vector<MomentLevel>& levels, PyramidTiles* tiles, const P* points,
+  const P* normals, std::int64_t count, const std::array<double, 3>& lightDirection,
+  const SurfaceOcclusionParameters& parameters, float* out, const Execution& execution)
 {
   return catchOutOfMemory(kQueryBuffers,
     [&]
@@ -339,7 +337,7 @@ Status guardedShadow(const std::vector<MomentLevel>& levels, detail::PyramidTile
 /// Both queries in one sweep: each batch marks the tiles of both and samples both, so a
 /// tile both reach is built once (their results are those of the two sweeps).
 template <class P>
-Status guardedBoth(const std::vector<MomentLevel>& levels, detail::PyramidTiles* tiles,
+Status guardedBoth(const std::vector<MomentLevel>& levels, PyramidTiles* tiles,
   const VolumeView& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, const P* points, const P* normals, std::int64_t count,
   const std::array<double, 3>& lightDirection, const SurfaceOcclusionParameters& parameters,
@@ -357,7 +355,7 @@ Status guardedBoth(const std::vector<MomentLevel>& levels, detail::PyramidTiles*
             shadow,
             [&](auto& markShadow, auto& sampleShadow)
             {
-              const auto mark = [&](const PointLanes& lanes, detail::PyramidTiles& t)
+              const auto mark = [&](const PointLanes& lanes, PyramidTiles& t)
               {
                 markOcclusion(lanes, t);
                 markShadow(lanes, t);

@@ -16,7 +16,7 @@ namespace avx2
 {
 #define VAO_LANES VAO_AVX2_HELPER
 #define VAO_LANES_ENTRY VAO_AVX2_INLINE
-#include "cpu/box_statistics/EstimatorLanes-inl.h"
+#include "cpu/simd/EstimatorLanes-inl.h"
 #undef VAO_LANES
 #undef VAO_LANES_ENTRY
 } // namespace avx2
@@ -25,7 +25,7 @@ namespace avx512
 {
 #define VAO_LANES VAO_AVX512_HELPER
 #define VAO_LANES_ENTRY VAO_AVX512_INLINE
-#include "cpu/box_statistics/EstimatorLanes-inl.h"
+#include "cpu/simd/EstimatorLanes-inl.h"
 #undef VAO_LANES
 #undef VAO_LANES_ENTRY
 } // namespace avx512

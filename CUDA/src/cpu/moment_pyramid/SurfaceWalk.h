@@ -9,7 +9,7 @@
 #pragma once
 
 #include "cpu/moment_pyramid/LevelTiles.h"
-#include "cpu/surface_queries/SurfaceBatches.h"
+#include "cpu/moment_pyramid/SurfaceBatches.h"
 
 #include <cstdint>
 #include <limits>

@@ -5,10 +5,10 @@
 // float-to-int conversions and selects stay branches.)
 #pragma once
 
-#include "cpu/box_statistics/EstimatorLanes.h"
+#include "cpu/moment_pyramid/LevelGrid.h"
+#include "cpu/moment_pyramid/RawSampler.h"
+#include "cpu/simd/EstimatorLanes.h"
 #include "cpu/simd/GatherLanes.h"
-#include "cpu/surface_queries/LevelGrid.h"
-#include "cpu/surface_queries/RawSampler.h"
 
 #include <cmath>
 #include <vector>
@@ -63,7 +63,7 @@ namespace avx2
 {
 #define VAO_LANES VAO_AVX2_HELPER
 #define VAO_LANES_ENTRY VAO_AVX2_INLINE
-#include "cpu/surface_queries/SurfaceLanes-inl.h"
+#include "cpu/moment_pyramid/SurfaceLanes-inl.h"
 #undef VAO_LANES
 #undef VAO_LANES_ENTRY
 } // namespace avx2
@@ -72,7 +72,7 @@ namespace avx512
 {
 #define VAO_LANES VAO_AVX512_HELPER
 #define VAO_LANES_ENTRY VAO_AVX512_INLINE
-#include "cpu/surface_queries/SurfaceLanes-inl.h"
+#include "cpu/moment_pyramid/SurfaceLanes-inl.h"
 #undef VAO_LANES
 #undef VAO_LANES_ENTRY
 } // namespace avx512

@@ -3,7 +3,7 @@
 // 2 r + 1 voxels of a lane. No CUDA runtime calls.
 #pragma once
 
-#include "cuda/box_statistics/AxisPasses.h"
+#include "cuda/common/AxisPasses.h"
 
 namespace vao
 {

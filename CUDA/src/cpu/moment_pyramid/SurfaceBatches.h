@@ -4,7 +4,7 @@
 #pragma once
 
 #include "cpu/common/Parallel.h"
-#include "cpu/surface_queries/LevelGrid.h"
+#include "cpu/moment_pyramid/LevelGrid.h"
 
 #include <algorithm>
 #include <array>

@@ -8,7 +8,7 @@
 // occlusion stops, which changes no maximum.
 #pragma once
 
-#include "cpu/surface_queries/LevelGrid.h"
+#include "cpu/moment_pyramid/LevelGrid.h"
 
 #include <algorithm>
 #include <array>

@@ -8,8 +8,8 @@
 // is what limits the radius a block's shared memory allows.
 #pragma once
 
-#include "cuda/box_statistics/FusedTile.h"
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/FusedTile.h"
+#include "cuda/common/Pipeline.h"
 
 namespace vao
 {

@@ -12,7 +12,7 @@
 // Other types (and a log-scale function undefined at some 8/16-bit values): a first pass
 // writes every voxel's fixed-point opacity, evaluated once per voxel, and reports a value
 // where the function is undefined.
-#include "cpu/transfer_function/TransferFunctionOpenness.h"
+#include "cpu/box_statistics/TransferFunctionOpenness.h"
 
 #include "cpu/box_statistics/MomentPlanes.h"
 #include "cpu/common/ConcurrentRange.h"

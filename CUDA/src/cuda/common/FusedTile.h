@@ -2,7 +2,7 @@
 // output columns, one per thread; 32 along x so that a warp reads whole rows.
 #pragma once
 
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/Pipeline.h"
 
 namespace vao
 {

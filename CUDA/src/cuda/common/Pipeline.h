@@ -12,8 +12,8 @@
 // the statistics themselves are never written out for the openness.
 #pragma once
 
-#include "cuda/box_statistics/AxisPasses.h"
-#include "cuda/box_statistics/VanHerkPasses.h"
+#include "cuda/common/AxisPasses.h"
+#include "cuda/common/VanHerkPasses.h"
 
 #include <algorithm>
 #include <cstdint>

@@ -20,9 +20,9 @@
 // reaches every barrier.
 #pragma once
 
-#include "cuda/box_statistics/FusedExtrema.h"
-#include "cuda/box_statistics/FusedTile.h"
-#include "cuda/box_statistics/Pipeline.h"
+#include "cuda/common/FusedExtrema.h"
+#include "cuda/common/FusedTile.h"
+#include "cuda/common/Pipeline.h"
 
 namespace vao
 {
