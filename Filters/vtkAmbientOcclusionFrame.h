@@ -13,6 +13,12 @@
 #include <string>
 
 class vtkImageData;
+class vtkPolyData;
+
+namespace vao
+{
+struct VolumeView;
+}
 
 namespace vtkAmbientOcclusionFrame
 {
@@ -38,6 +44,16 @@ bool FrameOf(vtkImageData* image, Frame& frame, std::string& error);
 /// Places `part`, laid out in the frame's image coordinates (its origin there), in the
 /// physical frame: its origin mapped, the frame's direction matrix copied.
 void PlaceInWorld(const Frame& frame, vtkImageData* part);
+
+/// Whether the points of `surface` (some of them) lie on the iso-surface of the oriented
+/// volume (`volume` in `frame`, its grid at `origin` and `spacing` in the image's frame)
+/// only along the image's axes, its direction matrix ignored: what VTK 9.2's
+/// vtkContourFilter and ParaView 5.11's Contour extract from an oriented image.
+bool SurfaceAlongImageAxes(vtkPolyData* surface, const vao::VolumeView& volume, const Frame& frame,
+  const std::array<double, 3>& origin, const std::array<double, 3>& spacing);
+
+/// The bounds of the surface's points in the image's axis-aligned frame (from `frame`).
+void SurfaceBoundsInFrame(vtkPolyData* surface, const Frame& frame, double bounds[6]);
 
 } // namespace vtkAmbientOcclusionFrame
 
