@@ -9,10 +9,12 @@ properties table (a table whose header starts with "| Property |"), written as
 the proxy does not have (a renamed or removed one). It also checks that the images the
 pages show exist, and that no file of the repository refers to the reference text outside
 it (the string built in OUTSIDE_REFERENCE), and that every relative link of README.md,
-Data/README.md, CUDA/README.md and docs/ names a file that exists. It prints "ok: ..." or
+Data/README.md, CUDA/README.md and docs/ names a file that exists, as does every
+repository path they name in their text (CUDA/..., Testing/..., and so on). It prints "ok: ..." or
 "FAILED: ..." per check (vao_test_utils.check) and ends with "N passed, M failed"; the exit
 status is 1 when anything failed.
 """
+import glob
 import os
 import re
 import sys
@@ -187,6 +189,54 @@ def check_links(root):
                   % (os.path.relpath(page, root), line, target))
 
 
+# A repository path in the text: a top-level folder of the repository, then a path, after
+# a space, a backtick, a bracket or a parenthesis (so that build/Testing/... is not one).
+TOP_LEVEL = ("CUDA", "Filters", "Plugin", "Python", "Testing", "Examples", "Benchmarks", "Data", "docs",
+             "cmake", ".ci")
+NAMED_PATH = re.compile(r"(?:^|(?<=[\s`(\[\"']))((?:%s)/[A-Za-z0-9_.*/+-]*)" % "|".join(re.escape(t) for t in TOP_LEVEL),
+                        re.M)
+
+SOURCE_NAME = re.compile(r"`([A-Za-z0-9_-]+\.(?:cxx|h|cu|py|xml|cmake|sh))`")
+
+
+def manual_pages(root):
+    pages = [os.path.join(root, "README.md"), os.path.join(root, "Data", "README.md"),
+             os.path.join(root, "CUDA", "README.md")]
+    for folder, _, files in os.walk(os.path.join(root, "docs")):
+        pages += [os.path.join(folder, f) for f in sorted(files) if f.endswith(".md")]
+    return [page for page in pages if os.path.exists(page)]
+
+
+def check_named_paths(root):
+    """Every repository path the README and the manual name (in text, code or commands)
+    exists: a file or folder, or a pattern with * that matches one."""
+    count = 0
+    for page in manual_pages(root):
+        text = open(page, encoding="utf-8").read()
+        for match in NAMED_PATH.finditer(text):
+            path = match.group(1).rstrip(".,:;")
+            count += 1
+            line = text.count("\n", 0, match.start()) + 1
+            where = os.path.join(root, path)
+            exists = bool(glob.glob(where)) if "*" in path else os.path.exists(where)
+            if not exists:
+                check(False, "%s:%d: names %s, which does not exist" % (os.path.relpath(page, root), line, path))
+    check(count > 100, "%d repository paths named in README.md and docs/, every one exists (or is listed above)"
+          % count)
+    # A source file named alone (`vtkFoo.cxx`, `Parallel.h`) is a file of the repository.
+    names = set()
+    for folder, directories, files in os.walk(root):
+        directories[:] = [d for d in directories if d != ".git" and not d.startswith("build")]
+        names.update(files)
+    for page in manual_pages(root):
+        text = open(page, encoding="utf-8").read()
+        for match in SOURCE_NAME.finditer(text):
+            line = text.count("\n", 0, match.start()) + 1
+            if match.group(1) not in names:
+                check(False, "%s:%d: names %s, which is no file of the repository"
+                      % (os.path.relpath(page, root), line, match.group(1)))
+
+
 def main(argv):
     if len(argv) != 2:
         sys.stderr.write("usage: python3 %s REPO_ROOT\n" % argv[0])
@@ -195,6 +245,7 @@ def main(argv):
     check_pages(root)
     check_outside_references(root)
     check_links(root)
+    check_named_paths(root)
     print(summary())
     finish("the manual matches the plugin")
 
