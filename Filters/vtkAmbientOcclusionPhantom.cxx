@@ -1,7 +1,7 @@
 #include "vtkAmbientOcclusionPhantom.h"
 
 #include "vtkAmbientOcclusionMemory.h"
-#include "vtkAmbientOcclusionRanges.h"
+#include "vtkAmbientOcclusionRequest.h"
 
 #include "vtkDataObject.h"
 #include "vtkImageData.h"
@@ -198,16 +198,8 @@ int vtkAmbientOcclusionPhantom::RequestInformation(
 int vtkAmbientOcclusionPhantom::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
-  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
-  // output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, output, "choose smaller Dimensions.",
-    [&]() -> int
-    {
-      const int result = this->ProduceOutput(outputVector);
-      vtkAmbientOcclusionRanges::CacheOutput(output);
-      return result;
-    });
+  return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector, "choose smaller Dimensions.",
+    [&] { return this->ProduceOutput(outputVector); });
 }
 
 //------------------------------------------------------------------------------

@@ -3,7 +3,7 @@
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionMemory.h"
 #include "vtkAmbientOcclusionOpacity.h"
-#include "vtkAmbientOcclusionRanges.h"
+#include "vtkAmbientOcclusionRequest.h"
 
 #include "vtkAmbientOcclusionCollectives.h"
 
@@ -251,17 +251,9 @@ bool vtkAmbientOcclusionShading::ShadePoints(vtkPointData* pd, vtkDataArray* sca
 int vtkAmbientOcclusionShading::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
-  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
-  // output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, output,
+  return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
     "shade a smaller extent or compute it in pieces (streaming or more MPI ranks).",
-    [&]() -> int
-    {
-      const int result = this->ProduceOutput(inputVector, outputVector);
-      vtkAmbientOcclusionRanges::CacheOutput(output);
-      return result;
-    });
+    [&] { return this->ProduceOutput(inputVector, outputVector); });
 }
 
 //------------------------------------------------------------------------------

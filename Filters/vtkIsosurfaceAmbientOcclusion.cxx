@@ -10,7 +10,7 @@
 #include "vtkAmbientOcclusionFrame.h"
 #include "vtkAmbientOcclusionMemory.h"
 #include "vtkAmbientOcclusionPyramidImages.h"
-#include "vtkAmbientOcclusionRanges.h"
+#include "vtkAmbientOcclusionRequest.h"
 
 #include "vao/Validation.h"
 #include "vao/VarianceOcclusionMap.h"
@@ -398,17 +398,9 @@ bool vtkIsosurfaceAmbientOcclusion::CheckSurfaceInVolume(
 int vtkIsosurfaceAmbientOcclusion::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
-  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
-  // output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, output,
+  return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
     "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.",
-    [&]() -> int
-    {
-      const int result = this->ProduceOutput(inputVector, outputVector);
-      vtkAmbientOcclusionRanges::CacheOutput(output);
-      return result;
-    });
+    [&] { return this->ProduceOutput(inputVector, outputVector); });
 }
 
 //------------------------------------------------------------------------------

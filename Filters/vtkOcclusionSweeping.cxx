@@ -1,7 +1,7 @@
 #include "vtkOcclusionSweeping.h"
 
 #include "vtkAmbientOcclusionMemory.h"
-#include "vtkAmbientOcclusionRanges.h"
+#include "vtkAmbientOcclusionRequest.h"
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionCollectives.h"
@@ -234,17 +234,9 @@ void vtkOcclusionSweeping::WarnNoSurface(const std::string& arrayName)
 int vtkOcclusionSweeping::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
-  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
-  // output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, output,
+  return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
     "use more MPI ranks, turn OutputOctantVisibility off, or crop or resample the volume.",
-    [&]() -> int
-    {
-      const int result = this->ProduceOutput(inputVector, outputVector);
-      vtkAmbientOcclusionRanges::CacheOutput(output);
-      return result;
-    });
+    [&] { return this->ProduceOutput(inputVector, outputVector); });
 }
 
 //------------------------------------------------------------------------------

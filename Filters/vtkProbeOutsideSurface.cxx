@@ -4,7 +4,7 @@
 #include "vtkAmbientOcclusionCollectives.h"
 #include "vtkAmbientOcclusionExtents.h"
 #include "vtkAmbientOcclusionMemory.h"
-#include "vtkAmbientOcclusionRanges.h"
+#include "vtkAmbientOcclusionRequest.h"
 
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
@@ -280,16 +280,9 @@ int vtkProbeOutsideSurface::RequestData(
     output->Initialize();
     return 1;
   }
-  // Allocation failure (the sample points, the probe's arrays, caching the ranges) becomes
-  // an error and an empty output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, output,
+  return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
     "try a surface with fewer points (Decimate), or more MPI ranks.",
-    [&]() -> int
-    {
-      const int result = this->ProduceOutput(surface, volume, output);
-      vtkAmbientOcclusionRanges::CacheOutput(output);
-      return result;
-    });
+    [&] { return this->ProduceOutput(surface, volume, output); });
 }
 
 //------------------------------------------------------------------------------

@@ -1,7 +1,6 @@
 #include "vtkVarianceOcclusionMap.h"
 
-#include "vtkAmbientOcclusionMemory.h"
-#include "vtkAmbientOcclusionRanges.h"
+#include "vtkAmbientOcclusionRequest.h"
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionCollectives.h"
@@ -111,17 +110,9 @@ vao::PyramidParameters vtkVarianceOcclusionMap::Parameters() const
 int vtkVarianceOcclusionMap::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
-  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
-  // output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, output,
+  return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
     "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.",
-    [&]() -> int
-    {
-      const int result = this->ProduceOutput(inputVector, outputVector);
-      vtkAmbientOcclusionRanges::CacheOutput(output);
-      return result;
-    });
+    [&] { return this->ProduceOutput(inputVector, outputVector); });
 }
 
 //------------------------------------------------------------------------------

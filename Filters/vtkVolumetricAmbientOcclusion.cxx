@@ -9,6 +9,7 @@
 #include "vtkAmbientOcclusionMemory.h"
 #include "vtkAmbientOcclusionOpacity.h"
 #include "vtkAmbientOcclusionRanges.h"
+#include "vtkAmbientOcclusionRequest.h"
 #include "vtkAmbientOcclusionThresholds.h"
 
 #include "vao/AmbientOcclusion.h"
@@ -299,18 +300,10 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
 int vtkVolumetricAmbientOcclusion::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
-  // Allocation failure anywhere below (caching the ranges too) is an error and an empty
-  // output, not an abort.
-  return vtkAmbientOcclusionMemory::Guard(this, output,
+  return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
     "compute it in pieces (streaming or more MPI ranks), on a smaller extent, or without "
     "ComputeVariance.",
-    [&]() -> int
-    {
-      const int result = this->ProduceOutput(inputVector, outputVector);
-      vtkAmbientOcclusionRanges::CacheOutput(output);
-      return result;
-    });
+    [&] { return this->ProduceOutput(inputVector, outputVector); });
 }
 
 //------------------------------------------------------------------------------
