@@ -114,20 +114,6 @@ inline void expectStatsMatchCpu(
   EXPECT_EQ(failures, 0) << "voxels that differ, of " << n;
 }
 
-struct MethodCase
-{
-  vao::Method method;
-  vao::ErfMode erf;
-  const char* name;
-};
-
-const MethodCase kSeparableMethods[] = {
-  { vao::Method::CdfReconstruction, vao::ErfMode::Exact, "CdfReconstruction" },
-  { vao::Method::GaussianCdf, vao::ErfMode::Exact, "GaussianCdf exact erf" },
-  { vao::Method::GaussianCdf, vao::ErfMode::Winitzki, "GaussianCdf Winitzki erf" },
-  { vao::Method::Chebyshev, vao::ErfMode::Exact, "Chebyshev" },
-};
-
 /// GPU openness and variance of the region against the CPU's: openness to
 /// kOpennessTolerance (absolute), variance to kStatsTolerance (relative).
 inline void expectOpennessMatchesCpu(const vao::VolumeView& view, const vao::Region& region,

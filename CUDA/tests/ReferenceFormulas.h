@@ -2,6 +2,7 @@
 // Estimators.h: a reference that called the library's own formulas would share its bugs.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -93,6 +94,39 @@ double histogramCdf(double q, const std::vector<double>& t, Fraction&& fractionA
     return f0;
   const double f1 = fractionAtOrBelow(t[k + 1]);
   return f0 + (q - t[k]) / (t[k + 1] - t[k]) * (f1 - f0);
+}
+
+/// docs/methods.md (Notation): the trilinear value at world point p of a grid of dims[a]
+/// values get(i, j, k) on each axis, the first at `origin`, `spacing` apart; p is clamped to
+/// the grid. The sum over the cell's 8 corners of the product of the per-axis weights.
+template <class Dims, class Point, class Get>
+double trilinear(
+  const Dims& dims, const Point& origin, const Point& spacing, const Point& p, Get get)
+{
+  long long lo[3], hi[3];
+  double w[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const double last = static_cast<double>(dims[a] - 1);
+    const double u = std::fmin(std::fmax((p[a] - origin[a]) / spacing[a], 0.0), last);
+    lo[a] = static_cast<long long>(std::floor(u));
+    hi[a] = std::min<long long>(lo[a] + 1, static_cast<long long>(dims[a] - 1));
+    w[a] = u - std::floor(u);
+  }
+  double sum = 0.0;
+  for (int c = 0; c < 8; ++c)
+  {
+    double weight = 1.0;
+    long long i[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const bool upper = (c >> a) & 1;
+      i[a] = upper ? hi[a] : lo[a];
+      weight *= upper ? w[a] : 1.0 - w[a];
+    }
+    sum += weight * get(i[0], i[1], i[2]);
+  }
+  return sum;
 }
 
 } // namespace reference

@@ -13,6 +13,30 @@
 namespace vaotest
 {
 
+/// A moment method with its erf: the cases every path of the separable methods is tested on.
+struct MethodCase
+{
+  vao::Method method;
+  vao::ErfMode erf;
+  const char* name;
+};
+
+inline const MethodCase kSeparableMethods[] = {
+  { vao::Method::CdfReconstruction, vao::ErfMode::Exact, "CDF Reconstruction" },
+  { vao::Method::GaussianCdf, vao::ErfMode::Exact, "Gaussian CDF" },
+  { vao::Method::GaussianCdf, vao::ErfMode::Winitzki, "Gaussian CDF (Winitzki)" },
+  { vao::Method::Chebyshev, vao::ErfMode::Exact, "Chebyshev" },
+};
+
+/// The separable methods and their oracle.
+inline const MethodCase kMomentMethodsAndExactBox[] = {
+  kSeparableMethods[0],
+  kSeparableMethods[1],
+  kSeparableMethods[2],
+  kSeparableMethods[3],
+  { vao::Method::ExactBox, vao::ErfMode::Exact, "Exact Box" },
+};
+
 template <class T>
 vao::ScalarType scalarTypeOf();
 template <>

@@ -66,21 +66,6 @@ double exactOpenness(
   return static_cast<double>(below) / static_cast<double>(total);
 }
 
-struct MethodCase
-{
-  vao::Method method;
-  vao::ErfMode erf;
-  const char* name;
-};
-
-const MethodCase kMethods[] = {
-  { vao::Method::GaussianCdf, vao::ErfMode::Exact, "Gaussian CDF" },
-  { vao::Method::GaussianCdf, vao::ErfMode::Winitzki, "Gaussian CDF (Winitzki)" },
-  { vao::Method::Chebyshev, vao::ErfMode::Exact, "Chebyshev" },
-  { vao::Method::CdfReconstruction, vao::ErfMode::Exact, "CDF Reconstruction" },
-  { vao::Method::ExactBox, vao::ErfMode::Exact, "Exact Box" },
-};
-
 /// Every method on every flat box of the volume: openness exactly the reference's.
 template <class T>
 void expectFlatBoxesExact(const std::vector<T>& v, const std::string& label)
@@ -103,7 +88,7 @@ void expectFlatBoxesExact(const std::vector<T>& v, const std::string& label)
           flats += isFlat;
         }
     ASSERT_GT(flats, 1000) << label << ": the scene must have flat boxes";
-    for (const MethodCase& m : kMethods)
+    for (const vaotest::MethodCase& m : vaotest::kMomentMethodsAndExactBox)
     {
       vao::AmbientOcclusionParameters p;
       p.method = m.method;

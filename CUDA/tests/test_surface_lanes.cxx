@@ -5,6 +5,8 @@
 #include "cpu/moment_pyramid/RayBounds.h"
 #include "cpu/moment_pyramid/SurfaceLanes.h"
 
+#include "ReferenceFormulas.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -20,36 +22,9 @@ namespace
 
 using Vec3 = std::array<double, 3>;
 
-/// The trilinear value at world p of a grid of `dims` values get(i, j, k), p clamped to
-/// the grid: linear along x on the cell's four x edges, then along y, then along z.
-template <class Get>
-double nestedTrilinear(
-  const vao::Index3& dims, const Vec3& origin, const Vec3& spacing, const Vec3& p, Get get)
-{
-  std::int64_t lower[3], upper[3];
-  double t[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    const double u =
-      std::min(std::max((p[a] - origin[a]) / spacing[a], 0.0), static_cast<double>(dims[a] - 1));
-    lower[a] = static_cast<std::int64_t>(std::floor(u));
-    upper[a] = std::min<std::int64_t>(lower[a] + 1, dims[a] - 1);
-    t[a] = u - std::floor(u);
-  }
-  const auto along = [](double a, double b, double f) { return a + f * (b - a); };
-  double plane[2];
-  for (int k = 0; k < 2; ++k)
-  {
-    const std::int64_t z = k ? upper[2] : lower[2];
-    const double front = along(get(lower[0], lower[1], z), get(upper[0], lower[1], z), t[0]);
-    const double back = along(get(lower[0], upper[1], z), get(upper[0], upper[1], z), t[0]);
-    plane[k] = along(front, back, t[1]);
-  }
-  return along(plane[0], plane[1], t[2]);
-}
-
 /// rawLanes on each vector tier against RawSampler (the same bits: the same operations)
-/// and against refTrilinear, for a volume of T with `components` values a voxel.
+/// and against the reference trilinear (ReferenceFormulas.h), for a volume of T with `components`
+/// values a voxel.
 template <class T>
 void checkRawLanes(T low, T high, int components)
 {
@@ -96,7 +71,7 @@ void checkRawLanes(T low, T high, int components)
           return static_cast<double>(
             values[static_cast<std::size_t>(components * ((l * dims[1] + j) * dims[0] + i))]);
         };
-        const double reference = nestedTrilinear(dims, origin, spacing, p, value);
+        const double reference = vaotest::reference::trilinear(dims, origin, spacing, p, value);
         EXPECT_NEAR(vector[k], reference, 1e-12 * std::max(1.0, static_cast<double>(high)))
           << "lane " << k;
       }
@@ -163,8 +138,8 @@ TEST(SurfaceLanes, MeanLanesEqualTheTrilinearSample)
             return static_cast<double>(
               level.mean[static_cast<std::size_t>((l * dims[1] + j) * dims[0] + i)]);
           };
-          const double reference =
-            nestedTrilinear(dims, level.origin, level.spacing, { x[k], y[k], z[k] }, mean);
+          const double reference = vaotest::reference::trilinear(
+            dims, level.origin, level.spacing, Vec3{ x[k], y[k], z[k] }, mean);
           EXPECT_NEAR(vector[k], reference, 1e-12)
             << "lane " << k << ", tier " << static_cast<int>(tier);
         }

@@ -8,6 +8,8 @@
 #include "cpu/moment_pyramid/SurfaceLanes.h"
 #include "vao/VarianceOcclusionMap.h"
 
+#include "ReferenceFormulas.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,38 +23,6 @@ namespace
 
 using Vec3 = std::array<double, 3>;
 
-/// Trilinear value of a grid of `dims` values at world p (clamped): the sum over the 8
-/// corners of the product of the per-axis weights.
-template <class Get>
-double refTrilinear(
-  const vao::Index3& dims, const Vec3& origin, const Vec3& spacing, const Vec3& p, Get get)
-{
-  std::int64_t lo[3], hi[3];
-  double w[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    double u = (p[a] - origin[a]) / spacing[a];
-    u = std::clamp(u, 0.0, static_cast<double>(dims[a] - 1));
-    lo[a] = static_cast<std::int64_t>(std::floor(u));
-    hi[a] = std::min<std::int64_t>(lo[a] + 1, dims[a] - 1);
-    w[a] = u - std::floor(u);
-  }
-  double sum = 0.0;
-  for (int c = 0; c < 8; ++c)
-  {
-    double weight = 1.0;
-    std::int64_t i[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      const bool upper = (c >> a) & 1;
-      i[a] = upper ? hi[a] : lo[a];
-      weight *= upper ? w[a] : 1.0 - w[a];
-    }
-    sum += weight * get(i[0], i[1], i[2]);
-  }
-  return sum;
-}
-
 /// Occluder fraction of q for a level sample: Cantelli's bound or the Gaussian tail.
 double refOcclusion(const vao::MomentLevel& level, const Vec3& p, double q, vao::Method estimator)
 {
@@ -64,9 +34,10 @@ double refOcclusion(const vao::MomentLevel& level, const Vec3& p, double q, vao:
         a[static_cast<std::size_t>((z * level.dims[1] + y) * level.dims[0] + x)]);
     };
   };
-  const double mu = refTrilinear(level.dims, level.origin, level.spacing, p, at(level.mean));
-  const double s2 =
-    std::max(0.0, refTrilinear(level.dims, level.origin, level.spacing, p, at(level.variance)));
+  const double mu =
+    vaotest::reference::trilinear(level.dims, level.origin, level.spacing, p, at(level.mean));
+  const double s2 = std::max(0.0,
+    vaotest::reference::trilinear(level.dims, level.origin, level.spacing, p, at(level.variance)));
   if (estimator == vao::Method::GaussianCdf)
     return 1.0 - 0.5 * std::erfc(-(q - mu) / std::sqrt(2.0 * s2));
   return q <= mu ? 1.0 : s2 / (s2 + (q - mu) * (q - mu));
@@ -137,7 +108,7 @@ double refAo(const Scene& s, int i, const vao::SurfaceOcclusionParameters& p)
   const double h = std::min({ s.spacing[0], s.spacing[1], s.spacing[2] });
   const double q = p.query == vao::SurfaceQuery::IsoValue
     ? p.isoValue
-    : refTrilinear(s.dims, s.origin, s.spacing, along(x, n, -h / 2),
+    : vaotest::reference::trilinear(s.dims, s.origin, s.spacing, along(x, n, -h / 2),
         [&](std::int64_t a, std::int64_t b, std::int64_t c)
         {
           return static_cast<double>(
@@ -164,7 +135,7 @@ double refShadow(const Scene& s, int i, const Vec3& light, const vao::SurfaceOcc
   if (p.query == vao::SurfaceQuery::HalfVoxelInside) // level 0's mean half a voxel inside
   {
     const Vec3 inside = along(x, n, -h / 2);
-    q = refTrilinear(base.dims, base.origin, base.spacing, inside,
+    q = vaotest::reference::trilinear(base.dims, base.origin, base.spacing, inside,
       [&](std::int64_t a, std::int64_t b, std::int64_t c)
       {
         return static_cast<double>(

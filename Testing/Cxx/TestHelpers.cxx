@@ -1,6 +1,8 @@
 #include "TestHelpers.h"
 #include "ScanPath.h"
 
+#include "ReferenceFormulas.h"
+
 #include "vtkMetaImageReader.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
@@ -96,6 +98,54 @@ vtkSmartPointer<vtkDataSet> WithPointArrayResized(
         array->SetComponent(i, c, 0.0);
   }
   return copy;
+}
+
+void ExpectRefused(
+  const std::vector<std::string>& errors, vtkDataSet* output, const std::string& words)
+{
+  ASSERT_FALSE(errors.empty()) << "no error for: " << words;
+  const bool named = std::any_of(errors.begin(), errors.end(),
+    [&](const std::string& e) { return e.find(words) != std::string::npos; });
+  EXPECT_TRUE(named) << "no error mentions '" << words << "': " << errors[0];
+  ASSERT_NE(output, nullptr);
+  EXPECT_EQ(output->GetNumberOfPoints(), 0);
+}
+
+Differences Compare(const std::vector<double>& estimate, const std::vector<double>& exact,
+  const std::function<bool(std::size_t)>& counted)
+{
+  double squares = 0.0, sum = 0.0;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < exact.size(); ++i)
+  {
+    if (counted && !counted(i))
+      continue;
+    const double d = estimate[i] - exact[i];
+    squares += d * d;
+    sum += d;
+    ++count;
+  }
+  if (count == 0)
+    return {};
+  return { std::sqrt(squares / count), sum / count };
+}
+
+double Trilinear(vtkImageData* image, const double x[3], vtkDataArray* field)
+{
+  vtkDataArray* values = field ? field : image->GetPointData()->GetScalars();
+  const int* ext = image->GetExtent();
+  const std::array<long long, 3> dims = { ext[1] - ext[0] + 1, ext[3] - ext[2] + 1,
+    ext[5] - ext[4] + 1 };
+  std::array<double, 3> first, spacing, point;
+  for (int a = 0; a < 3; ++a)
+  {
+    spacing[a] = image->GetSpacing()[a];
+    first[a] = image->GetOrigin()[a] + ext[2 * a] * spacing[a];
+    point[a] = x[a];
+  }
+  return reference::trilinear(dims, first, spacing, point,
+    [&](long long i, long long j, long long k)
+    { return values->GetComponent((k * dims[1] + j) * dims[0] + i, 0); });
 }
 
 } // namespace vaotest

@@ -58,6 +58,26 @@ vtkSmartPointer<vtkImageData> ReadMetaImage(const std::string& path);
 /// Values of a one-component array as doubles.
 std::vector<double> Values(vtkDataArray* array);
 
+/// Component 0 of `field` (a point array of `image`; its scalars when null) at world point
+/// x, trilinear between the voxels around it (reference::trilinear of ReferenceFormulas.h),
+/// x clamped to the image; no direction matrix.
+double Trilinear(vtkImageData* image, const double x[3], vtkDataArray* field = nullptr);
+
+/// How `estimate` differs from `exact` over the voxels `counted` picks (every voxel without
+/// it): the root mean square and the mean of estimate - exact (0 over no voxel).
+struct Differences
+{
+  double rms = 0.0, mean = 0.0;
+};
+Differences Compare(const std::vector<double>& estimate, const std::vector<double>& exact,
+  const std::function<bool(std::size_t)>& counted = {});
+
+/// What every filter does with input it refuses: at least one error, one of which names
+/// the problem (contains `words`, as written), and an output without points. For the
+/// tests' wrappers that run each filter on the bad input (ExpectRejected).
+void ExpectRefused(
+  const std::vector<std::string>& errors, vtkDataSet* output, const std::string& words);
+
 /// Fills `values` (any numeric array) with f(i, j, k) over the image's dimensions, x
 /// fastest, names it "Density" and makes it the image's point scalars.
 void SetDensity(

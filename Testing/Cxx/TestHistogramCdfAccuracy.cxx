@@ -52,24 +52,14 @@ struct Rmse
   double all, visible;
 };
 
-Rmse Compare(const std::vector<double>& estimate, const std::vector<double>& exact,
+/// RMSE over every voxel and over the visible ones (above a tenth of the value range).
+Rmse Errors(const std::vector<double>& estimate, const std::vector<double>& exact,
   const std::vector<double>& values)
 {
   const auto range = std::minmax_element(values.begin(), values.end());
   const double threshold = *range.first + 0.1 * (*range.second - *range.first);
-  double all = 0, visible = 0;
-  size_t shown = 0;
-  for (size_t i = 0; i < exact.size(); ++i)
-  {
-    const double e = (estimate[i] - exact[i]) * (estimate[i] - exact[i]);
-    all += e;
-    if (values[i] > threshold)
-    {
-      visible += e;
-      ++shown;
-    }
-  }
-  return { std::sqrt(all / exact.size()), std::sqrt(visible / std::max<size_t>(1, shown)) };
+  return { Compare(estimate, exact).rms,
+    Compare(estimate, exact, [&](std::size_t i) { return values[i] > threshold; }).rms };
 }
 
 /// Prints the table rows of one scan and radius; checks Histogram CDF's bars.
@@ -92,7 +82,7 @@ void AccuracyOf(const char* scan, const std::string& file, double radius)
   std::cout << std::fixed << std::setprecision(3);
   for (const Row& row : rows)
   {
-    const Rmse e = Compare(Openness(image, radius, MethodOnly(row.method)), exact, values);
+    const Rmse e = Errors(Openness(image, radius, MethodOnly(row.method)), exact, values);
     std::cout << "| " << scan << " | " << radius << " | " << row.name << " | " << e.all << " | "
               << e.visible << " |" << std::endl;
     if (row.method == vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF)
@@ -112,7 +102,7 @@ void AccuracyOf(const char* scan, const std::string& file, double radius)
   for (const Row& row : { rows[0], rows[1] })
   {
     const Rmse e =
-      Compare(Openness(image, radius, MethodOnly(row.method, smoothed)), exactSmoothed, values);
+      Errors(Openness(image, radius, MethodOnly(row.method, smoothed)), exactSmoothed, values);
     std::cout << "| " << scan << " | " << radius << " | " << row.name << ", smoothed query | "
               << e.all << " | " << e.visible << " |" << std::endl;
     if (row.method == vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF)

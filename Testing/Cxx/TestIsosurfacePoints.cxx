@@ -66,38 +66,6 @@ std::pair<std::vector<double>, std::vector<double>> Shaded(
   return { Values(pd->GetArray("AmbientOcclusion")), Values(pd->GetArray("Shadow")) };
 }
 
-/// The volume's first array at world point x, trilinear between the eight voxels around it
-/// (x inside the volume, no direction matrix).
-double Trilinear(vtkImageData* volume, const double x[3])
-{
-  double origin[3], spacing[3];
-  volume->GetOrigin(origin);
-  volume->GetSpacing(spacing);
-  int dims[3];
-  volume->GetDimensions(dims);
-  vtkDataArray* values = volume->GetPointData()->GetScalars();
-  int i0[3];
-  double t[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    const double u = (x[a] - origin[a]) / spacing[a];
-    i0[a] = std::min(static_cast<int>(std::floor(u)), dims[a] - 2);
-    t[a] = u - i0[a];
-  }
-  double sum = 0.0;
-  for (int c = 0; c < 8; ++c)
-  {
-    const int d[3] = { c & 1, (c >> 1) & 1, (c >> 2) & 1 };
-    double w = 1.0;
-    for (int a = 0; a < 3; ++a)
-      w *= d[a] ? t[a] : 1.0 - t[a];
-    const vtkIdType id =
-      i0[0] + d[0] + dims[0] * (i0[1] + d[1] + static_cast<vtkIdType>(dims[1]) * (i0[2] + d[2]));
-    sum += w * values->GetComponent(id, 0);
-  }
-  return sum;
-}
-
 /// The surface with its normals replaced by `normals` (float, 3 a point).
 vtkSmartPointer<vtkPolyData> WithNormals(vtkPolyData* surface, const std::vector<float>& normals)
 {

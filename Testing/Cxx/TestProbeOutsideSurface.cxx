@@ -66,33 +66,6 @@ vtkSmartPointer<vtkPolyData> Contour(vtkImageData* field)
   return contour->GetOutput();
 }
 
-/// The field's component 0 at world point x, trilinear over the voxel that holds it.
-double Trilinear(vtkImageData* image, vtkDataArray* field, const double x[3])
-{
-  const int* ext = image->GetExtent();
-  const double* o = image->GetOrigin();
-  const double* h = image->GetSpacing();
-  int base[3];
-  double t[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    const double u = (x[a] - o[a]) / h[a] - ext[2 * a];
-    base[a] = std::clamp(static_cast<int>(std::floor(u)), 0, ext[2 * a + 1] - ext[2 * a] - 1);
-    t[a] = u - base[a];
-  }
-  const int nx = ext[1] - ext[0] + 1, ny = ext[3] - ext[2] + 1;
-  double sum = 0.0;
-  for (int c = 0; c < 8; ++c)
-  {
-    const int di = c & 1, dj = (c >> 1) & 1, dk = (c >> 2) & 1;
-    const double w = (di ? t[0] : 1 - t[0]) * (dj ? t[1] : 1 - t[1]) * (dk ? t[2] : 1 - t[2]);
-    const vtkIdType id =
-      (static_cast<vtkIdType>(base[2] + dk) * ny + base[1] + dj) * nx + base[0] + di;
-    sum += w * field->GetComponent(id, 0);
-  }
-  return sum;
-}
-
 /// Whether world point x lies in the image's box.
 bool Inside(vtkImageData* image, const double x[3])
 {
@@ -173,8 +146,8 @@ TEST(ProbeOutsideSurface, SamplesEveryArrayOutsideTheSurface)
         out[k] = p[k] + offset * n[k] / length;
         in[k] = p[k] - offset * n[k] / length;
       }
-      const double expected = Trilinear(field, truth, Inside(field, out) ? out : p);
-      const double expectedInside = Trilinear(field, truth, Inside(field, in) ? in : p);
+      const double expected = Trilinear(field, Inside(field, out) ? out : p, truth);
+      const double expectedInside = Trilinear(field, Inside(field, in) ? in : p, truth);
       const double scale = std::max(1.0, std::abs(expected));
       worst = std::max({ worst, std::abs(a->GetComponent(i, 0) - expected) / scale,
         std::abs(b->GetComponent(i, 0) - expected) / scale });
