@@ -183,6 +183,23 @@ inline void spherePoints(
   }
 }
 
+/// A small level of `dims` voxels, anisotropic and off the origin, whose moments
+/// moments(i, mean, variance) gives voxel by voxel, in order.
+template <class Moments>
+vao::MomentLevel smallLevel(const vao::Index3& dims, Moments&& moments)
+{
+  vao::MomentLevel level;
+  level.dims = dims;
+  level.origin = { 1.0, -2.0, 0.5 };
+  level.spacing = { 1.5, 0.5, 2.0 };
+  const auto n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
+  level.mean.resize(n);
+  level.variance.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    moments(i, level.mean[i], level.variance[i]);
+  return level;
+}
+
 /// f(p) for the surface query parameters of each estimator a level can feed (Chebyshev,
 /// Gaussian CDF) with each query (half a voxel inside, the iso value 0.5).
 template <class F>

@@ -315,25 +315,23 @@ TEST(OutOfMemory, EveryEntryPointReportsItOrSucceeds)
     {
       std::fill(out.begin(), out.end(), -1.0f);
       const std::int64_t count = static_cast<std::int64_t>(out.size());
+      // The query on either form of the pyramid (each overload takes it first).
+      const auto query = [&](auto& pyramid)
+      {
+        return shadow ? vao::surfaceShadow(pyramid, points.data(), normals.data(), count,
+                          { 0, 0, 1 }, {}, out.data())
+                      : vao::surfaceAmbientOcclusion(pyramid, v.ctView(), origin, spacing,
+                          points.data(), normals.data(), count, {}, out.data());
+      };
       if (tiled)
       {
         vao::SurfacePyramid pyramid;
-        vao::Status s = vao::buildSurfacePyramid(v.ctView(), origin, spacing, {}, pyramid);
-        if (s.ok)
-          s = shadow ? vao::surfaceShadow(
-                         pyramid, points.data(), normals.data(), count, { 0, 0, 1 }, {}, out.data())
-                     : vao::surfaceAmbientOcclusion(pyramid, v.ctView(), origin, spacing,
-                         points.data(), normals.data(), count, {}, out.data());
-        return s;
+        const vao::Status s = vao::buildSurfacePyramid(v.ctView(), origin, spacing, {}, pyramid);
+        return s.ok ? query(pyramid) : s;
       }
       std::vector<vao::MomentLevel> pyramid;
-      vao::Status s = vao::buildMomentPyramid(v.ctView(), origin, spacing, {}, pyramid);
-      if (s.ok)
-        s = shadow ? vao::surfaceShadow(
-                       pyramid, points.data(), normals.data(), count, { 0, 0, 1 }, {}, out.data())
-                   : vao::surfaceAmbientOcclusion(pyramid, v.ctView(), origin, spacing,
-                       points.data(), normals.data(), count, {}, out.data());
-      return s;
+      const vao::Status s = vao::buildMomentPyramid(v.ctView(), origin, spacing, {}, pyramid);
+      return s.ok ? query(pyramid) : s;
     };
   };
   entries.push_back(

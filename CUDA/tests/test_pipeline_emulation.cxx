@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
 
 using namespace vaotest;
 using vao::gpu::Index;
@@ -98,28 +99,49 @@ TEST(GpuPipelineOnHost, EveryEstimatorEqualsTheCpu)
 namespace
 {
 
+/// The parameters of a query of `method` with `radius`, of the voxel's value or of isoValue.
+vao::AmbientOcclusionParameters queryOf(
+  vao::Method method, const vao::Radius& radius, bool iso, double isoValue)
+{
+  vao::AmbientOcclusionParameters p;
+  p.method = method;
+  p.radius = radius;
+  p.queryMode = iso ? vao::QueryMode::IsoValue : vao::QueryMode::VoxelValue;
+  p.isoValue = isoValue;
+  return p;
+}
+
+/// The device's passes run on the host, passes(executor, block, geometry, out), equal the
+/// CPU library's result of `p` voxel for voxel.
+template <class T, class Passes>
+void expectPassesLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims,
+  const vao::Region& region, const vao::AmbientOcclusionParameters& p, Passes&& passes)
+{
+  std::vector<float> cpu(region.voxelCount());
+  ASSERT_TRUE(vao::computeAmbientOcclusion(viewOf(v, dims), region, p, { cpu.data(), nullptr }).ok);
+  const auto g = vao::gpu::geometryFor(dims, region, p.radius);
+  const std::vector<T> block = blockOf(v, dims, region, g);
+  std::vector<float> gpu(region.voxelCount(), -1.0f);
+  HostExecutor ex;
+  passes(ex, block.data(), g, gpu.data());
+  for (size_t i = 0; i < cpu.size(); ++i)
+    ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " method " << static_cast<int>(p.method);
+}
+
 /// Histogram CDF through the GPU pipeline on the host against the CPU library.
 template <class T>
 void expectHistogramLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims,
   const vao::Region& region, const vao::Radius& radius, int bins, bool iso, double isoValue)
 {
-  const auto view = viewOf(v, dims);
-  vao::AmbientOcclusionParameters p;
-  p.method = vao::Method::HistogramCdf;
-  p.radius = radius;
-  p.queryMode = iso ? vao::QueryMode::IsoValue : vao::QueryMode::VoxelValue;
-  p.isoValue = isoValue;
-  ASSERT_TRUE(vao::volumeThresholds(view, bins, p.thresholds).ok);
-  std::vector<float> cpu(region.voxelCount());
-  ASSERT_TRUE(vao::computeAmbientOcclusion(view, region, p, { cpu.data(), nullptr }).ok);
-  const auto g = vao::gpu::geometryFor(dims, region, radius);
-  const std::vector<T> block = blockOf(v, dims, region, g);
-  std::vector<float> gpu(region.voxelCount(), -1.0f);
-  HostExecutor ex;
-  vao::gpu::runHistogramPasses<T>(ex, block.data(), g, p.thresholds.data(),
-    static_cast<int>(p.thresholds.size()), iso, isoValue, gpu.data());
-  for (size_t i = 0; i < cpu.size(); ++i)
-    ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " bins " << bins;
+  vao::AmbientOcclusionParameters p = queryOf(vao::Method::HistogramCdf, radius, iso, isoValue);
+  ASSERT_TRUE(vao::volumeThresholds(viewOf(v, dims), bins, p.thresholds).ok);
+  SCOPED_TRACE("bins " + std::to_string(bins));
+  expectPassesLikeTheCpu(v, dims, region, p,
+    [&](HostExecutor& ex, const T* block, const auto& g, float* out)
+    {
+      vao::gpu::runHistogramPasses<T>(ex, block, g, p.thresholds.data(),
+        static_cast<int>(p.thresholds.size()), iso, isoValue, out);
+    });
 }
 
 /// Exact Box or Exact Sphere through the device's passes equals the CPU reference voxel
@@ -129,23 +151,13 @@ void expectExactLikeTheCpu(const std::vector<T>& v, const vao::Index3& dims,
   const vao::Region& region, const vao::Radius& radius, vao::Method method, bool iso,
   double isoValue, double visitsPerLaunch)
 {
-  const auto view = viewOf(v, dims);
-  vao::AmbientOcclusionParameters p;
-  p.method = method;
-  p.radius = radius;
-  p.queryMode = iso ? vao::QueryMode::IsoValue : vao::QueryMode::VoxelValue;
-  p.isoValue = isoValue;
-  std::vector<float> cpu(region.voxelCount());
-  ASSERT_TRUE(vao::computeAmbientOcclusion(view, region, p, { cpu.data(), nullptr }).ok);
-  const auto g = vao::gpu::geometryFor(dims, region, radius);
-  const std::vector<T> block = blockOf(v, dims, region, g);
-  std::vector<float> gpu(region.voxelCount(), -1.0f);
-  HostExecutor ex;
-  vao::gpu::runExactPasses<T>(ex, block.data(), g,
-    vao::detail::neighbourhoodRowHalfWidths(radius, method == vao::Method::ExactSphere), iso,
-    isoValue, gpu.data(), 0.0, 1.0, visitsPerLaunch);
-  for (size_t i = 0; i < cpu.size(); ++i)
-    ASSERT_EQ(gpu[i], cpu[i]) << "voxel " << i << " method " << static_cast<int>(method);
+  expectPassesLikeTheCpu(v, dims, region, queryOf(method, radius, iso, isoValue),
+    [&](HostExecutor& ex, const T* block, const auto& g, float* out)
+    {
+      vao::gpu::runExactPasses<T>(ex, block, g,
+        vao::detail::neighbourhoodRowHalfWidths(radius, method == vao::Method::ExactSphere), iso,
+        isoValue, out, 0.0, 1.0, visitsPerLaunch);
+    });
 }
 
 /// The device's pyramid passes on the host against the CPU's buildMomentPyramid: the same

@@ -5,6 +5,7 @@
 #include "cpu/moment_pyramid/RayBounds.h"
 #include "cpu/moment_pyramid/SurfaceLanes.h"
 
+#include "PyramidTestSupport.h"
 #include "ReferenceFormulas.h"
 
 #include <gtest/gtest.h>
@@ -20,7 +21,7 @@
 namespace
 {
 
-using Vec3 = std::array<double, 3>;
+using vaotest::Vec3;
 
 /// rawLanes on each vector tier against RawSampler (the same bits: the same operations)
 /// and against the reference trilinear (ReferenceFormulas.h), for a volume of T with `components`
@@ -158,18 +159,12 @@ TEST(SurfaceLanes, RayBoundsHoldEveryCellBoundAheadOnTheRay)
   for (const vao::Index3 dims :
     { vao::Index3{ 9, 7, 5 }, vao::Index3{ 1, 6, 4 }, vao::Index3{ 8, 1, 1 } })
   {
-    vao::MomentLevel level;
-    level.dims = dims;
-    level.origin = { 1.0, -2.0, 0.5 };
-    level.spacing = { 1.5, 0.5, 2.0 };
-    const auto n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
-    level.mean.resize(n);
-    level.variance.resize(n);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      level.mean[i] = static_cast<float>(value(rng));
-      level.variance[i] = static_cast<float>(std::fabs(value(rng)));
-    }
+    const vao::MomentLevel level = vaotest::smallLevel(dims,
+      [&](std::size_t, float& mean, float& variance)
+      {
+        mean = static_cast<float>(value(rng));
+        variance = static_cast<float>(std::fabs(value(rng)));
+      });
     vao::detail::LevelGrid grid(level);
     const vao::detail::CellBounds cells(level, grid);
     for (int trial = 0; trial < 60; ++trial)

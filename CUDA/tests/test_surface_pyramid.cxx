@@ -8,6 +8,27 @@
 
 using namespace vaotest;
 
+namespace
+{
+/// The AO and the shadows of the points on the whole pyramid (buildMomentPyramid): what
+/// every SurfacePyramid must give bit for bit.
+void wholePyramidAnswers(const Field& f, const std::vector<double>& points,
+  const std::vector<double>& normals, const std::array<double, 3>& light, std::vector<float>& ao,
+  std::vector<float>& shadow)
+{
+  const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
+  std::vector<vao::MomentLevel> whole;
+  ASSERT_TRUE(vao::buildMomentPyramid(f.view(), f.origin, f.spacing, {}, whole).ok);
+  ao.assign(static_cast<std::size_t>(n), -1.0f);
+  shadow.assign(static_cast<std::size_t>(n), -1.0f);
+  ASSERT_TRUE(vao::surfaceAmbientOcclusion(
+    whole, f.view(), f.origin, f.spacing, points.data(), normals.data(), n, {}, ao.data())
+                .ok);
+  ASSERT_TRUE(
+    vao::surfaceShadow(whole, points.data(), normals.data(), n, light, {}, shadow.data()).ok);
+}
+} // namespace
+
 TEST(SurfacePyramid, TilesHoldTheWholeLevelsVoxels)
 {
   // Every tile of levels 0 and 1 built, read back in the layout of LevelTiles.h (tile
@@ -225,16 +246,9 @@ TEST(SurfacePyramid, SweepsInSlabsHoldingLittleMoreThanItKeeps)
   }
   const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
   vao::PyramidParameters pp;
-  std::vector<vao::MomentLevel> whole;
-  ASSERT_TRUE(vao::buildMomentPyramid(f.view(), f.origin, f.spacing, pp, whole).ok);
-  std::vector<float> expectedAo(n), expectedShadow(n), ao(n, -1.0f), shadow(n, -1.0f);
+  std::vector<float> expectedAo, expectedShadow, ao(n, -1.0f), shadow(n, -1.0f);
   const std::array<double, 3> light = { 0.3, -0.2, 1.0 };
-  ASSERT_TRUE(vao::surfaceAmbientOcclusion(
-    whole, f.view(), f.origin, f.spacing, points.data(), normals.data(), n, {}, expectedAo.data())
-                .ok);
-  ASSERT_TRUE(
-    vao::surfaceShadow(whole, points.data(), normals.data(), n, light, {}, expectedShadow.data())
-      .ok);
+  wholePyramidAnswers(f, points, normals, light, expectedAo, expectedShadow);
   auto held = [](const vao::SurfacePyramid& s) { return s.builtTiles(0) + s.builtTiles(1); };
   auto made = [](vao::SurfacePyramid& s)
   {
@@ -303,17 +317,10 @@ TEST(SurfacePyramid, AQueryAfterAnAbortedOneLosesNothing)
   scenePoints(f, points, normals);
   const std::int64_t n = static_cast<std::int64_t>(points.size() / 3);
   vao::PyramidParameters pp;
-  std::vector<vao::MomentLevel> whole;
-  ASSERT_TRUE(vao::buildMomentPyramid(f.view(), f.origin, f.spacing, pp, whole).ok);
   const std::int64_t sphere = n - 150; // scenePoints: the sphere's, then 150 anywhere
-  std::vector<float> expectedAo(n), expectedShadow(n), got(n);
+  std::vector<float> expectedAo, expectedShadow, got(n);
   const std::array<double, 3> light = { 0.3, -0.2, 1.0 };
-  ASSERT_TRUE(vao::surfaceAmbientOcclusion(
-    whole, f.view(), f.origin, f.spacing, points.data(), normals.data(), n, {}, expectedAo.data())
-                .ok);
-  ASSERT_TRUE(
-    vao::surfaceShadow(whole, points.data(), normals.data(), n, light, {}, expectedShadow.data())
-      .ok);
+  wholePyramidAnswers(f, points, normals, light, expectedAo, expectedShadow);
   for (std::size_t kept : { static_cast<std::size_t>(-1), std::size_t(0) })
   {
     int aborted = 0;

@@ -8,6 +8,7 @@
 #include "cpu/moment_pyramid/SurfaceLanes.h"
 #include "vao/VarianceOcclusionMap.h"
 
+#include "PyramidTestSupport.h"
 #include "ReferenceFormulas.h"
 
 #include <gtest/gtest.h>
@@ -21,7 +22,7 @@
 namespace
 {
 
-using Vec3 = std::array<double, 3>;
+using vaotest::Vec3;
 
 /// Occluder fraction of q for a level sample: Cantelli's bound or the Gaussian tail.
 double refOcclusion(const vao::MomentLevel& level, const Vec3& p, double q, vao::Method estimator)
@@ -189,15 +190,12 @@ TEST(SurfaceReference, AmbientOcclusionAndShadowsMatchTheDefinition)
     ASSERT_TRUE(vao::buildSurfacePyramid(
       s.view(), s.origin, s.spacing, { static_cast<int>(s.pyramid.size()), false }, tiled)
                   .ok);
-    for (vao::Method estimator : { vao::Method::Chebyshev, vao::Method::GaussianCdf })
-      for (vao::SurfaceQuery query :
-        { vao::SurfaceQuery::HalfVoxelInside, vao::SurfaceQuery::IsoValue })
+    vaotest::forEachSurfaceQuery(
+      [&](vao::SurfaceOcclusionParameters p)
+      {
         for (vao::LevelCombination combination :
           { vao::LevelCombination::MaximumOcclusion, vao::LevelCombination::Mean })
         {
-          vao::SurfaceOcclusionParameters p;
-          p.estimator = estimator;
-          p.query = query;
           p.isoValue = 150.0;
           p.combination = combination;
           p.offsetFactor = 0.8;
@@ -228,6 +226,7 @@ TEST(SurfaceReference, AmbientOcclusionAndShadowsMatchTheDefinition)
             ++compared;
           }
         }
+      });
   }
   EXPECT_EQ(compared, 8 * (1 + 5 + 8 + 37));
 }
@@ -239,22 +238,15 @@ TEST(SurfaceLanes, VectorPathEqualsThePlainLoop)
   for (const vao::Index3 dims :
     { vao::Index3{ 9, 7, 5 }, vao::Index3{ 6, 1, 4 }, vao::Index3{ 1, 5, 3 } })
   {
-    vao::MomentLevel level;
-    level.dims = dims;
-    level.origin = { 1.0, -2.0, 0.5 };
-    level.spacing = { 1.5, 0.5, 2.0 };
-    level.roundingVariance = 1e-9;
-    const auto n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
-    level.mean.resize(n);
-    level.variance.resize(n);
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> value(-50.0, 50.0);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      level.mean[i] = static_cast<float>(value(rng));
-      level.variance[i] =
-        i % 5 == 0 ? 0.0f : static_cast<float>(std::fabs(value(rng))); // some flat corners
-    }
+    vao::MomentLevel level = vaotest::smallLevel(dims,
+      [&](std::size_t i, float& mean, float& variance)
+      {
+        mean = static_cast<float>(value(rng));
+        variance = i % 5 == 0 ? 0.0f : static_cast<float>(std::fabs(value(rng))); // some flat
+      });
+    level.roundingVariance = 1e-9;
     const vao::detail::LevelGrid grid(level);
     std::uniform_real_distribution<double> where(-4.0, 16.0);
     int lanesCompared = 0;

@@ -3,6 +3,7 @@
 // second pass over it.
 #pragma once
 
+#include "VolumeAccess.h"
 #include "vao/AmbientOcclusion.h"
 
 #include <atomic>
@@ -55,14 +56,16 @@ private:
   std::atomic<bool> Finite{ true };
 };
 
-/// Runs pass(seen), `seen` keeping the range of what the pass writes (null when `range` is
-/// null, so that nothing is kept): Status::cancelled when the pass returns false, else
+/// Runs pass(tag, seen) with `tag` a value of the volume's scalar type (the pass reads the
+/// volume as that type), `seen` keeping the range of what the pass writes (null when `range`
+/// is null, so that nothing is kept): Status::cancelled when the pass returns false, else
 /// success with that range in `range`.
-template <class Pass>
-Status keepingOutputRange(OutputRange* range, Pass&& pass)
+template <class TypedPass>
+Status keepingOutputRange(ScalarType type, OutputRange* range, TypedPass&& pass)
 {
   ConcurrentRange seen;
-  if (!pass(range ? &seen : nullptr))
+  ConcurrentRange* kept = range ? &seen : nullptr;
+  if (!dispatchScalarType(type, [&](auto tag) { return pass(tag, kept); }))
     return Status::cancelled();
   if (range)
     *range = seen.result();

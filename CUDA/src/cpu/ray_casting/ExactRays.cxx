@@ -157,13 +157,9 @@ Status computeExactRays(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, float* openness, OutputRange* range,
   const Execution& execution)
 {
-  return keepingOutputRange(range,
-    [&](ConcurrentRange* seen)
-    {
-      return dispatchScalarType(volume.type,
-        [&](auto tag)
-        { return castRays<decltype(tag)>(volume, region, parameters, openness, seen, execution); });
-    });
+  return keepingOutputRange(volume.type, range,
+    [&](auto tag, ConcurrentRange* seen)
+    { return castRays<decltype(tag)>(volume, region, parameters, openness, seen, execution); });
 }
 
 } // namespace detail

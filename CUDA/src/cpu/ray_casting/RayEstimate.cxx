@@ -572,13 +572,9 @@ Status computeRays(const VolumeView& volume, const Region& region,
   const AmbientOcclusionParameters& parameters, float* openness, OutputRange* range,
   const Execution& execution)
 {
-  return keepingOutputRange(range,
-    [&](ConcurrentRange* seen)
-    {
-      return dispatchScalarType(volume.type,
-        [&](auto tag)
-        { return estimate<decltype(tag)>(volume, region, parameters, openness, seen, execution); });
-    });
+  return keepingOutputRange(volume.type, range,
+    [&](auto tag, ConcurrentRange* seen)
+    { return estimate<decltype(tag)>(volume, region, parameters, openness, seen, execution); });
 }
 
 } // namespace detail
