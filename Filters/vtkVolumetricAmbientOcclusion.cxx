@@ -55,30 +55,27 @@ const char* const MethodNames[] = { "CDF Reconstruction", "Gaussian CDF", "Cheby
   "Exact Sphere", "Histogram CDF", "Transfer Function", "Exact Rays", "Rays" };
 const char* const QueryModeNames[] = { "Voxel Value", "Iso Value", "Smoothed Voxel Value" };
 
+// The filter's Method is the kernel's method, by value.
+static_assert(vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION ==
+    static_cast<int>(vao::Method::CdfReconstruction) &&
+  vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF == static_cast<int>(vao::Method::GaussianCdf) &&
+  vtkVolumetricAmbientOcclusion::CHEBYSHEV == static_cast<int>(vao::Method::Chebyshev) &&
+  vtkVolumetricAmbientOcclusion::EXACT_BOX == static_cast<int>(vao::Method::ExactBox) &&
+  vtkVolumetricAmbientOcclusion::EXACT_SPHERE == static_cast<int>(vao::Method::ExactSphere) &&
+  vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF == static_cast<int>(vao::Method::HistogramCdf) &&
+  vtkVolumetricAmbientOcclusion::TRANSFER_FUNCTION ==
+    static_cast<int>(vao::Method::TransferFunction) &&
+  vtkVolumetricAmbientOcclusion::EXACT_RAYS == static_cast<int>(vao::Method::ExactRays) &&
+  vtkVolumetricAmbientOcclusion::RAYS == static_cast<int>(vao::Method::Rays));
+
+/// The kernel's method; Gaussian CDF for a value out of range, which CheckParameters
+/// refuses before any result.
 vao::Method KernelMethod(int method)
 {
-  switch (method)
-  {
-    case vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION:
-      return vao::Method::CdfReconstruction;
-    case vtkVolumetricAmbientOcclusion::CHEBYSHEV:
-      return vao::Method::Chebyshev;
-    case vtkVolumetricAmbientOcclusion::EXACT_BOX:
-      return vao::Method::ExactBox;
-    case vtkVolumetricAmbientOcclusion::EXACT_SPHERE:
-      return vao::Method::ExactSphere;
-    case vtkVolumetricAmbientOcclusion::HISTOGRAM_CDF:
-      return vao::Method::HistogramCdf;
-    case vtkVolumetricAmbientOcclusion::TRANSFER_FUNCTION:
-      return vao::Method::TransferFunction;
-    case vtkVolumetricAmbientOcclusion::EXACT_RAYS:
-      return vao::Method::ExactRays;
-    case vtkVolumetricAmbientOcclusion::RAYS:
-      return vao::Method::Rays;
-    case vtkVolumetricAmbientOcclusion::GAUSSIAN_CDF:
-    default: // CheckParameters rejects any other value
-      return vao::Method::GaussianCdf;
-  }
+  return method >= vtkVolumetricAmbientOcclusion::CDF_RECONSTRUCTION &&
+      method <= vtkVolumetricAmbientOcclusion::RAYS
+    ? static_cast<vao::Method>(method)
+    : vao::Method::GaussianCdf;
 }
 
 vao::QueryMode KernelQueryMode(int mode)

@@ -74,6 +74,7 @@ public:
   vtkTypeMacro(vtkVolumetricAmbientOcclusion, vtkImageAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
+  /// The kernel's methods (vao::Method: the .cxx checks that the values agree).
   enum MethodType
   {
     CDF_RECONSTRUCTION = 0,

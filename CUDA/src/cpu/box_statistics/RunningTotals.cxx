@@ -131,27 +131,25 @@ VAO_AVX512_TARGET inline __m512i scanLanes32(__m512i x)
   return _mm512_add_epi32(x, _mm512_alignr_epi32(x, zero, 8));
 }
 
-/// The AVX-512 lanes of 32- and 64-bit totals: how many a vector holds, the scan within
-/// it, the addition, and the last lane's total in every lane.
-struct Lanes32
+/// The AVX-512 lanes of totals of V (32- or 64-bit): how many a vector holds, the scan
+/// within it, the addition, and the last lane's total in every lane.
+template <class V>
+struct LanesOf
 {
-  static constexpr int kCount = 16;
-  static VAO_AVX512_TARGET __m512i scan(__m512i x) { return scanLanes32(x); }
-  static VAO_AVX512_TARGET __m512i add(__m512i x, __m512i y) { return _mm512_add_epi32(x, y); }
-  static VAO_AVX512_TARGET __m512i last(__m512i x)
+  static constexpr bool kNarrow = sizeof(V) == 4;
+  static constexpr int kCount = kNarrow ? 16 : 8;
+  static VAO_AVX512_TARGET __m512i scan(__m512i x)
   {
-    return _mm512_permutexvar_epi32(_mm512_set1_epi32(15), x);
+    return kNarrow ? scanLanes32(x) : scanLanes(x);
   }
-};
-
-struct Lanes64
-{
-  static constexpr int kCount = 8;
-  static VAO_AVX512_TARGET __m512i scan(__m512i x) { return scanLanes(x); }
-  static VAO_AVX512_TARGET __m512i add(__m512i x, __m512i y) { return _mm512_add_epi64(x, y); }
+  static VAO_AVX512_TARGET __m512i add(__m512i x, __m512i y)
+  {
+    return kNarrow ? _mm512_add_epi32(x, y) : _mm512_add_epi64(x, y);
+  }
   static VAO_AVX512_TARGET __m512i last(__m512i x)
   {
-    return _mm512_permutexvar_epi64(_mm512_set1_epi64(7), x);
+    return kNarrow ? _mm512_permutexvar_epi32(_mm512_set1_epi32(kCount - 1), x)
+                   : _mm512_permutexvar_epi64(_mm512_set1_epi64(kCount - 1), x);
   }
 };
 
@@ -179,9 +177,6 @@ VAO_AVX512_TARGET void runningTotalsAvx512(V* a, V* b, std::int64_t n)
   runningTotalsPlain(a, b, i, n);
 }
 
-/// The lanes of a row's width.
-template <class V>
-using LanesOf = typename std::conditional<sizeof(V) == 4, Lanes32, Lanes64>::type;
 #endif
 
 /// The widest tier the processor has, for 64- or 32-bit rows alike.

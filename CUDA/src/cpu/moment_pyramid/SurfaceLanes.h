@@ -58,24 +58,10 @@ inline std::vector<MarchStep> marchSchedule(const double* kernelRadius, int leve
   return steps;
 }
 
-#if VAO_HAVE_AVX2_TARGET
-namespace avx2
-{
-#define VAO_LANES VAO_AVX2_HELPER
-#define VAO_LANES_ENTRY VAO_AVX2_INLINE
-#include "cpu/moment_pyramid/SurfaceLanes-inl.h"
-#undef VAO_LANES
-#undef VAO_LANES_ENTRY
-} // namespace avx2
+#define VAO_TIER_FILE "cpu/moment_pyramid/SurfaceLanes-inl.h"
+#include "cpu/simd/ForEachTier.h"
 
-namespace avx512
-{
-#define VAO_LANES VAO_AVX512_HELPER
-#define VAO_LANES_ENTRY VAO_AVX512_INLINE
-#include "cpu/moment_pyramid/SurfaceLanes-inl.h"
-#undef VAO_LANES
-#undef VAO_LANES_ENTRY
-} // namespace avx512
+#if VAO_HAVE_AVX2_TARGET
 
 /// The Chebyshev shadow march of a batch (SurfaceLanes-inl.h) in the widest tier the
 /// processor has: `tier` is Avx2 or Avx512. `rays`: null, or the RayBounds (their data)

@@ -7,28 +7,11 @@
 
 #include "vao/Estimators.h"
 
-#if VAO_HAVE_AVX2_TARGET
 namespace vao
 {
 namespace detail
 {
-namespace avx2
-{
-#define VAO_LANES VAO_AVX2_HELPER
-#define VAO_LANES_ENTRY VAO_AVX2_INLINE
-#include "cpu/simd/EstimatorLanes-inl.h"
-#undef VAO_LANES
-#undef VAO_LANES_ENTRY
-} // namespace avx2
-
-namespace avx512
-{
-#define VAO_LANES VAO_AVX512_HELPER
-#define VAO_LANES_ENTRY VAO_AVX512_INLINE
-#include "cpu/simd/EstimatorLanes-inl.h"
-#undef VAO_LANES
-#undef VAO_LANES_ENTRY
-} // namespace avx512
+#define VAO_TIER_FILE "cpu/simd/EstimatorLanes-inl.h"
+#include "cpu/simd/ForEachTier.h"
 } // namespace detail
 } // namespace vao
-#endif

@@ -27,15 +27,6 @@ VAO_HD Index blurTap(Index o, int step, int k, Index n)
   return lower<Index>(greater<Index>(o * step + k - blur::kHalf, 0), n - 1);
 }
 
-/// The taps of both moments for kept output o along an axis of n voxels: at(i, u, v)
-/// loads the pair of input index i (clamped; a clipped tap has weight 0).
-template <class At>
-VAO_HD void tapsAlong(Index o, int step, Index n, const At& at, double* u, double* v)
-{
-  for (int k = 0; k < kTaps; ++k)
-    at(blurTap(o, step, k, n), u[k], v[k]);
-}
-
 /// z pass from the raw volume (nx * ny * nz values, x fastest): a = sum w d, b = sum w d^2
 /// with d = v - shift, into arrays of (nx, ny, oz).
 template <class T>
@@ -62,110 +53,114 @@ struct BlurRawZ
   }
 };
 
+/// A pass along `axis` of a grid of both moments: input (n[0], n[1], n[2]) into output
+/// (the same, `kept` values along `axis`). at(i, u, v) loads the pair of input voxel i (its
+/// linear index); put(t, a, b) stores the tap sums of output t.
+template <class At, class Put>
+struct AxisBlur
+{
+  Index n[3];
+  int axis;
+  Index kept;
+  int step;
+  const double* weights; // kTaps per kept output
+  At at;
+  Put put;
+
+  VAO_HD Index threads() const
+  {
+    Index count = kept;
+    for (int c = 0; c < 3; ++c)
+      count *= c == axis ? 1 : n[c];
+    return count;
+  }
+  VAO_HD void operator()(Index t) const
+  {
+    Index outDims[3] = { n[0], n[1], n[2] };
+    outDims[axis] = kept;
+    Index c[3] = { t % outDims[0], (t / outDims[0]) % outDims[1], t / (outDims[0] * outDims[1]) };
+    const Index o = c[axis];
+    const double* w = weights + o * kTaps;
+    double u[kTaps], v[kTaps];
+    for (int k = 0; k < kTaps; ++k)
+    {
+      c[axis] = blurTap(o, step, k, n[axis]);
+      at((c[2] * n[1] + c[1]) * n[0] + c[0], u[k], v[k]);
+    }
+    put(t, blur::tapSum(w, u), blur::tapSum(w, v));
+  }
+};
+
+template <class At, class Put>
+AxisBlur<At, Put> axisBlur(
+  const Index n[3], int axis, Index kept, int step, const double* weights, At at, Put put)
+{
+  return { { n[0], n[1], n[2] }, axis, kept, step, weights, at, put };
+}
+
+/// Where a pass's tap sums go: the a and b arrays of the next pass.
+struct PutPair
+{
+  double* a;
+  double* b;
+  VAO_HD void operator()(Index t, double sa, double sb) const
+  {
+    a[t] = sa;
+    b[t] = sb;
+  }
+};
+
 /// z pass from a stored level: d = mean - shift, s = variance + d^2.
-struct BlurLevelZ
+struct LevelPair
 {
   const float* mean;
   const float* variance;
-  Index nx, ny, nz, oz;
-  int step;
-  const double* wz;
   double shift;
-  double* a;
-  double* b;
-
-  VAO_HD Index threads() const { return nx * ny * oz; }
-  VAO_HD void operator()(Index t) const
+  VAO_HD void operator()(Index i, double& d, double& s) const
   {
-    const Index x = t % nx, y = (t / nx) % ny, zo = t / (nx * ny);
-    const double* w = wz + zo * kTaps;
-    double d[kTaps], s[kTaps];
-    tapsAlong(
-      zo, step, nz,
-      [&](Index z, double& dk, double& sk)
-      {
-        const Index i = (z * ny + y) * nx + x;
-        dk = static_cast<double>(mean[i]) - shift;
-        sk = static_cast<double>(variance[i]) + dk * dk;
-      },
-      d, s);
-    a[t] = blur::tapSum(w, d);
-    b[t] = blur::tapSum(w, s);
+    d = static_cast<double>(mean[i]) - shift;
+    s = static_cast<double>(variance[i]) + d * d;
   }
 };
 
-/// y pass: (nx, ny, oz) into (nx, oy, oz), both moments.
-struct BlurY
+/// y pass: the z pass's two arrays as they are.
+struct ArrayPair
 {
   const double* a;
   const double* b;
-  Index nx, ny, oy, oz;
-  int step;
-  const double* wy;
-  double* oa;
-  double* ob;
-
-  VAO_HD Index threads() const { return nx * oy * oz; }
-  VAO_HD void operator()(Index t) const
+  VAO_HD void operator()(Index i, double& u, double& v) const
   {
-    const Index x = t % nx, yo = (t / nx) % oy, zo = t / (nx * oy);
-    const double* w = wy + yo * kTaps;
-    double ta[kTaps], tb[kTaps];
-    tapsAlong(
-      yo, step, ny,
-      [&](Index y, double& u, double& v)
-      {
-        u = a[(zo * ny + y) * nx + x];
-        v = b[(zo * ny + y) * nx + x];
-      },
-      ta, tb);
-    oa[t] = blur::tapSum(w, ta);
-    ob[t] = blur::tapSum(w, tb);
+    u = a[i];
+    v = b[i];
   }
 };
 
-/// x pass: (nx, oy, oz) into the level's (ox, oy, oz) mean = A + shift and variance =
-/// max(0, B - A^2), as float.
-struct BlurX
+/// x pass: into the level's mean = A + shift and variance = max(0, B - A^2), as float.
+struct PutMoments
 {
-  const double* a;
-  const double* b;
-  Index nx, ox, oy, oz;
-  int step;
-  const double* wx;
   double shift;
   float* mean;
   float* variance;
-
-  VAO_HD Index threads() const { return ox * oy * oz; }
-  VAO_HD void operator()(Index t) const
+  VAO_HD void operator()(Index t, double a, double b) const
   {
-    const Index xo = t % ox, row = t / ox; // row: (yo, zo) of the (nx, oy, oz) arrays
-    const double* w = wx + xo * kTaps;
-    double ta[kTaps], tb[kTaps];
-    tapsAlong(
-      xo, step, nx,
-      [&](Index x, double& u, double& v)
-      {
-        u = a[row * nx + x];
-        v = b[row * nx + x];
-      },
-      ta, tb);
-    blur::levelMoments(blur::tapSum(w, ta), blur::tapSum(w, tb), shift, mean[t], variance[t]);
+    blur::levelMoments(a, b, shift, mean[t], variance[t]);
   }
 };
 
-/// One level's three passes: `z` (BlurRawZ or BlurLevelZ, its a and b the z arrays) then
-/// y and x into mean and variance of `out` kept voxels. The y arrays hold (nx, oy, oz).
+/// One level's three passes: `z` (BlurRawZ, or the z AxisBlur of a stored level; its
+/// output the arrays za, zb) then y and x into mean and variance of `out` kept voxels. The
+/// y arrays hold (nx, oy, oz).
 template <class Executor, class ZPass>
-void runBlurLevel(Executor& ex, const ZPass& z, const Index in[3], const Index out[3], int step,
-  const double* wy, const double* wx, double shift, double* ya, double* yb, float* mean,
-  float* variance)
+void runBlurLevel(Executor& ex, const ZPass& z, const double* za, const double* zb,
+  const Index in[3], const Index out[3], int step, const double* wy, const double* wx, double shift,
+  double* ya, double* yb, float* mean, float* variance)
 {
   ex.launch(z, "pyramid z", static_cast<double>(z.threads()) * 16.0);
-  const BlurY y{ z.a, z.b, in[0], in[1], out[1], out[2], step, wy, ya, yb };
+  const Index zDims[3] = { in[0], in[1], out[2] }, yDims[3] = { in[0], out[1], out[2] };
+  const auto y = axisBlur(zDims, 1, out[1], step, wy, ArrayPair{ za, zb }, PutPair{ ya, yb });
   ex.launch(y, "pyramid y", static_cast<double>(y.threads()) * 16.0 * 2.0);
-  const BlurX x{ ya, yb, in[0], out[0], out[1], out[2], step, wx, shift, mean, variance };
+  const auto x =
+    axisBlur(yDims, 0, out[0], step, wx, ArrayPair{ ya, yb }, PutMoments{ shift, mean, variance });
   ex.launch(x, "pyramid x",
     static_cast<double>(x.threads()) * 8.0 + static_cast<double>(y.threads()) * 16.0);
 }
@@ -203,13 +198,16 @@ void runPyramid(Executor& ex, const T* v, const Index3& dims, const detail::Pyra
     const double shift = setup.shift;
     if (l == 0)
       runBlurLevel(ex,
-        BlurRawZ<T>{ v, i[0], i[1], i[2], o[2], step, wz.get(), shift, za.get(), zb.get() }, i, o,
-        step, wy.get(), wx.get(), shift, ya.get(), yb.get(), mean.get(), variance.get());
+        BlurRawZ<T>{ v, i[0], i[1], i[2], o[2], step, wz.get(), shift, za.get(), zb.get() },
+        za.get(), zb.get(), i, o, step, wy.get(), wx.get(), shift, ya.get(), yb.get(), mean.get(),
+        variance.get());
     else
       runBlurLevel(ex,
-        BlurLevelZ{ sourceMean.get(), sourceVariance.get(), i[0], i[1], i[2], o[2], step, wz.get(),
-          shift, za.get(), zb.get() },
-        i, o, step, wy.get(), wx.get(), shift, ya.get(), yb.get(), mean.get(), variance.get());
+        axisBlur(i, 2, o[2], step, wz.get(),
+          LevelPair{ sourceMean.get(), sourceVariance.get(), shift },
+          PutPair{ za.get(), zb.get() }),
+        za.get(), zb.get(), i, o, step, wy.get(), wx.get(), shift, ya.get(), yb.get(), mean.get(),
+        variance.get());
     MomentLevel& level = out[static_cast<std::size_t>(l)];
     level.dims = kept;
     level.mean.resize(static_cast<std::size_t>(count));
