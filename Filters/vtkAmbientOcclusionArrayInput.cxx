@@ -379,30 +379,6 @@ bool ReadSurfacePoints(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Fra
     surface, out.points, frame, volume, origin, spacing, out.normals, out.replacedNormals, error);
 }
 
-vao::Execution ExecutionOf(vtkAlgorithm* algorithm, int threads, double from, double to)
-{
-  vao::Execution execution;
-  execution.threads = threads;
-  execution.progress = [algorithm, from, to](double p)
-  { algorithm->UpdateProgress(from + (to - from) * p); };
-  execution.abortRequested = [algorithm] { return algorithm->GetAbortExecute() != 0; };
-  return execution;
-}
-
-std::string NumberOfThreadsError(int threads)
-{
-  if (threads >= 0)
-  {
-    return {};
-  }
-  std::ostringstream why;
-  why << "NumberOfThreads must be 0 (the cores available, divided among the MPI ranks of the node) "
-         "or "
-         "positive (got "
-      << threads << ").";
-  return why.str();
-}
-
 std::string NonFiniteError(vtkDataArray* array)
 {
   vao::VolumeView view;

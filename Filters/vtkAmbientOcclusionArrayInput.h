@@ -93,19 +93,10 @@ bool ReadSurfacePoints(vtkPolyData* surface, const vtkAmbientOcclusionFrame::Fra
   const ScalarVolume& volume, const std::array<double, 3>& origin,
   const std::array<double, 3>& spacing, bool needed, SurfacePoints& out, std::string& error);
 
-/// The kernels' execution hooks for an algorithm: its progress, its abort flag, and
-/// `threads` (the filter's NumberOfThreads; 0: the kernels' default). The kernels' progress
-/// p is reported as from + (to - from) p, for a filter that runs them in stages.
-vao::Execution ExecutionOf(
-  vtkAlgorithm* algorithm, int threads, double from = 0.0, double to = 1.0);
-
 /// The error for a point array without one tuple for each of the data set's `points`
 /// (VTK does not keep the two equal: a script or a reader can attach any array, and a
 /// filter reading a short one would read past its end); empty when they match.
 std::string PointCountError(vtkDataArray* array, vtkIdType points);
-
-/// The error for a NumberOfThreads below 0; empty for a valid one.
-std::string NumberOfThreadsError(int threads);
 
 /// The error for a floating-point array with NaN or infinite values (how many, and the
 /// first one's point); empty for an array without any (or of an integer type).

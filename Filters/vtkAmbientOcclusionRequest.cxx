@@ -3,11 +3,43 @@
 #include "vtkAmbientOcclusionMemory.h"
 #include "vtkAmbientOcclusionRanges.h"
 
+#include "vtkAlgorithm.h"
 #include "vtkDataObject.h"
 #include "vtkInformationVector.h"
+#include "vtkMultiProcessController.h"
+
+#include <sstream>
 
 namespace vtkAmbientOcclusionRequest
 {
+
+vao::Execution Execution(vtkAlgorithm* algorithm, int threads, double from, double to)
+{
+  vao::Execution execution;
+  execution.threads = threads;
+  execution.progress = [algorithm, from, to](double p)
+  { algorithm->UpdateProgress(from + (to - from) * p); };
+  execution.abortRequested = [algorithm] { return algorithm->GetAbortExecute() != 0; };
+  return execution;
+}
+
+std::string ThreadsError(int threads)
+{
+  if (threads >= 0)
+  {
+    return {};
+  }
+  std::ostringstream why;
+  why << "NumberOfThreads must be 0 (the cores available, divided among the MPI ranks of the node) "
+         "or positive (got "
+      << threads << ").";
+  return why.str();
+}
+
+bool Distributed(vtkMultiProcessController* controller)
+{
+  return controller && controller->GetNumberOfProcesses() > 1;
+}
 
 int ProduceOutput(vtkAlgorithm* algorithm, vtkInformationVector* outputs, const char* memoryHint,
   const std::function<int()>& produce)

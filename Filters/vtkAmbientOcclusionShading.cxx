@@ -116,7 +116,7 @@ std::string vtkAmbientOcclusionShading::CheckInput(
   else if (!std::isfinite(this->VarianceMax))
     why << "VarianceMax must be finite (0 or less: automatic).";
   else if (this->NumberOfThreads < 0)
-    why << vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+    why << vtkAmbientOcclusionRequest::ThreadsError(this->NumberOfThreads);
   else if (this->ColorPreset < GRAYSCALE || this->ColorPreset > COOL_TO_WARM)
     why << "Unknown ColorPreset " << this->ColorPreset << " (0 Grayscale, 1 Bone, 2 Cool to Warm).";
   else if (!ao || ao->GetNumberOfComponents() != 1)
@@ -212,7 +212,7 @@ bool vtkAmbientOcclusionShading::ShadePoints(vtkPointData* pd, vtkDataArray* sca
   // transfer functions: their evaluation may build tables lazily, which is not
   // thread-safe on one shared object. Progress and abort are polled on this thread.
   const bool finished =
-    vao::parallelRanges(n, vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads),
+    vao::parallelRanges(n, vtkAmbientOcclusionRequest::Execution(this, this->NumberOfThreads),
       [&](std::int64_t begin, std::int64_t end)
       {
         vtkSmartPointer<vtkScalarsToColors> chunkColors =

@@ -46,9 +46,9 @@ vtkCxxSetSmartPointerMacro(vtkIsosurfaceAmbientOcclusion, Controller, vtkMultiPr
 
 namespace Extents = vtkAmbientOcclusionExtents;
 namespace PyramidImages = vtkAmbientOcclusionPyramidImages;
-using vtkAmbientOcclusionArrayInput::ExecutionOf;
 using vtkAmbientOcclusionArrayInput::PrepareScalars;
 using vtkAmbientOcclusionArrayInput::SurfacePoints;
+using vtkAmbientOcclusionRequest::Execution;
 
 namespace
 {
@@ -307,7 +307,7 @@ bool vtkIsosurfaceAmbientOcclusion::CheckParameters()
     why << "LightDirection must be a non-zero vector of finite length (got " << l[0] << ", " << l[1]
         << ", " << l[2] << ").";
   else if (this->NumberOfThreads < 0)
-    why << vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+    why << vtkAmbientOcclusionRequest::ThreadsError(this->NumberOfThreads);
   if (why.tellp() == 0)
   {
     return true;
@@ -339,8 +339,7 @@ vao::PyramidParameters vtkIsosurfaceAmbientOcclusion::PyramidRequest() const
 //------------------------------------------------------------------------------
 bool vtkIsosurfaceAmbientOcclusion::IsDistributed() const
 {
-  return this->Controller && this->Controller->GetNumberOfProcesses() > 1 &&
-    this->NumberOfLevels >= 2;
+  return vtkAmbientOcclusionRequest::Distributed(this->Controller) && this->NumberOfLevels >= 2;
 }
 
 //------------------------------------------------------------------------------
@@ -524,7 +523,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
   if (!Extents::CheckWholeExtent(volume->GetExtent(), error) ||
     !PrepareScalars(this, chosen, volume, this->Component, cache.scalars, error) ||
     !PyramidImages::BuildPyramid(cache.scalars, volume, this->PyramidRequest(),
-      ExecutionOf(this, this->NumberOfThreads, 0.0, kPyramidShare), cache.surface, error))
+      Execution(this, this->NumberOfThreads, 0.0, kPyramidShare), cache.surface, error))
   {
     cache.surface.clear();
     if (!error.empty())
@@ -568,7 +567,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
     PrepareScalars(this, chosen, volume, this->Component, cache.scalars, error))
   {
     PyramidImages::BuildPyramid(cache.scalars, volume, this->PyramidRequest(),
-      ExecutionOf(this, this->NumberOfThreads, 0.0, kPyramidShare), cache.levels, error);
+      Execution(this, this->NumberOfThreads, 0.0, kPyramidShare), cache.levels, error);
   }
   // Every process learns whether any failed before the coarsest level is shared.
   const bool failed = !error.empty() || (!empty && cache.levels.empty());
@@ -655,7 +654,7 @@ bool vtkIsosurfaceAmbientOcclusion::Shade(vtkPolyData* surface, vtkPolyData* out
 {
   Cache& cache = *this->Pyramid;
   const Sampling sampling{ cache.scalars.view, cache.origin, cache.spacing, this->Parameters(),
-    ExecutionOf(this, this->NumberOfThreads, kPyramidShare, 1.0) };
+    Execution(this, this->NumberOfThreads, kPyramidShare, 1.0) };
   const SurfaceKey key(surface, sampling.parameters, this->PyramidBuilds);
   const bool newOcclusion = !cache.occlusion || !(cache.occlusionKey == key);
   const vtkAmbientOcclusionFrame::Frame& frame = cache.surfaceFrame; // PlaceSurface's

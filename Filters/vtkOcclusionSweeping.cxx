@@ -32,11 +32,11 @@
 vtkStandardNewMacro(vtkOcclusionSweeping);
 vtkCxxSetSmartPointerMacro(vtkOcclusionSweeping, Controller, vtkMultiProcessController);
 
-using vtkAmbientOcclusionArrayInput::ExecutionOf;
 using vtkAmbientOcclusionArrayInput::KernelError;
 using vtkAmbientOcclusionArrayInput::PrepareScalars;
 using vtkAmbientOcclusionArrayInput::ScalarVolume;
 using vtkAmbientOcclusionCollectives::GlobalMax;
+using vtkAmbientOcclusionRequest::Execution;
 
 namespace
 {
@@ -251,7 +251,7 @@ int vtkOcclusionSweeping::ProduceOutput(
     return 1;
   }
   int whole[6], outExt[6];
-  std::string error = vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+  std::string error = vtkAmbientOcclusionRequest::ThreadsError(this->NumberOfThreads);
   if (!error.empty() ||
     !vtkAmbientOcclusionExtents::WholeAndRequestedExtent(
       inputVector[0], outputVector, whole, outExt, error))
@@ -286,7 +286,7 @@ int vtkOcclusionSweeping::ProduceOutput(
   vao::SweepReport report;
   const vao::Status status =
     vao::computeOcclusionSweeping(scalars.view, { spacing[0], spacing[1], spacing[2] },
-      this->Parameters(), arrays, ExecutionOf(this, this->NumberOfThreads), &report);
+      this->Parameters(), arrays, Execution(this, this->NumberOfThreads), &report);
   if (!status.ok)
   {
     error = KernelError(status, scalars, "Occlusion sweeping failed");
@@ -343,7 +343,7 @@ std::string vtkOcclusionSweeping::StartSlab(
     placement.size[a] = slab.extent[2 * a + 1] - slab.extent[2 * a] + 1;
   }
   slab.block.reset(new vao::BlockSweeper(slab.scalars.view, placement,
-    { spacing[0], spacing[1], spacing[2] }, parameters, ExecutionOf(this, this->NumberOfThreads)));
+    { spacing[0], spacing[1], spacing[2] }, parameters, Execution(this, this->NumberOfThreads)));
   return KernelError(slab.block->initialise(), slab.scalars, "Occlusion sweeping failed");
 }
 

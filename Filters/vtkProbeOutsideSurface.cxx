@@ -150,8 +150,8 @@ int vtkProbeOutsideSurface::RequestUpdateExtent(
     return 1;
   }
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
-  if (!Extents::CanProduceSubExtent(volumeInfo) && controller &&
-    controller->GetNumberOfProcesses() > 1)
+  if (!Extents::CanProduceSubExtent(volumeInfo) &&
+    vtkAmbientOcclusionRequest::Distributed(controller))
   {
     // A reader that does not split: read on one process, sent whole to the processes with
     // surface points (RequestData).
@@ -253,7 +253,7 @@ int vtkProbeOutsideSurface::RequestData(
   vtkNew<vtkImageData> fetched;
   vtkInformation* volumeInfo = inputVector[1]->GetInformationObject(0);
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
-  if (surface && volume && controller && controller->GetNumberOfProcesses() > 1 &&
+  if (surface && volume && vtkAmbientOcclusionRequest::Distributed(controller) &&
     outputVector->GetInformationObject(0)->Get(
       vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()) > 1 &&
     std::isfinite(this->Distance) && !Extents::CanProduceSubExtent(volumeInfo))

@@ -61,7 +61,7 @@ namespace
 vtkMultiProcessController* SharedController(vtkInformation* inputInformation)
 {
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
-  return controller && controller->GetNumberOfProcesses() > 1 &&
+  return vtkAmbientOcclusionRequest::Distributed(controller) &&
       !Extents::CanProduceSubExtent(inputInformation)
     ? controller
     : nullptr;
@@ -122,7 +122,7 @@ int vtkVarianceOcclusionMap::ProduceOutput(
   vtkImageData* input = vtkImageData::GetData(inputVector[0]);
   vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector);
   output->Initialize();
-  std::string error = vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+  std::string error = vtkAmbientOcclusionRequest::ThreadsError(this->NumberOfThreads);
   if (!error.empty())
   {
     vtkErrorMacro(<< error);
@@ -177,7 +177,7 @@ int vtkVarianceOcclusionMap::ProduceOutput(
     !vtkAmbientOcclusionArrayInput::PrepareScalars(
       this, this->GetInputArrayToProcess(0, input), input, this->Component, scalars, error) ||
     !vtkAmbientOcclusionPyramidImages::BuildPyramid(scalars, input, this->Parameters(),
-      vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads), pyramid, error))
+      vtkAmbientOcclusionRequest::Execution(this, this->NumberOfThreads), pyramid, error))
   {
     if (!error.empty())
     {

@@ -256,7 +256,7 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
   {
     // A reader that does not split: all of it on one process, fetched from there by the
     // others (NeededInput).
-    const bool shared = this->Controller && this->Controller->GetNumberOfProcesses() > 1;
+    const bool shared = vtkAmbientOcclusionRequest::Distributed(this->Controller);
     vtkAmbientOcclusionExtents::RequestPieceOfWhole(inInfo,
       shared ? this->Controller->GetLocalProcessId() : 0,
       shared ? this->Controller->GetNumberOfProcesses() : 1);
@@ -503,8 +503,7 @@ vao::Status vtkVolumetricAmbientOcclusion::Compute(const vao::VolumeView& volume
   const vao::Region& region, const vao::AmbientOcclusionParameters& parameters,
   const vao::AmbientOcclusionOutput& arrays)
 {
-  vao::Execution execution =
-    vtkAmbientOcclusionArrayInput::ExecutionOf(this, this->NumberOfThreads);
+  vao::Execution execution = vtkAmbientOcclusionRequest::Execution(this, this->NumberOfThreads);
   execution.device = this->Device;
   vao::Status status;
   // The device runs every method but Transfer Function, with the voxel's value or an iso
@@ -625,7 +624,7 @@ bool vtkVolumetricAmbientOcclusion::CheckParameters()
            "device index, got "
         << this->Device << ".";
   else if (this->NumberOfThreads < 0)
-    why << vtkAmbientOcclusionArrayInput::NumberOfThreadsError(this->NumberOfThreads);
+    why << vtkAmbientOcclusionRequest::ThreadsError(this->NumberOfThreads);
   else if (this->OutputArrayName.empty())
     why << "OutputArrayName must not be empty.";
   else if (this->ComputeVariance && this->OutputArrayName == "Variance")
@@ -710,8 +709,8 @@ bool vtkVolumetricAmbientOcclusion::CheckVoxelRadius(
 //------------------------------------------------------------------------------
 bool vtkVolumetricAmbientOcclusion::IsDistributed() const
 {
-  return this->Method == HISTOGRAM_CDF && !this->HistogramThresholds && this->Controller &&
-    this->Controller->GetNumberOfProcesses() > 1;
+  return this->Method == HISTOGRAM_CDF && !this->HistogramThresholds &&
+    vtkAmbientOcclusionRequest::Distributed(this->Controller);
 }
 
 //------------------------------------------------------------------------------

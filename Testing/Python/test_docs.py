@@ -72,10 +72,22 @@ def source_proxies(plugin_dir):
     proxies = []
     files = sorted(f for f in os.listdir(plugin_dir) if f.endswith(".xml")) if os.path.isdir(plugin_dir) else []
     check(bool(files), "Plugin/*.xml found under %s" % plugin_dir)
+    # The properties the proxies share stand where a proxy says @NAME@ (Plugin/CMakeLists.txt
+    # puts them there): Plugin/NumberOfThreads.xml.
+    shared = {}
+    for name in files:
+        if "<SourceProxy" not in open(os.path.join(plugin_dir, name), encoding="utf-8").read():
+            shared["@VAO_%s_PROPERTY@" % re.sub(r"(?<!^)(?=[A-Z])", "_", name[:-4]).upper()] = \
+                open(os.path.join(plugin_dir, name), encoding="utf-8").read()
     for name in files:
         path = os.path.join(plugin_dir, name)
+        text = open(path, encoding="utf-8").read()
+        if "<SourceProxy" not in text:
+            continue
+        for placeholder, fragment in shared.items():
+            text = text.replace(placeholder, fragment)
         try:
-            root = ET.parse(path).getroot()
+            root = ET.fromstring(text)
         except ET.ParseError as error:
             check(False, "Plugin/%s does not parse: %s" % (name, error))
             continue
