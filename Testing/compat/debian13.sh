@@ -41,6 +41,9 @@ cp /etc/resolv.conf "$root/etc/resolv.conf"
 
 echo "== copying the checkout${shared:+ and $shared} (build trees left out)"
 mkdir -p "$root/work/main"
+# The last run's copy goes first (its build trees stay, for an incremental build): a file
+# removed or moved since would otherwise remain there.
+find "$root/work/main" -mindepth 1 -maxdepth 1 ! -name 'build*' -exec rm -rf {} +
 tar -C "$repo" --exclude='./build*' --exclude='./vao-output' -cf - . | tar -C "$root/work/main" -xf -
 if [ -n "$shared" ]; then
   mkdir -p "$root/work/shared"
