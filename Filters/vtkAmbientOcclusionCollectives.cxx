@@ -16,6 +16,7 @@
 #include "vtkSmartPointer.h"
 
 #include <algorithm>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -285,8 +286,31 @@ bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
 }
 
 vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageData* input,
-  const int needed[6], vtkImageData* fetched, std::string& error)
+  const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error)
 {
+  // One whole extent on every process: the largest of each bound and of its negation.
+  int bounds[12], largest[12];
+  for (int i = 0; i < 6; ++i)
+  {
+    bounds[i] = whole[i];
+    bounds[6 + i] = -whole[i];
+  }
+  controller->AllReduce(bounds, largest, 12, vtkCommunicator::MAX_OP);
+  for (int i = 0; i < 6; ++i)
+  {
+    if (largest[i] != -largest[6 + i])
+    {
+      std::ostringstream why;
+      why << "The processes disagree on the whole extent of the input (this one's: " << whole[0]
+          << ".." << whole[1] << ", " << whole[2] << ".." << whole[3] << ", " << whole[4] << ".."
+          << whole[5] << "): each was handed its piece as if it were the whole volume, and "
+          << "the result would be wrong at every piece's border. Give the source the whole "
+          << "extent of the data set (in Catalyst, the adaptor's whole extent, e.g. "
+          << "bridge.coprocess(..., wholeExtent=...); in VTK, vtkTrivialProducer::SetWholeExtent).";
+      error = why.str();
+      return nullptr;
+    }
+  }
   int common[6];
   const bool covered = EmptyExtent(needed) ||
     (input->GetNumberOfPoints() > 0 && IntersectExtents(input->GetExtent(), needed, common) &&

@@ -37,11 +37,13 @@ bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
 /// The image a process reads to compute its piece: `input` itself when every process's
 /// input covers the extent it needs (`needed`, possibly empty), as readers that split
 /// deliver it; else `fetched`, filled by RedistributeExtents from whatever the processes
-/// hold (a reader that does not split reads everything on one process). Costs one
-/// reduction when nothing is missing. nullptr, with `error`, when no process holds some
-/// needed voxel (the same on every process).
+/// hold (a reader that does not split reads everything on one process). Costs two
+/// reductions when nothing is missing. nullptr, with `error` (the same on every process),
+/// when the processes disagree on the data set's `whole` extent (each was handed its piece
+/// as a whole volume: its AO would be wrong at the piece's borders), or when no process
+/// holds some needed voxel.
 vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageData* input,
-  const int needed[6], vtkImageData* fetched, std::string& error);
+  const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error);
 
 /// One message of RedistributeExtents: the voxels `ext` from process `from` to `to`.
 struct Transfer

@@ -431,8 +431,8 @@ int vtkIsosurfaceAmbientOcclusion::ProduceOutput(
     }
     const int none[6] = { 0, -1, 0, -1, 0, -1 };
     std::string error;
-    volume = vtkAmbientOcclusionCollectives::CoverNeededExtent(
-      this->Controller, volume, surface->GetNumberOfPoints() > 0 ? whole : none, fetched, error);
+    volume = vtkAmbientOcclusionCollectives::CoverNeededExtent(this->Controller, volume, whole,
+      surface->GetNumberOfPoints() > 0 ? whole : none, fetched, error);
     if (!volume)
     {
       vtkErrorMacro(<< error);

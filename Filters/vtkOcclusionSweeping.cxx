@@ -406,7 +406,7 @@ int vtkOcclusionSweeping::RequestDistributedData(vtkImageData* input, vtkImageDa
   vtkNew<vtkImageData> fetched, cropped;
   std::string fetchError;
   input = vtkAmbientOcclusionCollectives::CoverNeededExtent(
-    controller, input, expected, fetched, fetchError);
+    controller, input, whole, expected, fetched, fetchError);
   if (!input)
   {
     vtkErrorMacro(<< fetchError); // the same on every process

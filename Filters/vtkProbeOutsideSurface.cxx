@@ -265,7 +265,7 @@ int vtkProbeOutsideSurface::RequestData(
     volumeInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
     std::string why;
     volume = vtkAmbientOcclusionCollectives::CoverNeededExtent(
-      controller, volume, surface->GetNumberOfPoints() > 0 ? whole : none, fetched, why);
+      controller, volume, whole, surface->GetNumberOfPoints() > 0 ? whole : none, fetched, why);
     if (!volume)
     {
       vtkErrorMacro(<< why);

@@ -144,7 +144,7 @@ int vtkVarianceOcclusionMap::ProduceOutput(
     // Collective: every process, also one with an empty piece, takes part.
     const int none[6] = { 0, -1, 0, -1, 0, -1 };
     input = vtkAmbientOcclusionCollectives::CoverNeededExtent(
-      controller, input, Extents::EmptyExtent(piece) ? none : expected, fetched, error);
+      controller, input, whole, Extents::EmptyExtent(piece) ? none : expected, fetched, error);
     if (!input)
     {
       vtkErrorMacro(<< error);

@@ -377,7 +377,7 @@ vtkImageData* vtkVolumetricAmbientOcclusion::NeededInput(vtkImageData* input,
   }
   std::string error;
   vtkImageData* covered = vtkAmbientOcclusionCollectives::CoverNeededExtent(
-    this->Controller, input, needed, fetched, error);
+    this->Controller, input, run.whole, needed, fetched, error);
   if (!covered)
   {
     vtkErrorMacro(<< error);
