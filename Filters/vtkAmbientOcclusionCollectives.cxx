@@ -126,35 +126,82 @@ void Subtract(const Box& box, const int hole[6], std::vector<Box>& parts)
   }
 }
 
+template <typename T>
+void GatherAll(vtkMultiProcessController* controller, const std::vector<T>& mine, int per,
+  std::vector<T>& all, std::vector<int>& owners)
+{
+  const int ranks = controller ? controller->GetNumberOfProcesses() : 1;
+  if (ranks < 2)
+  {
+    all = mine;
+    owners.assign(mine.size() / per, 0);
+    return;
+  }
+  const vtkIdType count = static_cast<vtkIdType>(mine.size());
+  std::vector<vtkIdType> counts(ranks), offsets(ranks);
+  controller->AllGather(&count, counts.data(), 1);
+  vtkIdType total = 0;
+  owners.clear();
+  for (int r = 0; r < ranks; ++r)
+  {
+    offsets[r] = total;
+    total += counts[r];
+    owners.insert(owners.end(), static_cast<size_t>(counts[r] / per), r);
+  }
+  all.assign(static_cast<size_t>(std::max<vtkIdType>(total, 1)), T());
+  controller->AllGatherV(mine.data(), all.data(), count, counts.data(), offsets.data());
+  all.resize(static_cast<size_t>(total));
+}
+
+/// The bytes of the point arrays of an image (what a message of it carries, less framing).
+vtkIdType ArrayBytes(vtkImageData* image)
+{
+  vtkIdType bytes = 0;
+  vtkPointData* data = image->GetPointData();
+  for (int a = 0; a < data->GetNumberOfArrays(); ++a)
+    if (vtkDataArray* array = data->GetArray(a))
+      bytes += array->GetNumberOfValues() * array->GetDataTypeSize();
+  return bytes;
+}
+
 } // namespace
 
-std::vector<Transfer> PlanTransfers(
-  const std::vector<int>& held, const std::vector<int>& wanted, bool& complete)
+std::vector<Transfer> PlanTransfers(const std::vector<int>& held,
+  const std::vector<int>& heldOwners, const std::vector<int>& wanted,
+  const std::vector<int>& wantedOwners, bool& complete)
 {
-  const int ranks = static_cast<int>(held.size() / 6);
+  const int ranks = 1 +
+    std::max(heldOwners.empty() ? 0 : *std::max_element(heldOwners.begin(), heldOwners.end()),
+      wantedOwners.empty() ? 0 : *std::max_element(wantedOwners.begin(), wantedOwners.end()));
   std::vector<Transfer> plan;
   complete = true;
-  for (int to = 0; to < ranks; ++to)
+  for (size_t w = 0; w < wantedOwners.size(); ++w)
   {
+    const int to = wantedOwners[w];
     std::vector<Box> remaining;
-    if (!EmptyExtent(&wanted[6 * to]))
-      remaining.push_back(Box{ { wanted[6 * to], wanted[6 * to + 1], wanted[6 * to + 2],
-        wanted[6 * to + 3], wanted[6 * to + 4], wanted[6 * to + 5] } });
-    // Its own block first (no message), then the others' in rank order.
+    if (!EmptyExtent(&wanted[6 * w]))
+      remaining.push_back(Box{ { wanted[6 * w], wanted[6 * w + 1], wanted[6 * w + 2],
+        wanted[6 * w + 3], wanted[6 * w + 4], wanted[6 * w + 5] } });
+    // Its own blocks first (no message), then the others' in rank order.
     for (int k = -1; k < ranks && !remaining.empty(); ++k)
     {
       const int from = k < 0 ? to : k;
-      if ((k >= 0 && from == to) || EmptyExtent(&held[6 * from]))
+      if (k >= 0 && from == to)
         continue;
-      std::vector<Box> next;
-      for (const Box& box : remaining)
+      for (size_t h = 0; h < heldOwners.size() && !remaining.empty(); ++h)
       {
-        Transfer part{ from, to, {} };
-        if (IntersectExtents(box.ext, &held[6 * from], part.ext))
-          plan.push_back(part);
-        Subtract(box, &held[6 * from], next);
+        if (heldOwners[h] != from || EmptyExtent(&held[6 * h]))
+          continue;
+        std::vector<Box> next;
+        for (const Box& box : remaining)
+        {
+          Transfer part{ from, to, static_cast<int>(h), static_cast<int>(w), {} };
+          if (IntersectExtents(box.ext, &held[6 * h], part.ext))
+            plan.push_back(part);
+          Subtract(box, &held[6 * h], next);
+        }
+        remaining.swap(next);
       }
-      remaining.swap(next);
     }
     complete = complete && remaining.empty();
   }
@@ -186,10 +233,17 @@ GatheredLayout LayoutOf(const std::vector<int>& extents, int valuesPerPoint)
 
 } // namespace
 
+void GatherLists(vtkMultiProcessController* controller, const std::vector<double>& mine, int per,
+  std::vector<double>& all, std::vector<int>& owners)
+{
+  GatherAll(controller, mine, per, all, owners);
+}
+
 double GlobalMax(vtkMultiProcessController* controller, double value)
 {
   double result = value;
-  controller->AllReduce(&value, &result, 1, vtkCommunicator::MAX_OP);
+  if (controller && controller->GetNumberOfProcesses() > 1)
+    controller->AllReduce(&value, &result, 1, vtkCommunicator::MAX_OP);
   return result;
 }
 
@@ -204,40 +258,66 @@ void GlobalRange(vtkMultiProcessController* controller, double range[2])
   controller->AllReduce(&local[1], &range[1], 1, vtkCommunicator::MAX_OP);
 }
 
-bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
-  const int wanted[6], vtkImageData* output)
+bool RedistributeExtents(vtkMultiProcessController* controller,
+  const std::vector<vtkImageData*>& held, const std::vector<int>& wanted,
+  const std::vector<vtkImageData*>& outputs, vtkIdType* bytesSent)
 {
-  const int ranks = controller->GetNumberOfProcesses(), rank = controller->GetLocalProcessId();
-  int heldExtent[6] = { 0, -1, 0, -1, 0, -1 };
-  if (held->GetNumberOfPoints() > 0)
-    held->GetExtent(heldExtent);
-  std::vector<int> heldExtents(6 * ranks), wantedExtents(6 * ranks);
-  controller->AllGather(heldExtent, heldExtents.data(), 6);
-  controller->AllGather(wanted, wantedExtents.data(), 6);
+  const int ranks = controller ? controller->GetNumberOfProcesses() : 1;
+  const int rank = controller ? controller->GetLocalProcessId() : 0;
+  std::vector<int> myHeld;
+  vtkImageData* holder = nullptr; // this process's first block with voxels
+  for (vtkImageData* block : held)
+  {
+    int ext[6] = { 0, -1, 0, -1, 0, -1 };
+    if (block && block->GetNumberOfPoints() > 0)
+    {
+      block->GetExtent(ext);
+      holder = holder ? holder : block;
+    }
+    myHeld.insert(myHeld.end(), ext, ext + 6);
+  }
+  std::vector<int> heldExtents, heldOwners, wantedExtents, wantedOwners;
+  GatherAll(controller, myHeld, 6, heldExtents, heldOwners);
+  GatherAll(controller, wanted, 6, wantedExtents, wantedOwners);
   // The grid from a process that holds voxels: a reader that does not split (MetaImage,
   // NRRD) hands the others an empty image without one.
-  double geometry[15];
-  held->GetOrigin(geometry);
-  held->GetSpacing(geometry + 3);
-  std::copy(
-    held->GetDirectionMatrix()->GetData(), held->GetDirectionMatrix()->GetData() + 9, geometry + 6);
-  std::vector<double> geometries(15 * ranks);
-  controller->AllGather(geometry, geometries.data(), 15);
-  for (int r = 0; r < ranks; ++r)
-    if (!EmptyExtent(&heldExtents[6 * r]))
+  std::vector<double> mine(15), geometries;
+  std::vector<int> geometryOwners;
+  if (holder)
+  {
+    holder->GetOrigin(mine.data());
+    holder->GetSpacing(mine.data() + 3);
+    std::copy(holder->GetDirectionMatrix()->GetData(), holder->GetDirectionMatrix()->GetData() + 9,
+      mine.data() + 6);
+  }
+  GatherAll(controller, mine, 15, geometries, geometryOwners);
+  double geometry[15] = {};
+  for (size_t h = 0; h < heldOwners.size(); ++h)
+    if (!EmptyExtent(&heldExtents[6 * h]))
     {
-      std::copy(&geometries[15 * r], &geometries[15 * r] + 15, geometry);
+      std::copy(&geometries[15 * heldOwners[h]], &geometries[15 * heldOwners[h]] + 15, geometry);
       break;
     }
 
-  output->Initialize();
+  for (vtkImageData* output : outputs)
+    output->Initialize();
   bool complete = true;
-  const std::vector<Transfer> plan = PlanTransfers(heldExtents, wantedExtents, complete);
+  const std::vector<Transfer> plan =
+    PlanTransfers(heldExtents, heldOwners, wantedExtents, wantedOwners, complete);
   if (!complete)
     return false;
-  const bool wantsSomething = !EmptyExtent(wanted);
-  if (wantsSomething && !EmptyExtent(heldExtent))
-    AllocateWanted(held, geometry, wanted, output);
+  // Index of this process's first held block and first wanted extent in the global lists.
+  const int firstHeld =
+    static_cast<int>(std::find(heldOwners.begin(), heldOwners.end(), rank) - heldOwners.begin());
+  const int firstWanted = static_cast<int>(
+    std::find(wantedOwners.begin(), wantedOwners.end(), rank) - wantedOwners.begin());
+  auto paste = [&](vtkImageData* piece, const Transfer& part)
+  {
+    vtkImageData* output = outputs[part.into - firstWanted];
+    if (output->GetNumberOfPoints() == 0)
+      AllocateWanted(piece, geometry, &wanted[6 * (part.into - firstWanted)], output);
+    PasteExtent(piece, part.ext, output); // the transport may not keep the extent
+  };
   // Pairs in one global order, the lower rank sending first: no two wait on each other.
   constexpr int kPieceTag = 7102;
   for (int a = 0; a < ranks; ++a)
@@ -252,8 +332,10 @@ bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
           if (part.from == rank && part.to == other && other != rank)
           {
             vtkNew<vtkImageData> piece;
-            CopyRequestedExtent(held, piece, part.ext);
+            CopyRequestedExtent(held[part.block - firstHeld], piece, part.ext);
             controller->Send(piece.Get(), other, kPieceTag);
+            if (bytesSent)
+              *bytesSent += ArrayBytes(piece);
           }
       };
       auto receive = [&]
@@ -263,12 +345,10 @@ bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
           {
             vtkNew<vtkImageData> piece;
             if (other == rank)
-              CopyRequestedExtent(held, piece, part.ext);
+              CopyRequestedExtent(held[part.block - firstHeld], piece, part.ext);
             else
               controller->Receive(piece.Get(), other, kPieceTag);
-            if (output->GetNumberOfPoints() == 0)
-              AllocateWanted(piece, geometry, wanted, output);
-            PasteExtent(piece, part.ext, output); // the transport may not keep the extent
+            paste(piece, part);
           }
       };
       if (rank == a)
@@ -285,8 +365,16 @@ bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
   return true;
 }
 
+bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
+  const int wanted[6], vtkImageData* output, vtkIdType* bytesSent)
+{
+  return RedistributeExtents(controller, std::vector<vtkImageData*>{ held },
+    std::vector<int>(wanted, wanted + 6), std::vector<vtkImageData*>{ output }, bytesSent);
+}
+
 vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageData* input,
-  const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error)
+  const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error,
+  vtkIdType* bytesSent)
 {
   // One whole extent on every process: the largest of each bound and of its negation.
   int bounds[12], largest[12];
@@ -317,7 +405,7 @@ vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageD
       std::equal(common, common + 6, needed));
   if (GlobalMax(controller, covered ? 0.0 : 1.0) == 0.0)
     return input;
-  if (RedistributeExtents(controller, input, needed, fetched))
+  if (RedistributeExtents(controller, input, needed, fetched, bytesSent))
     return fetched;
   error = "The processes' pieces of the input do not hold every voxel this filter needs: "
           "give it a source that delivers the whole data set across the processes.";

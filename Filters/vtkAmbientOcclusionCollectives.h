@@ -5,6 +5,8 @@
 #ifndef vtkAmbientOcclusionCollectives_h
 #define vtkAmbientOcclusionCollectives_h
 
+#include "vtkType.h"
+
 #include <string>
 #include <vector>
 
@@ -18,7 +20,14 @@ struct MomentLevel;
 namespace vtkAmbientOcclusionCollectives
 {
 
-/// The largest `value` over every process of the controller (a failure flag, a change).
+/// Every process's list of items (`per` values each) in rank order, in `all`, with each
+/// item's process in `owners`: the lists may differ in length. One process (or no
+/// controller): its own list.
+void GatherLists(vtkMultiProcessController* controller, const std::vector<double>& mine, int per,
+  std::vector<double>& all, std::vector<int>& owners);
+
+/// The largest `value` over every process of the controller (a failure flag, a change);
+/// `value` itself with one process or no controller.
 double GlobalMax(vtkMultiProcessController* controller, double value);
 
 /// range = [min, max] over every process of the controller (unchanged with one process
@@ -26,13 +35,21 @@ double GlobalMax(vtkMultiProcessController* controller, double value);
 void GlobalRange(vtkMultiProcessController* controller, double range[2]);
 
 /// Distributed data held as blocks to distributed data as requested: every process holds
-/// `held` (its block, any extent; empty on the processes of a reader that does not split)
-/// and wants `wanted` (an extent, possibly empty); each receives every voxel it wants
-/// once, from itself where it can, else from the lowest process that holds it. `output`
-/// gets the wanted extent with the holders' geometry and point arrays. False, with every
-/// output empty, when some wanted voxel is held by no process (the same on every process).
+/// the images `held` (its blocks, any extents on one grid; none, or empty images, on the
+/// processes of a reader that does not split) and wants the extents `wanted` (6 ints each,
+/// possibly empty); `outputs[i]` receives every voxel of wanted extent i once, from the
+/// process's own blocks where it can, else from the lowest process that holds it, with the
+/// holders' geometry and point arrays. Only the voxels wanted elsewhere travel. False,
+/// with every output empty, when some wanted voxel is held by no process (the same on
+/// every process). `bytesSent`, when given, grows by the array bytes this process sent.
+/// Without a controller (or with one process) nothing is sent.
+bool RedistributeExtents(vtkMultiProcessController* controller,
+  const std::vector<vtkImageData*>& held, const std::vector<int>& wanted,
+  const std::vector<vtkImageData*>& outputs, vtkIdType* bytesSent = nullptr);
+
+/// RedistributeExtents with one held block and one wanted extent on each process.
 bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
-  const int wanted[6], vtkImageData* output);
+  const int wanted[6], vtkImageData* output, vtkIdType* bytesSent = nullptr);
 
 /// The image a process reads to compute its piece: `input` itself when every process's
 /// input covers the extent it needs (`needed`, possibly empty), as readers that split
@@ -43,20 +60,25 @@ bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
 /// as a whole volume: its AO would be wrong at the piece's borders), or when no process
 /// holds some needed voxel.
 vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageData* input,
-  const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error);
+  const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error,
+  vtkIdType* bytesSent = nullptr);
 
-/// One message of RedistributeExtents: the voxels `ext` from process `from` to `to`.
+/// One message of RedistributeExtents: the voxels `ext` of held block `block` from
+/// process `from` to wanted extent `into` of process `to` (block and extent indices count
+/// over every process).
 struct Transfer
 {
-  int from, to;
+  int from, to, block, into;
   int ext[6];
 };
 
-/// The messages that give each process r the extent wanted[6r..6r+5] from the blocks
-/// held[6r..6r+5] (its own first, then the others' in rank order, each voxel once);
+/// The messages that give each wanted extent (wanted[6i..6i+5], on process
+/// wantedOwners[i]) its voxels from the held blocks (held[6h..6h+5], on heldOwners[h]):
+/// its own process's blocks first, then the others' in rank order, each voxel once.
 /// `complete` says whether every wanted voxel is held somewhere.
-std::vector<Transfer> PlanTransfers(
-  const std::vector<int>& held, const std::vector<int>& wanted, bool& complete);
+std::vector<Transfer> PlanTransfers(const std::vector<int>& held,
+  const std::vector<int>& heldOwners, const std::vector<int>& wanted,
+  const std::vector<int>& wantedOwners, bool& complete);
 
 /// A pyramid level held in pieces, made whole on every process: each passes its piece
 /// (`part`: float arrays "Mean" and "Variance", its extent in the whole level's grid;

@@ -202,8 +202,8 @@ bool CanProduceSubExtent(vtkInformation* info)
     int port = 0;
     vtkExecutive::PRODUCER()->Get(info, producer, port);
     vtkAlgorithm* algorithm = producer ? producer->GetAlgorithm() : nullptr;
-    if (!algorithm)
-      return true; // data without a pipeline behind it: nothing reads a file
+    if (!algorithm) // data without a pipeline behind it: nothing reads a file, unless the
+      return !info->Has(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT()); // pieces were handed over
     if (algorithm->GetNumberOfInputPorts() == 0 || algorithm->GetNumberOfInputConnections(0) == 0)
       return false; // a source that did not say it can
     info = producer->GetInputInformation(0, 0);

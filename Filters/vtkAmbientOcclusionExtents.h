@@ -78,7 +78,9 @@ void RequestWholeExtent(vtkInformation* inputInformation);
 /// that, the source itself. A reader that does not split (ParaView's MetaImage, NRRD)
 /// cannot: asked for part of the volume as one piece it reads the file on every process
 /// (and VTK 9.2's MetaImage reader crashes on compressed data). Filters in between that
-/// pass extents along (a Calculator, a Programmable Filter) do not decide it.
+/// pass extents along (a Calculator, a Programmable Filter) do not decide it. Data without
+/// a pipeline behind it can, unless its information says it cannot (pieces of a composite
+/// input, already spread over the processes).
 bool CanProduceSubExtent(vtkInformation* inputInformation);
 
 /// Asks the input for piece `piece` of `pieces` of its whole extent, without ghost levels:

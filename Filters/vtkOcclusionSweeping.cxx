@@ -5,6 +5,7 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionCollectives.h"
+#include "vtkAmbientOcclusionComposite.h"
 #include "vtkAmbientOcclusionExtents.h"
 
 #include "vao/BlockSweeping.h"
@@ -187,9 +188,35 @@ bool vtkOcclusionSweeping::IsDistributed(const int whole[6]) const
 }
 
 //------------------------------------------------------------------------------
-int vtkOcclusionSweeping::RequestInformation(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+vtkTypeBool vtkOcclusionSweeping::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  // The output is like the input: an image, or a composite data set of images.
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT()))
+    return vtkAmbientOcclusionComposite::RequestDataObject(inputVector, outputVector);
+  return this->Superclass::ProcessRequest(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------
+int vtkOcclusionSweeping::FillInputPortInformation(int, vtkInformation* info)
+{
+  vtkAmbientOcclusionComposite::AcceptImagesAndComposites(info);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkOcclusionSweeping::FillOutputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkDataObject"); // made by ProcessRequest
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkOcclusionSweeping::RequestInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (vtkAmbientOcclusionComposite::IsComposite(inputVector[0]->GetInformationObject(0)))
+    return 1; // each volume's pieces are where the composite data set has them
   // Any piece can be produced, from the whole volume (see RequestUpdateExtent).
   outputVector->GetInformationObject(0)->Set(CAN_PRODUCE_SUB_EXTENT(), 1);
   return 1;
@@ -202,6 +229,8 @@ int vtkOcclusionSweeping::RequestUpdateExtent(
   // Sweeping is global: an occluder anywhere shadows everything behind it. One process
   // sweeps the whole volume; several sweep a slab each (plus its ghost layer).
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  if (vtkAmbientOcclusionComposite::IsComposite(inInfo))
+    return 1; // the piece request passes on as it is
   int whole[6];
   inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
   if (this->IsDistributed(whole))
@@ -234,6 +263,11 @@ void vtkOcclusionSweeping::WarnNoSurface(const std::string& arrayName)
 int vtkOcclusionSweeping::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  if (vtkAmbientOcclusionComposite::IsComposite(inputVector[0]->GetInformationObject(0)))
+    return vtkAmbientOcclusionComposite::ProduceEachVolume(this, this->Controller, inputVector,
+      outputVector,
+      [&](vtkInformationVector** in, vtkInformationVector* out)
+      { return this->RequestData(nullptr, in, out); });
   return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
     "use more MPI ranks, turn OutputOctantVisibility off, or crop or resample the volume.",
     [&] { return this->ProduceOutput(inputVector, outputVector); });

@@ -4,12 +4,14 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionCollectives.h"
+#include "vtkAmbientOcclusionComposite.h"
 #include "vtkAmbientOcclusionExtents.h"
 #include "vtkAmbientOcclusionFrame.h"
 #include "vtkAmbientOcclusionPyramidImages.h"
 
 #include "vao/VarianceOcclusionMap.h"
 
+#include "vtkCompositeDataSet.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -38,7 +40,7 @@ vtkVarianceOcclusionMap::vtkVarianceOcclusionMap()
 //------------------------------------------------------------------------------
 int vtkVarianceOcclusionMap::FillInputPortInformation(int, vtkInformation* info)
 {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  vtkAmbientOcclusionComposite::AcceptImagesAndComposites(info);
   return 1;
 }
 
@@ -75,6 +77,8 @@ int vtkVarianceOcclusionMap::RequestUpdateExtent(
   // Each level voxel depends on the input within PyramidReach of it: a piece needs its
   // extent grown by that (aligned on the coarsest level's voxels), not the whole volume.
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  if (vtkAmbientOcclusionComposite::IsComposite(inInfo))
+    return 1; // the piece request passes on as it is
   if (vtkMultiProcessController* controller = SharedController(inInfo))
   {
     // A reader that does not split: read on one process, fetched by ProduceOutput.
@@ -110,9 +114,58 @@ vao::PyramidParameters vtkVarianceOcclusionMap::Parameters() const
 int vtkVarianceOcclusionMap::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  if (vtkAmbientOcclusionComposite::IsComposite(inputVector[0]->GetInformationObject(0)))
+    return this->ProduceEachVolume(inputVector, outputVector);
   return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
     "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.",
     [&] { return this->ProduceOutput(inputVector, outputVector); });
+}
+
+//------------------------------------------------------------------------------
+int vtkVarianceOcclusionMap::ProduceEachVolume(
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // One volume: its levels, as from an image. Several: a block of levels per volume.
+  vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector);
+  output->Initialize();
+  std::string error;
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  const int rank = controller ? controller->GetLocalProcessId() : 0;
+  const int ranks = controller ? controller->GetNumberOfProcesses() : 1;
+  const bool done = vtkAmbientOcclusionComposite::ForEachVolume(
+    controller, inputVector[0]->GetInformationObject(0),
+    [&](int volume, int volumes, vtkInformation* inInfo)
+    {
+      vtkNew<vtkInformationVector> inputs, outputs;
+      inputs->Append(inInfo);
+      vtkNew<vtkInformation> outInfo;
+      vtkNew<vtkMultiBlockDataSet> levels;
+      outInfo->Set(vtkDataObject::DATA_OBJECT(), levels);
+      outInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), rank);
+      outInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), ranks);
+      outputs->Append(outInfo);
+      vtkInformationVector* in[1] = { inputs };
+      this->RequestData(nullptr, in, outputs);
+      if (levels->GetNumberOfBlocks() == 0 && this->NumberOfLevels > 0)
+        return false; // it said why
+      if (volumes == 1)
+        output->ShallowCopy(levels);
+      else
+      {
+        output->SetBlock(static_cast<unsigned int>(volume), levels);
+        output->GetMetaData(static_cast<unsigned int>(volume))
+          ->Set(vtkCompositeDataSet::NAME(), ("Volume " + std::to_string(volume)).c_str());
+      }
+      return true;
+    },
+    error);
+  if (!done)
+  {
+    output->Initialize();
+    if (!error.empty())
+      vtkErrorMacro(<< error);
+  }
+  return 1;
 }
 
 //------------------------------------------------------------------------------

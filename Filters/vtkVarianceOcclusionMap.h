@@ -85,6 +85,8 @@ private:
   vtkVarianceOcclusionMap(const vtkVarianceOcclusionMap&) = delete;
   void operator=(const vtkVarianceOcclusionMap&) = delete;
 
+  /// The levels of each volume of a composite input.
+  int ProduceEachVolume(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
   /// The pyramid's levels of the requested piece (RequestData's body, inside its memory
   /// guard).
   int ProduceOutput(vtkInformationVector** inputVector, vtkInformationVector* outputVector);

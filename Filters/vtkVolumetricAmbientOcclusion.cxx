@@ -5,6 +5,7 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionCollectives.h"
+#include "vtkAmbientOcclusionComposite.h"
 #include "vtkAmbientOcclusionExtents.h"
 #include "vtkAmbientOcclusionMemory.h"
 #include "vtkAmbientOcclusionOpacity.h"
@@ -237,9 +238,35 @@ vao::RayParameters vtkVolumetricAmbientOcclusion::Rays(const double spacing[3]) 
 }
 
 //------------------------------------------------------------------------------
-int vtkVolumetricAmbientOcclusion::RequestInformation(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+vtkTypeBool vtkVolumetricAmbientOcclusion::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  // The output is like the input: an image, or a composite data set of images.
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT()))
+    return vtkAmbientOcclusionComposite::RequestDataObject(inputVector, outputVector);
+  return this->Superclass::ProcessRequest(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumetricAmbientOcclusion::FillInputPortInformation(int, vtkInformation* info)
+{
+  vtkAmbientOcclusionComposite::AcceptImagesAndComposites(info);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumetricAmbientOcclusion::FillOutputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkDataObject"); // made by ProcessRequest
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumetricAmbientOcclusion::RequestInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (vtkAmbientOcclusionComposite::IsComposite(inputVector[0]->GetInformationObject(0)))
+    return 1; // each volume's pieces are where the composite data set has them
   // Any sub-extent can be computed (from that extent grown by the radius), so the
   // executive may turn a piece request (MPI rank, streaming) into an extent request here.
   outputVector->GetInformationObject(0)->Set(CAN_PRODUCE_SUB_EXTENT(), 1);
@@ -251,6 +278,8 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  if (vtkAmbientOcclusionComposite::IsComposite(inInfo))
+    return 1; // the piece request passes on as it is
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   if (!vtkAmbientOcclusionExtents::CanProduceSubExtent(inInfo))
   {
@@ -297,6 +326,11 @@ int vtkVolumetricAmbientOcclusion::RequestUpdateExtent(
 int vtkVolumetricAmbientOcclusion::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  if (vtkAmbientOcclusionComposite::IsComposite(inputVector[0]->GetInformationObject(0)))
+    return vtkAmbientOcclusionComposite::ProduceEachVolume(this, this->Controller, inputVector,
+      outputVector,
+      [&](vtkInformationVector** in, vtkInformationVector* out)
+      { return this->RequestData(nullptr, in, out); });
   return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
     "compute it in pieces (streaming or more MPI ranks), on a smaller extent, or without "
     "ComputeVariance.",

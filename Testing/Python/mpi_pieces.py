@@ -12,15 +12,13 @@ import sys
 import numpy as np
 
 from paraview.simple import LoadPlugin
-from vtkmodules.util.misc import calldata_type
-from vtkmodules.vtkCommonCore import VTK_STRING, vtkCommand
 from vtkmodules.vtkCommonDataModel import vtkImageData
 from vtkmodules.vtkCommonExecutionModel import vtkTrivialProducer
 from vtkmodules.vtkParallelCore import vtkMultiProcessController
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from vao_test_utils import check  # noqa: E402
+from vao_test_utils import check, errors_of  # noqa: E402
 
 LoadPlugin(sys.argv[1], remote=False)
 sys.path.insert(0, sys.argv[2])
@@ -45,18 +43,6 @@ def slab_producer(whole):
     if whole:
         producer.SetWholeExtent(0, nx - 1, 0, ny - 1, 0, nz - 1)
     return producer
-
-
-def errors_of(algorithm):
-    """The error messages `algorithm` will emit."""
-    errors = []
-
-    @calldata_type(VTK_STRING)
-    def collect(caller, event, message):
-        errors.append(message)
-
-    algorithm.AddObserver(vtkCommand.ErrorEvent, collect)
-    return errors
 
 
 def piece_of(image, array, serial):

@@ -127,3 +127,16 @@ def opacity_openness(values, function, radii):
     alpha = np.array([function.GetValue(float(v)) for v in distinct])[inverse].reshape(values.shape)
     return 1.0 - box_mean(alpha, radii)
 
+
+def errors_of(algorithm):
+    """The list that collects the error messages `algorithm` will emit."""
+    from vtkmodules.util.misc import calldata_type
+    from vtkmodules.vtkCommonCore import VTK_STRING, vtkCommand
+    errors = []
+
+    @calldata_type(VTK_STRING)
+    def collect(caller, event, message):
+        errors.append(message)
+
+    algorithm.AddObserver(vtkCommand.ErrorEvent, collect)
+    return errors
