@@ -62,10 +62,10 @@ struct Volume
 /// The composite input's leaves, in traversal order, and its volumes.
 struct Volumes
 {
-  std::vector<vtkDataObject*> leaves;   // every non-empty leaf, in traversal order
-  std::vector<int> leafPiece;           // its index among this process's image pieces, or -1
-  std::vector<vtkImageData*> pieces;    // this process's image pieces with voxels
-  std::vector<int> pieceVolume;         // the volume of each
+  std::vector<vtkDataObject*> leaves;         // every non-empty leaf, in traversal order
+  std::vector<int> leafPiece;                 // its index among this process's image pieces, or -1
+  std::vector<vtkImageData*> pieces;          // this process's image pieces with voxels
+  std::vector<int> pieceVolume;               // the volume of each
   std::vector<std::array<int, 3>> pieceShift; // its extent's shift into the volume's indices
   std::vector<Volume> volumes;
 };
@@ -147,8 +147,8 @@ void ListLeaves(vtkCompositeDataSet* input, std::vector<vtkDataObject*>& leaves,
 }
 
 /// Collective: the volumes of a composite input, the same on every process.
-bool FindVolumes(
-  vtkMultiProcessController* controller, vtkCompositeDataSet* input, Volumes& found, std::string& error)
+bool FindVolumes(vtkMultiProcessController* controller, vtkCompositeDataSet* input, Volumes& found,
+  std::string& error)
 {
   std::map<vtkDataObject*, int> scopes;
   ListLeaves(input, found.leaves, scopes);
@@ -157,9 +157,8 @@ bool FindVolumes(
   for (vtkDataObject* leaf : found.leaves)
   {
     auto* image = vtkImageData::SafeDownCast(leaf);
-    found.leafPiece.push_back(image && image->GetNumberOfPoints() > 0
-        ? static_cast<int>(found.pieces.size())
-        : -1);
+    found.leafPiece.push_back(
+      image && image->GetNumberOfPoints() > 0 ? static_cast<int>(found.pieces.size()) : -1);
     if (!image)
     {
       foreign = leaf->GetClassName();
@@ -295,8 +294,8 @@ bool GatherPiece(vtkMultiProcessController* controller, const Volumes& found, in
   vtkAmbientOcclusionExtents::PieceOfWhole(rank, ranks, volume.whole, piece);
   const auto held = PiecesOf(found, v);
   vtkNew<vtkImageData> gathered;
-  if (!vtkAmbientOcclusionCollectives::RedistributeExtents(controller, Raw(held),
-        std::vector<int>(piece, piece + 6), { gathered.Get() }))
+  if (!vtkAmbientOcclusionCollectives::RedistributeExtents(
+        controller, Raw(held), std::vector<int>(piece, piece + 6), { gathered.Get() }))
   {
     const int* w = volume.whole;
     std::ostringstream why;
@@ -322,8 +321,8 @@ bool GatherPiece(vtkMultiProcessController* controller, const Volumes& found, in
 }
 
 /// An output information asking for piece `rank` of `ranks` of `whole`.
-void AskForPiece(vtkInformation* information, vtkDataObject* output, int rank, int ranks,
-  const int whole[6])
+void AskForPiece(
+  vtkInformation* information, vtkDataObject* output, int rank, int ranks, const int whole[6])
 {
   int piece[6];
   vtkAmbientOcclusionExtents::PieceOfWhole(rank, ranks, whole, piece);
@@ -375,8 +374,7 @@ bool ForEachVolume(vtkMultiProcessController* controller, vtkInformation* input,
 {
   Volumes found;
   if (!FindVolumes(controller,
-        vtkCompositeDataSet::SafeDownCast(input->Get(vtkDataObject::DATA_OBJECT())), found,
-        error))
+        vtkCompositeDataSet::SafeDownCast(input->Get(vtkDataObject::DATA_OBJECT())), found, error))
     return false;
   const int volumes = static_cast<int>(found.volumes.size());
   for (int v = 0; v < volumes; ++v)

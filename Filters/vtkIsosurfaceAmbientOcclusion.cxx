@@ -160,11 +160,24 @@ PyramidKernels Kernels(Source& source, const Sampling& s)
 }
 } // namespace
 
+namespace
+{
+/// The time step of a data object (DATA_TIME_STEP), NaN when it has none.
+double DataTime(vtkDataObject* data)
+{
+  vtkInformation* info = data->GetInformation();
+  return info && info->Has(vtkDataObject::DATA_TIME_STEP())
+    ? info->Get(vtkDataObject::DATA_TIME_STEP())
+    : std::nan("");
+}
+} // namespace
+
 /// The pyramid of the last volume, and what it was built from: the array (and its MTime,
 /// which VTK bumps whenever a source refills it or a user calls array->Modified()) on the
 /// volume's grid. Not the volume object's MTime: ParaView hands the filter a shallow copy
 /// of the reader's output that is made again on every update (vtkPVPostFilter), which
-/// rebuilt the pyramid on every light move.
+/// rebuilt the pyramid on every light move. And the volume's time step: an in situ adaptor
+/// may refill the same array at each step without marking it modified.
 struct vtkIsosurfaceAmbientOcclusion::Cache
 {
   // One process: level 0 kept only where the surfaces sample it. Under MPI: the whole
@@ -174,6 +187,7 @@ struct vtkIsosurfaceAmbientOcclusion::Cache
   std::array<int, 6> extent{};
   vtkDataArray* array = nullptr;
   vtkMTimeType arrayTime = 0;
+  double dataTime = std::nan(""); // the volume's DATA_TIME_STEP; NaN when it has none
   int component = -1;
   int numberOfLevels = 0;
   bool halfResolution = false;
@@ -509,8 +523,11 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
     cache.origin == PyramidImages::ExtentOrigin(volume) &&
     cache.spacing == std::array<double, 3>{ h[0], h[1], h[2] } &&
     std::equal(d, d + 9, cache.scalars.frame.direction.begin());
+  const double dataTime = DataTime(volume);
+  const bool sameTime =
+    dataTime == cache.dataTime || (std::isnan(dataTime) && std::isnan(cache.dataTime));
   const bool fresh = chosen && cache.array == chosen && cache.arrayTime == chosen->GetMTime() &&
-    sameGrid && cache.component == this->Component &&
+    sameTime && sameGrid && cache.component == this->Component &&
     cache.numberOfLevels == this->NumberOfLevels &&
     cache.halfResolution == (this->StartAtHalfResolution != 0) && !cache.surface.empty();
   if (fresh)
@@ -538,6 +555,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
   std::copy(extent, extent + 6, cache.extent.begin());
   cache.array = chosen;
   cache.arrayTime = chosen ? chosen->GetMTime() : 0;
+  cache.dataTime = dataTime;
   cache.component = this->Component;
   cache.numberOfLevels = this->NumberOfLevels;
   cache.halfResolution = this->StartAtHalfResolution != 0;
