@@ -284,6 +284,7 @@ int vtkIsosurfaceAmbientOcclusion::RequestUpdateExtent(
   {
     volumeInfo->Get(vtkDataObject::SPACING(), spacing);
   }
+  this->PieceOf(whole, piece);
   this->VolumeExtentOf(whole, spacing, piece, ext);
   Extents::RequestExactExtent(volumeInfo, ext);
   return 1;
@@ -357,11 +358,16 @@ bool vtkIsosurfaceAmbientOcclusion::IsDistributed() const
 }
 
 //------------------------------------------------------------------------------
-void vtkIsosurfaceAmbientOcclusion::VolumeExtentOf(
-  const int whole[6], const double spacing[3], int piece[6], int ext[6]) const
+void vtkIsosurfaceAmbientOcclusion::PieceOf(const int whole[6], int piece[6]) const
 {
   Extents::PieceOfWhole(
     this->Controller->GetLocalProcessId(), this->Controller->GetNumberOfProcesses(), whole, piece);
+}
+
+//------------------------------------------------------------------------------
+void vtkIsosurfaceAmbientOcclusion::VolumeExtentOf(
+  const int whole[6], const double spacing[3], const int piece[6], int ext[6]) const
+{
   if (Extents::EmptyExtent(piece))
   {
     std::copy(piece, piece + 6, ext);
@@ -370,6 +376,62 @@ void vtkIsosurfaceAmbientOcclusion::VolumeExtentOf(
   const int levels = std::max(2, std::min(this->NumberOfLevels, 16));
   Extents::GrowForSurfaceQueries(whole, piece, spacing, levels, this->StartAtHalfResolution != 0,
     this->OffsetFactor, kSurfaceSlack, ext);
+}
+
+//------------------------------------------------------------------------------
+int vtkIsosurfaceAmbientOcclusion::AdoptHeldPiece(vtkPolyData* surface, vtkImageData*& volume,
+  const int whole[6], int piece[6], vtkImageData* fetched)
+{
+  // Whether this process's surface points lie in its piece (a Contour of it), with the
+  // slack of a surface piece's ghost cells; on an axis-aligned grid only.
+  int held[6] = { 0, -1, 0, -1, 0, -1 };
+  if (volume->GetNumberOfPoints() > 0)
+    volume->GetExtent(held);
+  bool inside = surface->GetNumberOfPoints() == 0;
+  if (!inside && !Extents::EmptyExtent(held) && volume->GetDirectionMatrix()->IsIdentity())
+  {
+    const int slacks[3] = { kSurfaceSlack, kSurfaceSlack, kSurfaceSlack };
+    int reached[6];
+    std::copy(held, held + 6, reached);
+    Extents::GrowExtent(reached, slacks, whole);
+    const double* bounds = surface->GetBounds();
+    const double* origin = volume->GetOrigin();
+    const double* h = volume->GetSpacing();
+    inside = true;
+    for (int a = 0; a < 3; ++a)
+      inside = inside && bounds[2 * a] >= origin[a] + (reached[2 * a] - 0.5) * h[a] &&
+        bounds[2 * a + 1] <= origin[a] + (reached[2 * a + 1] + 0.5) * h[a];
+  }
+  // The coarsest level is assembled from every piece's: they must fill the whole extent.
+  std::vector<double> mine(held, held + 6), all;
+  std::vector<int> owners;
+  vtkAmbientOcclusionCollectives::GatherLists(this->Controller, mine, 6, all, owners);
+  bool complete = false;
+  vtkAmbientOcclusionCollectives::PlanTransfers(std::vector<int>(all.begin(), all.end()), owners,
+    std::vector<int>(whole, whole + 6), { 0 }, complete);
+  if (vtkAmbientOcclusionCollectives::GlobalMax(this->Controller, complete && inside ? 0.0 : 1.0) >
+    0.0)
+    return 0;
+  std::copy(held, held + 6, piece);
+  int ext[6];
+  this->VolumeExtentOf(whole, volume->GetSpacing(), piece, ext);
+  std::string error;
+  vtkImageData* covered = vtkAmbientOcclusionCollectives::CoverNeededExtent(
+    this->Controller, volume, whole, ext, fetched, error);
+  if (!covered)
+  {
+    vtkErrorMacro(<< error);
+    return -1;
+  }
+  if (!Extents::EmptyExtent(ext) && !std::equal(ext, ext + 6, covered->GetExtent()))
+  {
+    vtkNew<vtkImageData> cropped;
+    Extents::CopyRequestedExtent(covered, cropped, ext);
+    fetched->ShallowCopy(cropped);
+    covered = fetched;
+  }
+  volume = covered;
+  return 1;
 }
 
 //------------------------------------------------------------------------------
@@ -435,30 +497,44 @@ int vtkIsosurfaceAmbientOcclusion::ProduceOutput(
   bool distributed = this->IsDistributed();
   vtkNew<vtkImageData> fetched;
   vtkDataArray* chosen = this->GetInputArrayToProcess(0, inputVector);
+  int piece[6];
+  std::copy(whole, whole + 6, piece);
+  if (distributed)
+    this->PieceOf(whole, piece);
   if (distributed && !Extents::CanProduceSubExtent(inputVector[1]->GetInformationObject(0)))
   {
-    // The volume's reader does not split: every process with surface points takes the
-    // whole volume from the one that read it, and shades its points as one process does.
-    if (!this->CheckParameters()) // the same answer on every process, before the collective
+    if (!this->CheckParameters()) // the same answer on every process, before the collectives
     {
       return 1;
     }
-    const int none[6] = { 0, -1, 0, -1, 0, -1 };
-    std::string error;
-    volume = vtkAmbientOcclusionCollectives::CoverNeededExtent(this->Controller, volume, whole,
-      surface->GetNumberOfPoints() > 0 ? whole : none, fetched, error);
-    if (!volume)
+    // Pieces handed over (in situ): each process keeps its own, with its reach.
+    const int adopted = this->AdoptHeldPiece(surface, volume, whole, piece, fetched);
+    if (adopted < 0)
     {
-      vtkErrorMacro(<< error);
       return 1;
     }
-    if (surface->GetNumberOfPoints() == 0)
+    if (adopted == 0)
     {
-      output->ShallowCopy(surface);
-      return 1;
+      // A reader that does not split, or a surface away from the pieces: every process
+      // with surface points takes the whole volume from the processes that hold it, and
+      // shades its points as one process does.
+      const int none[6] = { 0, -1, 0, -1, 0, -1 };
+      std::string error;
+      volume = vtkAmbientOcclusionCollectives::CoverNeededExtent(this->Controller, volume, whole,
+        surface->GetNumberOfPoints() > 0 ? whole : none, fetched, error);
+      if (!volume)
+      {
+        vtkErrorMacro(<< error);
+        return 1;
+      }
+      if (surface->GetNumberOfPoints() == 0)
+      {
+        output->ShallowCopy(surface);
+        return 1;
+      }
+      distributed = false;
     }
     chosen = this->GetInputArrayToProcess(0, volume);
-    distributed = false;
   }
   if (!distributed && !std::equal(whole, whole + 6, volume->GetExtent()))
   {
@@ -473,8 +549,8 @@ int vtkIsosurfaceAmbientOcclusion::ProduceOutput(
   {
     return 1;
   }
-  int piece[6];
-  std::copy(whole, whole + 6, piece);
+  if (!distributed)
+    std::copy(whole, whole + 6, piece);
   if (distributed ? !this->UpdateDistributedPyramid(volume, chosen, whole, piece)
                   : !this->UpdatePyramid(volume, chosen))
   {
@@ -565,7 +641,7 @@ bool vtkIsosurfaceAmbientOcclusion::UpdatePyramid(vtkImageData* volume, vtkDataA
 
 //------------------------------------------------------------------------------
 bool vtkIsosurfaceAmbientOcclusion::UpdateDistributedPyramid(
-  vtkImageData* volume, vtkDataArray* chosen, const int whole[6], int piece[6])
+  vtkImageData* volume, vtkDataArray* chosen, const int whole[6], const int piece[6])
 {
   Cache& cache = *this->Pyramid;
   cache.levels.clear();

@@ -195,12 +195,22 @@ private:
   vao::PyramidParameters PyramidRequest() const;
   bool UpdatePyramid(vtkImageData* volume, vtkDataArray* chosen);
   bool IsDistributed() const;
-  /// This process's piece of the volume and the extent it reads (grown by the reach).
-  void VolumeExtentOf(const int whole[6], const double spacing[3], int piece[6], int ext[6]) const;
-  /// The pyramid of this process's extent, its coarsest level replaced by the whole one.
+  /// This process's piece of the volume as ParaView splits it.
+  void PieceOf(const int whole[6], int piece[6]) const;
+  /// The extent a piece's pyramid reads: the piece grown by the reach of the queries.
+  void VolumeExtentOf(
+    const int whole[6], const double spacing[3], const int piece[6], int ext[6]) const;
+  /// Pieces handed over (a source that cannot be asked for an extent): when every
+  /// process's surface lies in the piece it holds and the pieces fill the whole extent,
+  /// `piece` becomes the held piece and `volume` that piece with its reach fetched from
+  /// the neighbours (into `fetched`): 1. 0 when not (the whole volume is needed), -1 on
+  /// an error (reported). Collective.
+  int AdoptHeldPiece(vtkPolyData* surface, vtkImageData*& volume, const int whole[6], int piece[6],
+    vtkImageData* fetched);
+  /// The pyramid of this process's piece, its coarsest level replaced by the whole one.
   /// Collective: every process calls it, also after an error of its own.
   bool UpdateDistributedPyramid(
-    vtkImageData* volume, vtkDataArray* chosen, const int whole[6], int piece[6]);
+    vtkImageData* volume, vtkDataArray* chosen, const int whole[6], const int piece[6]);
   /// Replaces the coarsest level of this process's pyramid (built from `inputExt`) by the
   /// whole volume's, assembled from every process's piece. Collective.
   void ShareCoarsestLevel(

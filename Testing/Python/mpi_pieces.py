@@ -1,7 +1,8 @@
 """pvbatch --symmetric under mpiexec: each rank owns a z-slab of a volume, without ghost
 layers, handed to the filters by a vtkTrivialProducer (what an in situ adaptor does). With
 the whole extent given to the producer, Volumetric AO (Gaussian CDF and Histogram CDF),
-Occlusion Sweeping and the Variance Occlusion Map give the serial numbers; without it (each
+Occlusion Sweeping, the Variance Occlusion Map and Isosurface AO (of each slab's contour)
+give the serial numbers, fetching only their reach from the neighbours; without it (each
 rank's whole extent is its own slab) each refuses on every rank with an error that names the
 whole extent, and outputs nothing, instead of results that are wrong at every slab's border.
 Prints "ok: ..." / "FAILED: ..." per check and ends normally either way: ctest judges the
@@ -14,6 +15,7 @@ import numpy as np
 from paraview.simple import LoadPlugin
 from vtkmodules.vtkCommonDataModel import vtkImageData
 from vtkmodules.vtkCommonExecutionModel import vtkTrivialProducer
+from vtkmodules.vtkFiltersCore import vtkFlyingEdges3D
 from vtkmodules.vtkParallelCore import vtkMultiProcessController
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 
@@ -120,4 +122,45 @@ for whole in (True, False):
               % (rank, ranks))
         check(any("disagree on the whole extent" in e for e in errors),
               "Variance Occlusion Map, rank %d: an error says the ranks disagree on the whole extent" % rank)
+# Isosurface AO of each slab's own contour (a Contour in the same Catalyst pipeline): the
+# serial AO of those points, from the slab and its reach, not from the whole volume.
+whole_image = vtkImageData()
+whole_image.SetExtent(0, nx - 1, 0, ny - 1, 0, nz - 1)
+values = numpy_to_vtk(volume.ravel(), deep=1)
+values.SetName("f")
+whole_image.GetPointData().SetScalars(values)
+for whole in (True, False):
+    producer = slab_producer(whole)
+    contour = vtkFlyingEdges3D()
+    contour.SetInputConnection(producer.GetOutputPort())
+    contour.SetValue(0, 1.0)
+    contour.ComputeNormalsOn()
+    iso = volumetricao.vtkIsosurfaceAmbientOcclusion()
+    iso.SetController(controller)
+    iso.SetInputConnection(0, contour.GetOutputPort())
+    iso.SetInputConnection(1, producer.GetOutputPort())
+    errors = errors_of(iso)
+    iso.UpdatePiece(rank, ranks, 0)
+    ao = iso.GetOutput().GetPointData().GetArray("AmbientOcclusion")
+    if whole:
+        surface = contour.GetOutput().NewInstance()
+        surface.DeepCopy(contour.GetOutput())
+        serial = volumetricao.vtkIsosurfaceAmbientOcclusion()
+        serial.SetController(None)
+        serial.SetInputData(0, surface)
+        serial.SetInputData(1, whole_image)
+        serial.Update()
+        expected = vtk_to_numpy(serial.GetOutput().GetPointData().GetArray("AmbientOcclusion"))
+        got = vtk_to_numpy(ao) if ao is not None else np.zeros(0)
+        check(got.size == expected.size and expected.size > 0,
+              "Isosurface AO, rank %d of %d: AO on each of the slab contour's %d points" % (rank, ranks, expected.size))
+        if got.size == expected.size:
+            difference = float(np.abs(got - expected).max()) if got.size else 0.0
+            check(difference <= 1e-6, "Isosurface AO, rank %d of %d: the serial AO (max difference %.3g)"
+                  % (rank, ranks, difference))
+        check(not errors, "Isosurface AO, rank %d: no error (%s)" % (rank, errors[:1]))
+    else:
+        check(ao is None, "Isosurface AO, rank %d of %d, slabs without the whole extent: no AO" % (rank, ranks))
+        check(any("disagree on the whole extent" in e for e in errors),
+              "Isosurface AO, rank %d: an error says the ranks disagree on the whole extent" % rank)
 print("rank %d of %d done" % (rank, ranks), flush=True)
