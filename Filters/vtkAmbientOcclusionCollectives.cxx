@@ -16,6 +16,7 @@
 #include "vtkSmartPointer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -233,6 +234,21 @@ GatheredLayout LayoutOf(const std::vector<int>& extents, int valuesPerPoint)
 
 } // namespace
 
+namespace
+{
+std::atomic<vtkIdType> sentBytes{ 0 };
+}
+
+vtkIdType BytesSent()
+{
+  return sentBytes.load();
+}
+
+void CountSent(vtkIdType bytes)
+{
+  sentBytes += bytes;
+}
+
 void GatherLists(vtkMultiProcessController* controller, const std::vector<double>& mine, int per,
   std::vector<double>& all, std::vector<int>& owners)
 {
@@ -260,7 +276,7 @@ void GlobalRange(vtkMultiProcessController* controller, double range[2])
 
 bool RedistributeExtents(vtkMultiProcessController* controller,
   const std::vector<vtkImageData*>& held, const std::vector<int>& wanted,
-  const std::vector<vtkImageData*>& outputs, vtkIdType* bytesSent)
+  const std::vector<vtkImageData*>& outputs)
 {
   const int ranks = controller ? controller->GetNumberOfProcesses() : 1;
   const int rank = controller ? controller->GetLocalProcessId() : 0;
@@ -334,8 +350,7 @@ bool RedistributeExtents(vtkMultiProcessController* controller,
             vtkNew<vtkImageData> piece;
             CopyRequestedExtent(held[part.block - firstHeld], piece, part.ext);
             controller->Send(piece.Get(), other, kPieceTag);
-            if (bytesSent)
-              *bytesSent += ArrayBytes(piece);
+            CountSent(ArrayBytes(piece));
           }
       };
       auto receive = [&]
@@ -366,15 +381,14 @@ bool RedistributeExtents(vtkMultiProcessController* controller,
 }
 
 bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
-  const int wanted[6], vtkImageData* output, vtkIdType* bytesSent)
+  const int wanted[6], vtkImageData* output)
 {
   return RedistributeExtents(controller, std::vector<vtkImageData*>{ held },
-    std::vector<int>(wanted, wanted + 6), std::vector<vtkImageData*>{ output }, bytesSent);
+    std::vector<int>(wanted, wanted + 6), std::vector<vtkImageData*>{ output });
 }
 
 vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageData* input,
-  const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error,
-  vtkIdType* bytesSent)
+  const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error)
 {
   // One whole extent on every process: the largest of each bound and of its negation.
   int bounds[12], largest[12];
@@ -405,7 +419,7 @@ vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageD
       std::equal(common, common + 6, needed));
   if (GlobalMax(controller, covered ? 0.0 : 1.0) == 0.0)
     return input;
-  if (RedistributeExtents(controller, input, needed, fetched, bytesSent))
+  if (RedistributeExtents(controller, input, needed, fetched))
     return fetched;
   error = "The processes' pieces of the input do not hold every voxel this filter needs: "
           "give it a source that delivers the whole data set across the processes.";
@@ -430,6 +444,8 @@ void GatherLevel(vtkMultiProcessController* controller, vtkImageData* part, vao:
   controller->AllGather(ext, extents.data(), 6);
   GatheredLayout layout = LayoutOf(extents, 2);
   std::vector<float> all(static_cast<size_t>(std::max<vtkIdType>(layout.total, 1)));
+  CountSent(static_cast<vtkIdType>(mine.size() * sizeof(float)) *
+    (controller->GetNumberOfProcesses() - 1)); // each other process receives it
   controller->AllGatherV(mine.data(), all.data(), static_cast<vtkIdType>(mine.size()),
     layout.lengths.data(), layout.offsets.data());
 

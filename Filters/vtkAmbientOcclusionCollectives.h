@@ -20,6 +20,14 @@ struct MomentLevel;
 namespace vtkAmbientOcclusionCollectives
 {
 
+/// The bytes of voxel and pyramid data this process has sent to the others so far (pieces
+/// and halos of RedistributeExtents, sweeping faces, pyramid levels): what the filters
+/// report as AmbientOcclusionBytesSent. Reductions of a few values are not counted.
+vtkIdType BytesSent();
+
+/// Adds to BytesSent (for messages sent outside this file).
+void CountSent(vtkIdType bytes);
+
 /// Every process's list of items (`per` values each) in rank order, in `all`, with each
 /// item's process in `owners`: the lists may differ in length. One process (or no
 /// controller): its own list.
@@ -41,15 +49,15 @@ void GlobalRange(vtkMultiProcessController* controller, double range[2]);
 /// process's own blocks where it can, else from the lowest process that holds it, with the
 /// holders' geometry and point arrays. Only the voxels wanted elsewhere travel. False,
 /// with every output empty, when some wanted voxel is held by no process (the same on
-/// every process). `bytesSent`, when given, grows by the array bytes this process sent.
+/// every process).
 /// Without a controller (or with one process) nothing is sent.
 bool RedistributeExtents(vtkMultiProcessController* controller,
   const std::vector<vtkImageData*>& held, const std::vector<int>& wanted,
-  const std::vector<vtkImageData*>& outputs, vtkIdType* bytesSent = nullptr);
+  const std::vector<vtkImageData*>& outputs);
 
 /// RedistributeExtents with one held block and one wanted extent on each process.
 bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* held,
-  const int wanted[6], vtkImageData* output, vtkIdType* bytesSent = nullptr);
+  const int wanted[6], vtkImageData* output);
 
 /// The image a process reads to compute its piece: `input` itself when every process's
 /// input covers the extent it needs (`needed`, possibly empty), as readers that split
@@ -60,8 +68,7 @@ bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
 /// as a whole volume: its AO would be wrong at the piece's borders), or when no process
 /// holds some needed voxel.
 vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageData* input,
-  const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error,
-  vtkIdType* bytesSent = nullptr);
+  const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error);
 
 /// One message of RedistributeExtents: the voxels `ext` of held block `block` from
 /// process `from` to wanted extent `into` of process `to` (block and extent indices count

@@ -1,12 +1,16 @@
 #include "vtkAmbientOcclusionRequest.h"
 
+#include "vtkAmbientOcclusionCollectives.h"
 #include "vtkAmbientOcclusionMemory.h"
 #include "vtkAmbientOcclusionRanges.h"
 
 #include "vtkAlgorithm.h"
 #include "vtkDataObject.h"
+#include "vtkFieldData.h"
+#include "vtkIdTypeArray.h"
 #include "vtkInformationVector.h"
 #include "vtkMultiProcessController.h"
+#include "vtkNew.h"
 
 #include <sstream>
 
@@ -48,8 +52,16 @@ int ProduceOutput(vtkAlgorithm* algorithm, vtkInformationVector* outputs, const 
   return vtkAmbientOcclusionMemory::Guard(algorithm, output, memoryHint,
     [&]() -> int
     {
+      const vtkIdType sentBefore = vtkAmbientOcclusionCollectives::BytesSent();
       const int result = produce();
       vtkAmbientOcclusionRanges::CacheOutput(output);
+      if (Distributed(vtkMultiProcessController::GetGlobalController()) && output)
+      {
+        vtkNew<vtkIdTypeArray> sent; // what the halos and pieces of this run cost this process
+        sent->SetName("AmbientOcclusionBytesSent");
+        sent->InsertNextValue(vtkAmbientOcclusionCollectives::BytesSent() - sentBefore);
+        output->GetFieldData()->AddArray(sent);
+      }
       return result;
     });
 }

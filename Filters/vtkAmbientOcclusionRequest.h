@@ -34,6 +34,8 @@ bool Distributed(vtkMultiProcessController* controller);
 /// the ranges of the output's arrays (vtkAmbientOcclusionRanges::CacheOutput), both under
 /// the memory guard (vtkAmbientOcclusionMemory::Guard): an allocation failure anywhere is
 /// the error "Not enough memory ...; <memoryHint>" and an empty output, never an abort.
+/// Under MPI the output's field data gets AmbientOcclusionBytesSent: the voxel and level
+/// bytes this process sent to the others during the run (vtkAmbientOcclusionCollectives).
 /// Returns what `produce` returned (1 after a shortage: the error is the answer).
 int ProduceOutput(vtkAlgorithm* algorithm, vtkInformationVector* outputs, const char* memoryHint,
   const std::function<int()>& produce);

@@ -100,6 +100,7 @@ double ExchangeFaces(vtkMultiProcessController* controller, vao::BlockSweeper& b
     const int neighbour = (face & 1) ? rank + 1 : rank - 1;
     std::vector<float> out(static_cast<std::size_t>(count)), in(static_cast<std::size_t>(count));
     block.exportFace(face, out.data());
+    vtkAmbientOcclusionCollectives::CountSent(count * static_cast<vtkIdType>(sizeof(float)));
     if (face & 1) // the lower of the pair
     {
       controller->Send(out.data(), count, neighbour, kFaceTag);
