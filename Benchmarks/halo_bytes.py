@@ -32,7 +32,9 @@ def worker(plugin, site_packages):
     from vtkmodules.vtkParallelCore import vtkMultiProcessController
     LoadPlugin(plugin, remote=False)
     sys.path.insert(0, site_packages)
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Testing", "Python"))
     import volumetricao
+    from vao_test_utils import serial_surface_values
 
     controller = vtkMultiProcessController.GetGlobalController()
     rank, ranks = controller.GetLocalProcessId(), controller.GetNumberOfProcesses()
@@ -103,17 +105,22 @@ def worker(plugin, site_packages):
     all_values = numpy_to_vtk(volume.ravel(), deep=1)
     all_values.SetName("f")
     whole.GetPointData().SetScalars(all_values)
-    surface = contour.GetOutput().NewInstance()
-    surface.DeepCopy(contour.GetOutput())
-    serial = volumetricao.vtkIsosurfaceAmbientOcclusion()
-    serial.SetController(None)
-    serial.SetInputData(0, surface)
-    serial.SetInputData(1, whole)
-    serial.Update()
-    got = vtk_to_numpy(iso.GetOutput().GetPointData().GetArray("AmbientOcclusion"))
-    expected = vtk_to_numpy(serial.GetOutput().GetPointData().GetArray("AmbientOcclusion"))
+
+    def surface_difference(f, make, name):
+        """Max difference of `name` from one process's filter at the same points."""
+        got = vtk_to_numpy(f.GetOutput().GetPointData().GetArray(name))
+        expected = serial_surface_values(make, contour.GetOutput(), whole, name)
+        return float(np.abs(got - expected).max()) if got.size == expected.size else float("inf")
+
     rows.append(("Isosurface AO (of each slab's contour)", sent(iso.GetOutput()),
-                 float(np.abs(got - expected).max()) if got.size == expected.size else float("inf")))
+                 surface_difference(iso, volumetricao.vtkIsosurfaceAmbientOcclusion, "AmbientOcclusion")))
+
+    probe = volumetricao.vtkProbeOutsideSurface()
+    probe.SetInputConnection(0, contour.GetOutputPort())
+    probe.SetInputConnection(1, producer.GetOutputPort())
+    probe.UpdatePiece(rank, ranks, 0)
+    rows.append(("Probe Outside Surface (of each contour)", sent(probe.GetOutput()),
+                 surface_difference(probe, volumetricao.vtkProbeOutsideSurface, "f")))
 
     values = np.array([r[1] for r in rows] + [r[2] for r in rows], dtype=np.float64)
     gathered = np.zeros(values.size * ranks)

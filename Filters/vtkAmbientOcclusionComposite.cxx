@@ -4,10 +4,12 @@
 #include "vtkAmbientOcclusionExtents.h"
 
 #include "vtkAlgorithm.h"
+#include "vtkAppendPolyData.h"
 #include "vtkCompositeDataSet.h"
 #include "vtkDataArray.h"
 #include "vtkDataObjectTree.h"
 #include "vtkDataObjectTreeIterator.h"
+#include "vtkDataObjectTypes.h"
 #include "vtkFieldData.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -18,6 +20,7 @@
 #include "vtkPartitionedDataSet.h"
 #include "vtkPartitionedDataSetCollection.h"
 #include "vtkPointData.h"
+#include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
@@ -350,22 +353,163 @@ bool IsComposite(vtkInformation* info)
   return info && vtkCompositeDataSet::SafeDownCast(info->Get(vtkDataObject::DATA_OBJECT()));
 }
 
-int RequestDataObject(vtkInformationVector** inputs, vtkInformationVector* outputs)
+void AcceptSurfacesAndComposites(vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkCompositeDataSet");
+}
+
+int RequestDataObject(
+  vtkInformationVector** inputs, vtkInformationVector* outputs, const char* single)
 {
   vtkInformation* inInfo = inputs[0]->GetInformationObject(0);
   vtkInformation* outInfo = outputs->GetInformationObject(0);
   vtkDataObject* input = inInfo ? inInfo->Get(vtkDataObject::DATA_OBJECT()) : nullptr;
   vtkDataObject* output = outInfo->Get(vtkDataObject::DATA_OBJECT());
   const bool composite = vtkCompositeDataSet::SafeDownCast(input) != nullptr;
-  if (composite ? (output && output->IsA(input->GetClassName()))
-                : vtkImageData::SafeDownCast(output) != nullptr)
+  const char* type = composite ? input->GetClassName() : single;
+  if (output && output->IsA(type))
     return 1;
   vtkSmartPointer<vtkDataObject> made;
   if (composite)
     made.TakeReference(input->NewInstance());
   else
-    made = vtkSmartPointer<vtkImageData>::New();
+    made.TakeReference(vtkDataObjectTypes::NewDataObject(single));
   outInfo->Set(vtkDataObject::DATA_OBJECT(), made);
+  return 1;
+}
+
+int ProduceOnSurface(vtkAlgorithm* filter, vtkMultiProcessController* controller,
+  vtkInformationVector** inputs, vtkInformationVector* outputs, const ImagePath& path)
+{
+  vtkInformation* surfaceInfo = inputs[0]->GetInformationObject(0);
+  vtkInformation* volumeInfo = inputs[1]->GetInformationObject(0);
+  vtkDataObject* output = vtkDataObject::GetData(outputs);
+  std::string error;
+  auto refuse = [&]
+  {
+    output->Initialize();
+    if (!error.empty())
+      vtkErrorWithObjectMacro(filter, << error);
+    return 1;
+  };
+  vtkNew<vtkInformationVector> surfaces, volumes;
+  if (IsComposite(volumeInfo))
+  {
+    Volumes found;
+    if (!FindVolumes(controller,
+          vtkCompositeDataSet::SafeDownCast(volumeInfo->Get(vtkDataObject::DATA_OBJECT())), found,
+          error))
+      return refuse();
+    if (found.volumes.size() != 1)
+    {
+      error = "The Volume input holds " + std::to_string(found.volumes.size()) +
+        " volumes (pieces on different grids, or none); this filter samples one.";
+      return refuse();
+    }
+    vtkNew<vtkInformation> gathered;
+    if (!GatherPiece(controller, found, 0, gathered, error))
+      return refuse();
+    volumes->Append(gathered);
+  }
+  else
+    volumes->Append(volumeInfo);
+
+  // The surface's blocks as one surface, each block's first point in it.
+  auto* composite =
+    vtkCompositeDataSet::SafeDownCast(surfaceInfo->Get(vtkDataObject::DATA_OBJECT()));
+  std::vector<vtkDataObject*> leaves;
+  std::vector<vtkIdType> firsts;
+  vtkNew<vtkPolyData> joined;
+  if (composite)
+  {
+    vtkNew<vtkAppendPolyData> append;
+    std::string foreign;
+    vtkIdType points = 0;
+    vtkSmartPointer<vtkCompositeDataIterator> it = LeafIterator(composite);
+    for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+    {
+      vtkDataObject* leaf = it->GetCurrentDataObject();
+      leaves.push_back(leaf);
+      firsts.push_back(points);
+      auto* polygons = vtkPolyData::SafeDownCast(leaf);
+      if (!polygons)
+        foreign = leaf->GetClassName();
+      else if (polygons->GetNumberOfPoints() > 0)
+      {
+        append->AddInputData(polygons);
+        points += polygons->GetNumberOfPoints();
+      }
+    }
+    if (GlobalMax(controller, foreign.empty() ? 0.0 : 1.0) > 0.0)
+    {
+      error = "The surface input holds " +
+        (foreign.empty() ? std::string("other data than surfaces") : "a " + foreign) +
+        " (on some process): give it polygonal data, or a composite data set of it.";
+      return refuse();
+    }
+    if (points > 0)
+    {
+      append->Update();
+      joined->ShallowCopy(append->GetOutput());
+    }
+    vtkNew<vtkInformation> info;
+    info->Set(vtkDataObject::DATA_OBJECT(), joined);
+    surfaces->Append(info);
+  }
+  else
+    surfaces->Append(surfaceInfo);
+
+  vtkNew<vtkInformationVector> results;
+  vtkNew<vtkPolyData> shaded;
+  if (composite)
+  {
+    vtkNew<vtkInformation> info;
+    info->Set(vtkDataObject::DATA_OBJECT(), shaded);
+    vtkInformation* asked = outputs->GetInformationObject(0);
+    info->CopyEntry(asked, vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
+    info->CopyEntry(asked, vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
+    results->Append(info);
+  }
+  vtkInformationVector* in[2] = { surfaces, volumes };
+  path(in, composite ? results.Get() : outputs);
+  if (!composite)
+    return 1;
+
+  // Each block with its points' new arrays.
+  auto* out = vtkCompositeDataSet::SafeDownCast(output);
+  out->Initialize();
+  if (shaded->GetNumberOfPoints() != joined->GetNumberOfPoints())
+    return 1; // the filter said why
+  out->CopyStructure(composite);
+  vtkSmartPointer<vtkCompositeDataIterator> it = LeafIterator(composite);
+  size_t leaf = 0;
+  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem(), ++leaf)
+  {
+    vtkSmartPointer<vtkDataObject> copy;
+    copy.TakeReference(leaves[leaf]->NewInstance());
+    copy->ShallowCopy(leaves[leaf]);
+    auto* block = vtkPolyData::SafeDownCast(copy);
+    const vtkIdType n = block->GetNumberOfPoints();
+    vtkPointData* arrays = shaded->GetPointData();
+    for (int a = 0; n > 0 && a < arrays->GetNumberOfArrays(); ++a)
+    {
+      vtkDataArray* from = arrays->GetArray(a);
+      if (!from)
+        continue;
+      vtkSmartPointer<vtkDataArray> part;
+      part.TakeReference(from->NewInstance());
+      part->SetName(from->GetName());
+      part->SetNumberOfComponents(from->GetNumberOfComponents());
+      part->SetNumberOfTuples(n);
+      part->InsertTuples(0, n, firsts[leaf], from);
+      block->GetPointData()->AddArray(part);
+    }
+    vtkFieldData* fields = shaded->GetFieldData();
+    for (int a = 0; a < fields->GetNumberOfArrays(); ++a)
+      block->GetFieldData()->AddArray(fields->GetAbstractArray(a));
+    out->SetDataSet(it, copy);
+  }
   return 1;
 }
 

@@ -32,9 +32,13 @@ void AcceptImagesAndComposites(vtkInformation* portInformation);
 /// Whether the data object on this input information is a composite data set.
 bool IsComposite(vtkInformation* inputInformation);
 
-/// The output of an image filter: of the input's type when it is a composite data set,
-/// else a vtkImageData (its REQUEST_DATA_OBJECT).
-int RequestDataObject(vtkInformationVector** inputs, vtkInformationVector* outputs);
+/// An input port that takes a surface or a composite data set of surfaces.
+void AcceptSurfacesAndComposites(vtkInformation* portInformation);
+
+/// The output of a filter (its REQUEST_DATA_OBJECT): of the first input's type when that is
+/// a composite data set, else a `single` (vtkImageData, vtkPolyData).
+int RequestDataObject(
+  vtkInformationVector** inputs, vtkInformationVector* outputs, const char* single);
 
 /// A filter's image path: its RequestData given an image input (with WHOLE_EXTENT) and
 /// an output information asking for one piece of it.
@@ -49,6 +53,16 @@ using ImagePath = std::function<int(vtkInformationVector** inputs, vtkInformatio
 /// On failure the output is empty on every process and `filter` reports why (the image
 /// path reports its own errors). Returns 1, as RequestData does.
 int ProduceEachVolume(vtkAlgorithm* filter, vtkMultiProcessController* controller,
+  vtkInformationVector** inputs, vtkInformationVector* outputs, const ImagePath& path);
+
+/// For a filter that samples a volume at a surface's points (port 0 the surface, port 1
+/// the volume), either of which may be composite: the surface's blocks are taken as one
+/// surface and the volume's pieces as one volume (piece `rank` of it on each process, as
+/// ForEachVolume hands it), `path` runs once, collectively, and each block of the surface
+/// gets its points' new arrays back. The output has the surface's type and structure. A
+/// volume input that holds several volumes, or blocks that are not surfaces, are refused.
+/// Returns 1, as RequestData does.
+int ProduceOnSurface(vtkAlgorithm* filter, vtkMultiProcessController* controller,
   vtkInformationVector** inputs, vtkInformationVector* outputs, const ImagePath& path);
 
 /// Calls `each` for every volume of a composite input, collectively, in the same order on

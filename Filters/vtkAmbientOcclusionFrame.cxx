@@ -1,5 +1,7 @@
 #include "vtkAmbientOcclusionFrame.h"
 
+#include "vtkAmbientOcclusionExtents.h"
+
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
 #include "vtkPolyData.h"
@@ -154,6 +156,25 @@ void SurfaceBoundsInFrame(vtkPolyData* surface, const Frame& frame, double bound
       bounds[2 * a + 1] = std::max(bounds[2 * a + 1], p[a]);
     }
   }
+}
+
+bool SurfaceWithinExtent(
+  vtkPolyData* surface, vtkImageData* grid, const int ext[6], const int whole[6], int slack)
+{
+  if (vtkAmbientOcclusionExtents::EmptyExtent(ext) || !grid->GetDirectionMatrix()->IsIdentity())
+    return false;
+  const int slacks[3] = { slack, slack, slack };
+  int reached[6];
+  std::copy(ext, ext + 6, reached);
+  vtkAmbientOcclusionExtents::GrowExtent(reached, slacks, whole);
+  const double* bounds = surface->GetBounds();
+  const double* origin = grid->GetOrigin();
+  const double* h = grid->GetSpacing();
+  for (int a = 0; a < 3; ++a)
+    if (bounds[2 * a] < origin[a] + (reached[2 * a] - 0.5) * h[a] ||
+      bounds[2 * a + 1] > origin[a] + (reached[2 * a + 1] + 0.5) * h[a])
+      return false;
+  return true;
 }
 
 } // namespace vtkAmbientOcclusionFrame

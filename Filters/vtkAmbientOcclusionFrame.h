@@ -55,6 +55,12 @@ bool SurfaceAlongImageAxes(vtkPolyData* surface, const vao::VolumeView& volume, 
 /// The bounds of the surface's points in the image's axis-aligned frame (from `frame`).
 void SurfaceBoundsInFrame(vtkPolyData* surface, const Frame& frame, double bounds[6]);
 
+/// Whether the points of `surface` lie in the extent `ext` of `grid`'s voxels grown by
+/// `slack` voxels (clipped to `whole`), half a voxel of rounding allowed: a Contour of a
+/// piece, whose ghost cells reach past it. Axis-aligned grids only (false otherwise).
+bool SurfaceWithinExtent(
+  vtkPolyData* surface, vtkImageData* grid, const int ext[6], const int whole[6], int slack);
+
 } // namespace vtkAmbientOcclusionFrame
 
 #endif

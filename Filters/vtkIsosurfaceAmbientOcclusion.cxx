@@ -6,6 +6,7 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionCollectives.h"
+#include "vtkAmbientOcclusionComposite.h"
 #include "vtkAmbientOcclusionExtents.h"
 #include "vtkAmbientOcclusionFrame.h"
 #include "vtkAmbientOcclusionMemory.h"
@@ -251,9 +252,30 @@ void vtkIsosurfaceAmbientOcclusion::SetVolumeScalars(const char* name)
 }
 
 //------------------------------------------------------------------------------
+vtkTypeBool vtkIsosurfaceAmbientOcclusion::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // The output is like the surface: polygonal data, or a composite data set of it.
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT()))
+    return vtkAmbientOcclusionComposite::RequestDataObject(
+      inputVector, outputVector, "vtkPolyData");
+  return this->Superclass::ProcessRequest(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------
 int vtkIsosurfaceAmbientOcclusion::FillInputPortInformation(int port, vtkInformation* info)
 {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 0 ? "vtkPolyData" : "vtkImageData");
+  if (port == 0)
+    vtkAmbientOcclusionComposite::AcceptSurfacesAndComposites(info);
+  else
+    vtkAmbientOcclusionComposite::AcceptImagesAndComposites(info);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkIsosurfaceAmbientOcclusion::FillOutputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkDataObject"); // made by ProcessRequest
   return 1;
 }
 
@@ -264,6 +286,8 @@ int vtkIsosurfaceAmbientOcclusion::RequestUpdateExtent(
   // One process reads the whole volume. Several read their piece grown by the reach of
   // the finer levels' queries; the coarsest level is shared (UpdateDistributedPyramid).
   vtkInformation* volumeInfo = inputVector[1]->GetInformationObject(0);
+  if (vtkAmbientOcclusionComposite::IsComposite(volumeInfo))
+    return 1; // the piece request passes on as it is; the pieces are gathered in RequestData
   if (!this->IsDistributed())
   {
     Extents::RequestWholeExtent(volumeInfo);
@@ -387,21 +411,8 @@ int vtkIsosurfaceAmbientOcclusion::AdoptHeldPiece(vtkPolyData* surface, vtkImage
   int held[6] = { 0, -1, 0, -1, 0, -1 };
   if (volume->GetNumberOfPoints() > 0)
     volume->GetExtent(held);
-  bool inside = surface->GetNumberOfPoints() == 0;
-  if (!inside && !Extents::EmptyExtent(held) && volume->GetDirectionMatrix()->IsIdentity())
-  {
-    const int slacks[3] = { kSurfaceSlack, kSurfaceSlack, kSurfaceSlack };
-    int reached[6];
-    std::copy(held, held + 6, reached);
-    Extents::GrowExtent(reached, slacks, whole);
-    const double* bounds = surface->GetBounds();
-    const double* origin = volume->GetOrigin();
-    const double* h = volume->GetSpacing();
-    inside = true;
-    for (int a = 0; a < 3; ++a)
-      inside = inside && bounds[2 * a] >= origin[a] + (reached[2 * a] - 0.5) * h[a] &&
-        bounds[2 * a + 1] <= origin[a] + (reached[2 * a + 1] + 0.5) * h[a];
-  }
+  const bool inside = surface->GetNumberOfPoints() == 0 ||
+    vtkAmbientOcclusionFrame::SurfaceWithinExtent(surface, volume, held, whole, kSurfaceSlack);
   // The coarsest level is assembled from every piece's: they must fill the whole extent.
   std::vector<double> mine(held, held + 6), all;
   std::vector<int> owners;
@@ -473,6 +484,12 @@ bool vtkIsosurfaceAmbientOcclusion::CheckSurfaceInVolume(
 int vtkIsosurfaceAmbientOcclusion::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  if (vtkAmbientOcclusionComposite::IsComposite(inputVector[0]->GetInformationObject(0)) ||
+    vtkAmbientOcclusionComposite::IsComposite(inputVector[1]->GetInformationObject(0)))
+    return vtkAmbientOcclusionComposite::ProduceOnSurface(this, this->Controller, inputVector,
+      outputVector,
+      [&](vtkInformationVector** in, vtkInformationVector* out)
+      { return this->RequestData(nullptr, in, out); });
   return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
     "try StartAtHalfResolution, fewer NumberOfLevels, or more MPI ranks.",
     [&] { return this->ProduceOutput(inputVector, outputVector); });

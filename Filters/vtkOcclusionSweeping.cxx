@@ -194,7 +194,8 @@ vtkTypeBool vtkOcclusionSweeping::ProcessRequest(
 {
   // The output is like the input: an image, or a composite data set of images.
   if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT()))
-    return vtkAmbientOcclusionComposite::RequestDataObject(inputVector, outputVector);
+    return vtkAmbientOcclusionComposite::RequestDataObject(
+      inputVector, outputVector, "vtkImageData");
   return this->Superclass::ProcessRequest(request, inputVector, outputVector);
 }
 

@@ -2,7 +2,9 @@
 
 #include "vtkAmbientOcclusionArrayInput.h"
 #include "vtkAmbientOcclusionCollectives.h"
+#include "vtkAmbientOcclusionComposite.h"
 #include "vtkAmbientOcclusionExtents.h"
+#include "vtkAmbientOcclusionFrame.h"
 #include "vtkAmbientOcclusionMemory.h"
 #include "vtkAmbientOcclusionRequest.h"
 
@@ -127,9 +129,30 @@ vtkProbeOutsideSurface::vtkProbeOutsideSurface()
 }
 
 //------------------------------------------------------------------------------
+vtkTypeBool vtkProbeOutsideSurface::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // The output is like the surface: polygonal data, or a composite data set of it.
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT()))
+    return vtkAmbientOcclusionComposite::RequestDataObject(
+      inputVector, outputVector, "vtkPolyData");
+  return this->Superclass::ProcessRequest(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------
 int vtkProbeOutsideSurface::FillInputPortInformation(int port, vtkInformation* info)
 {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 0 ? "vtkPolyData" : "vtkImageData");
+  if (port == 0)
+    vtkAmbientOcclusionComposite::AcceptSurfacesAndComposites(info);
+  else
+    vtkAmbientOcclusionComposite::AcceptImagesAndComposites(info);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkProbeOutsideSurface::FillOutputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkDataObject"); // made by ProcessRequest
   return 1;
 }
 
@@ -140,6 +163,8 @@ int vtkProbeOutsideSurface::RequestUpdateExtent(
   // One piece: the whole volume. Several: the piece of the surface's process, grown by
   // the distance and two voxels (a surface piece's ghost cells reach one voxel past it).
   vtkInformation* volumeInfo = inputVector[1]->GetInformationObject(0);
+  if (vtkAmbientOcclusionComposite::IsComposite(volumeInfo))
+    return 1; // the piece request passes on as it is; the pieces are gathered in RequestData
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   const int pieces = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
     ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
@@ -165,17 +190,24 @@ int vtkProbeOutsideSurface::RequestUpdateExtent(
   if (volumeInfo->Has(vtkDataObject::SPACING()))
     volumeInfo->Get(vtkDataObject::SPACING(), spacing);
   Extents::RequestedPiece(outInfo, whole, ext);
-  const double smallest = SmallestSpacing(spacing);
   int reach[3];
+  this->ReachOf(spacing, reach);
+  Extents::GrowExtent(ext, reach, whole);
+  Extents::RequestExactExtent(volumeInfo, ext);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkProbeOutsideSurface::ReachOf(const double spacing[3], int reach[3]) const
+{
+  // The distance and two voxels (a surface piece's ghost cells reach one voxel past it).
+  const double smallest = SmallestSpacing(spacing);
   for (int a = 0; a < 3; ++a)
   {
     const double voxels =
       std::abs(spacing[a]) > 0.0 ? this->Distance * smallest / std::abs(spacing[a]) : 0.0;
     reach[a] = static_cast<int>(std::ceil(std::min(voxels, 1e6))) + 2;
   }
-  Extents::GrowExtent(ext, reach, whole);
-  Extents::RequestExactExtent(volumeInfo, ext);
-  return 1;
 }
 
 //------------------------------------------------------------------------------
@@ -188,6 +220,8 @@ std::string vtkProbeOutsideSurface::InputError(vtkPolyData* surface, vtkImageDat
   else if (this->Orientation < AUTO || this->Orientation > REVERSED_NORMALS)
     why << "Unknown Orientation " << this->Orientation
         << " (0 Auto, 1 Normals, 2 Reversed Normals).";
+  else if (surface->GetNumberOfPoints() == 0)
+    return {}; // nothing to sample (a process without surface points under MPI)
   else if (!volume || volume->GetNumberOfPoints() == 0)
     why << "No volume: connect image data to the Volume input (e.g. the output of Occlusion "
            "Sweeping).";
@@ -247,6 +281,21 @@ int vtkProbeOutsideSurface::OutsideSide(
 int vtkProbeOutsideSurface::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  if (vtkAmbientOcclusionComposite::IsComposite(inputVector[0]->GetInformationObject(0)) ||
+    vtkAmbientOcclusionComposite::IsComposite(inputVector[1]->GetInformationObject(0)))
+    return vtkAmbientOcclusionComposite::ProduceOnSurface(this,
+      vtkMultiProcessController::GetGlobalController(), inputVector, outputVector,
+      [&](vtkInformationVector** in, vtkInformationVector* out)
+      { return this->RequestData(nullptr, in, out); });
+  return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
+    "try a surface with fewer points (Decimate), or more MPI ranks.",
+    [&] { return this->ProduceOutput(inputVector, outputVector); });
+}
+
+//------------------------------------------------------------------------------
+int vtkProbeOutsideSurface::ProduceOutput(
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
   vtkPolyData* surface = vtkPolyData::GetData(inputVector[0], 0);
   vtkImageData* volume = vtkImageData::GetData(inputVector[1], 0);
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
@@ -258,14 +307,30 @@ int vtkProbeOutsideSurface::RequestData(
       vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()) > 1 &&
     std::isfinite(this->Distance) && !Extents::CanProduceSubExtent(volumeInfo))
   {
-    // The volume's reader does not split: every process with surface points takes it
-    // whole from the one that read it (collective, as RequestUpdateExtent asked).
-    int whole[6];
-    const int none[6] = { 0, -1, 0, -1, 0, -1 };
+    // Pieces handed over, or a reader that does not split (collective, as
+    // RequestUpdateExtent asked): when every process's surface lies in the piece it holds
+    // (a Contour of it), each fetches its piece's reach from the neighbours; else every
+    // process with surface points takes the whole volume from those that hold it.
+    int whole[6], held[6] = { 0, -1, 0, -1, 0, -1 }, needed[6] = { 0, -1, 0, -1, 0, -1 };
     volumeInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+    if (volume->GetNumberOfPoints() > 0)
+      volume->GetExtent(held);
+    const bool hasPoints = surface->GetNumberOfPoints() > 0;
+    const bool inside =
+      !hasPoints || vtkAmbientOcclusionFrame::SurfaceWithinExtent(surface, volume, held, whole, 2);
+    if (hasPoints)
+      std::copy(whole, whole + 6, needed);
+    if (vtkAmbientOcclusionCollectives::GlobalMax(controller, inside ? 0.0 : 1.0) == 0.0 &&
+      hasPoints)
+    {
+      int reach[3];
+      this->ReachOf(volume->GetSpacing(), reach);
+      std::copy(held, held + 6, needed);
+      Extents::GrowExtent(needed, reach, whole);
+    }
     std::string why;
     volume = vtkAmbientOcclusionCollectives::CoverNeededExtent(
-      controller, volume, whole, surface->GetNumberOfPoints() > 0 ? whole : none, fetched, why);
+      controller, volume, whole, needed, fetched, why);
     if (!volume)
     {
       vtkErrorMacro(<< why);
@@ -280,9 +345,7 @@ int vtkProbeOutsideSurface::RequestData(
     output->Initialize();
     return 1;
   }
-  return vtkAmbientOcclusionRequest::ProduceOutput(this, outputVector,
-    "try a surface with fewer points (Decimate), or more MPI ranks.",
-    [&] { return this->ProduceOutput(surface, volume, output); });
+  return this->ProduceOutput(surface, volume, output);
 }
 
 //------------------------------------------------------------------------------

@@ -74,7 +74,12 @@ protected:
   vtkProbeOutsideSurface();
   ~vtkProbeOutsideSurface() override = default;
 
+  vtkTypeBool ProcessRequest(
+    vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int FillInputPortInformation(int port, vtkInformation* info) override;
+  /// Voxels of the volume a piece's points reach, per axis (Distance and two voxels).
+  void ReachOf(const double spacing[3], int reach[3]) const;
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
@@ -87,8 +92,10 @@ private:
   /// +1 or -1: the side of the normals that is outside (see the class documentation).
   int OutsideSide(
     vtkPolyData* surface, vtkDataArray* normals, vtkImageData* volume, double offset) const;
-  /// The surface with the volume's arrays sampled outside it (RequestData's body, inside
-  /// its memory guard; the inputs were checked).
+  /// RequestData's body, inside its memory guard: the volume each process needs, fetched
+  /// under MPI, then ProduceOutput below.
+  int ProduceOutput(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
+  /// The surface with the volume's arrays sampled outside it (the inputs were checked).
   int ProduceOutput(vtkPolyData* surface, vtkImageData* volume, vtkPolyData* output);
 
   double Distance = 1.5;

@@ -5,7 +5,10 @@ vtkMultiBlockDataSet (some pieces with their own origin and extents from 0, as C
 adaptors make them) and a vtkPartitionedDataSetCollection holding two volumes on different
 grids. Each filter's output holds every input piece with the serial result of its own
 volume on it: Volumetric AO (Gaussian CDF; Histogram CDF, whose thresholds come from the
-whole volume), Occlusion Sweeping and the Variance Occlusion Map (level by level).
+whole volume), Occlusion Sweeping and the Variance Occlusion Map (level by level); Isosurface
+AO and Probe Outside Surface of the pieces' contours (a composite surface) in the composite
+volume give, on every block's points, the serial result in the whole volume (and refuse a
+volume input that holds two volumes).
 Prints "ok: ..." / "FAILED: ..." per check and ends normally either way: ctest judges the
 output. Usage: [mpiexec -np N] pvbatch --symmetric mpi_composite.py PLUGIN SITE_PACKAGES"""
 import os
@@ -16,11 +19,12 @@ import numpy as np
 from paraview.simple import LoadPlugin
 from vtkmodules.vtkCommonDataModel import (vtkImageData, vtkMultiBlockDataSet, vtkPartitionedDataSet,
                                            vtkPartitionedDataSetCollection)
+from vtkmodules.vtkFiltersCore import vtkFlyingEdges3D
 from vtkmodules.vtkParallelCore import vtkMultiProcessController
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from vao_test_utils import check, errors_of  # noqa: E402
+from vao_test_utils import check, errors_of, serial_surface_values  # noqa: E402
 
 LoadPlugin(sys.argv[1], remote=False)
 sys.path.insert(0, sys.argv[2])
@@ -186,4 +190,53 @@ for seed, kind in enumerate(("partitioned", "multiblock", "collection")):
     check(worst <= 1e-6, "Variance Occlusion Map, %s, rank %d of %d: the serial means (relative difference %.3g)"
           % (kind, rank, ranks, worst))
     check(not errors, "Variance Occlusion Map, %s, rank %d: no error (%s)" % (kind, rank, errors[:1]))
+    # Isosurface AO and Probe Outside Surface of the pieces' contours, in the composite volume.
+    contour = vtkFlyingEdges3D()
+    contour.SetInputData(data)
+    contour.SetValue(0, 1.0)
+    contour.ComputeNormalsOn()
+    contour.Update()
+    surfaces = contour.GetOutputDataObject(0)
+    sweep = volumetricao.vtkOcclusionSweeping()
+    sweep.SetIsoValue(1.0)
+    sweep.SetInputData(data)
+    sweep.UpdatePiece(rank, ranks, 0)
+    swept = sweep.GetOutputDataObject(0)
+    for name, make, volume_of in (("Isosurface AO", volumetricao.vtkIsosurfaceAmbientOcclusion, lambda: data),
+                                  ("Probe Outside Surface", volumetricao.vtkProbeOutsideSurface, lambda: swept)):
+        f = make()
+        f.SetInputData(0, surfaces)
+        f.SetInputData(1, volume_of())
+        errors = errors_of(f)
+        f.UpdatePiece(rank, ranks, 0)
+        out = f.GetOutputDataObject(0)
+        if kind == "collection":
+            check(any("holds 2 volumes" in e for e in errors),
+                  "%s, %s, rank %d: a volume input with two volumes is refused" % (name, kind, rank))
+            continue
+        check(out.GetClassName() == surfaces.GetClassName(), "%s, %s, rank %d: a %s (got %s)"
+              % (name, kind, rank, surfaces.GetClassName(), out.GetClassName()))
+        # The reference: one process, each block's points in the whole volume.
+        whole_volume = piece("A", [0, VOLUMES["A"][0].shape[2] - 1, 0, VOLUMES["A"][0].shape[1] - 1,
+                                   0, VOLUMES["A"][0].shape[0] - 1], False)
+        if name == "Probe Outside Surface":
+            whole_sweep = volumetricao.vtkOcclusionSweeping()
+            whole_sweep.SetIsoValue(1.0)
+            whole_sweep.SetController(None)
+            whole_sweep.SetInputData(whole_volume)
+            whole_sweep.Update()
+            whole_volume = whole_sweep.GetOutput()
+        worst, points, blocks = 0.0, 0, 0
+        for block, got_block in zip(leaves_of(surfaces), leaves_of(out)):
+            if block.GetNumberOfPoints() == 0:
+                continue
+            expected = serial_surface_values(make, block, whole_volume, "AmbientOcclusion")
+            array = got_block.GetPointData().GetArray("AmbientOcclusion")
+            got = vtk_to_numpy(array) if array is not None else np.zeros(0)
+            worst = max(worst, float(np.abs(got - expected).max()) if got.size == expected.size else np.inf)
+            points += expected.size
+            blocks += 1
+        check(worst <= 1e-6, "%s, %s, rank %d of %d, %d blocks, %d points: the serial AO (max difference %.3g)"
+              % (name, kind, rank, ranks, blocks, points, worst))
+        check(not errors, "%s, %s, rank %d: no error (%s)" % (name, kind, rank, errors[:1]))
 print("rank %d of %d done" % (rank, ranks), flush=True)

@@ -1,8 +1,8 @@
 """pvbatch --symmetric under mpiexec: each rank owns a z-slab of a volume, without ghost
 layers, handed to the filters by a vtkTrivialProducer (what an in situ adaptor does). With
 the whole extent given to the producer, Volumetric AO (Gaussian CDF and Histogram CDF),
-Occlusion Sweeping, the Variance Occlusion Map and Isosurface AO (of each slab's contour)
-give the serial numbers, fetching only their reach from the neighbours; without it (each
+Occlusion Sweeping, the Variance Occlusion Map, Isosurface AO and Probe Outside Surface (of
+each slab's contour) give the serial numbers, fetching only their reach from the neighbours; without it (each
 rank's whole extent is its own slab) each refuses on every rank with an error that names the
 whole extent, and outputs nothing, instead of results that are wrong at every slab's border.
 Prints "ok: ..." / "FAILED: ..." per check and ends normally either way: ctest judges the
@@ -20,7 +20,7 @@ from vtkmodules.vtkParallelCore import vtkMultiProcessController
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from vao_test_utils import check, errors_of  # noqa: E402
+from vao_test_utils import check, errors_of, serial_surface_values  # noqa: E402
 
 LoadPlugin(sys.argv[1], remote=False)
 sys.path.insert(0, sys.argv[2])
@@ -122,45 +122,43 @@ for whole in (True, False):
               % (rank, ranks))
         check(any("disagree on the whole extent" in e for e in errors),
               "Variance Occlusion Map, rank %d: an error says the ranks disagree on the whole extent" % rank)
-# Isosurface AO of each slab's own contour (a Contour in the same Catalyst pipeline): the
-# serial AO of those points, from the slab and its reach, not from the whole volume.
+# Isosurface AO and Probe Outside Surface of each slab's own contour (a Contour in the same
+# Catalyst pipeline): the serial values at those points, from the slab and its reach.
 whole_image = vtkImageData()
 whole_image.SetExtent(0, nx - 1, 0, ny - 1, 0, nz - 1)
 values = numpy_to_vtk(volume.ravel(), deep=1)
 values.SetName("f")
 whole_image.GetPointData().SetScalars(values)
-for whole in (True, False):
-    producer = slab_producer(whole)
-    contour = vtkFlyingEdges3D()
-    contour.SetInputConnection(producer.GetOutputPort())
-    contour.SetValue(0, 1.0)
-    contour.ComputeNormalsOn()
-    iso = volumetricao.vtkIsosurfaceAmbientOcclusion()
-    iso.SetController(controller)
-    iso.SetInputConnection(0, contour.GetOutputPort())
-    iso.SetInputConnection(1, producer.GetOutputPort())
-    errors = errors_of(iso)
-    iso.UpdatePiece(rank, ranks, 0)
-    ao = iso.GetOutput().GetPointData().GetArray("AmbientOcclusion")
-    if whole:
-        surface = contour.GetOutput().NewInstance()
-        surface.DeepCopy(contour.GetOutput())
-        serial = volumetricao.vtkIsosurfaceAmbientOcclusion()
-        serial.SetController(None)
-        serial.SetInputData(0, surface)
-        serial.SetInputData(1, whole_image)
-        serial.Update()
-        expected = vtk_to_numpy(serial.GetOutput().GetPointData().GetArray("AmbientOcclusion"))
-        got = vtk_to_numpy(ao) if ao is not None else np.zeros(0)
-        check(got.size == expected.size and expected.size > 0,
-              "Isosurface AO, rank %d of %d: AO on each of the slab contour's %d points" % (rank, ranks, expected.size))
+SURFACE_FILTERS = [("Isosurface AO", volumetricao.vtkIsosurfaceAmbientOcclusion, "AmbientOcclusion"),
+                   ("Probe Outside Surface", volumetricao.vtkProbeOutsideSurface, "f")]
+for name, make, array_name in SURFACE_FILTERS:
+    for whole in (True, False):
+        producer = slab_producer(whole)
+        contour = vtkFlyingEdges3D()
+        contour.SetInputConnection(producer.GetOutputPort())
+        contour.SetValue(0, 1.0)
+        contour.ComputeNormalsOn()
+        f = make()
+        if hasattr(f, "SetController"):
+            f.SetController(controller)
+        f.SetInputConnection(0, contour.GetOutputPort())
+        f.SetInputConnection(1, producer.GetOutputPort())
+        errors = errors_of(f)
+        f.UpdatePiece(rank, ranks, 0)
+        sampled = f.GetOutput().GetPointData().GetArray(array_name)
+        if not whole:
+            check(f.GetOutput().GetNumberOfPoints() == 0,
+                  "%s, rank %d of %d, slabs without the whole extent: no output" % (name, rank, ranks))
+            check(any("disagree on the whole extent" in e for e in errors),
+                  "%s, rank %d: an error says the ranks disagree on the whole extent" % (name, rank))
+            continue
+        expected = serial_surface_values(make, contour.GetOutput(), whole_image, array_name)
+        got = vtk_to_numpy(sampled) if sampled is not None else np.zeros(0)
+        check(got.size == expected.size and expected.size > 0, "%s, rank %d of %d: %s on each of the slab "
+              "contour's %d points" % (name, rank, ranks, array_name, expected.size))
         if got.size == expected.size:
             difference = float(np.abs(got - expected).max()) if got.size else 0.0
-            check(difference <= 1e-6, "Isosurface AO, rank %d of %d: the serial AO (max difference %.3g)"
-                  % (rank, ranks, difference))
-        check(not errors, "Isosurface AO, rank %d: no error (%s)" % (rank, errors[:1]))
-    else:
-        check(ao is None, "Isosurface AO, rank %d of %d, slabs without the whole extent: no AO" % (rank, ranks))
-        check(any("disagree on the whole extent" in e for e in errors),
-              "Isosurface AO, rank %d: an error says the ranks disagree on the whole extent" % rank)
+            check(difference <= 1e-6, "%s, rank %d of %d: the serial %s (max difference %.3g)"
+                  % (name, rank, ranks, array_name, difference))
+        check(not errors, "%s, rank %d: no error (%s)" % (name, rank, errors[:1]))
 print("rank %d of %d done" % (rank, ranks), flush=True)

@@ -140,3 +140,18 @@ def errors_of(algorithm):
 
     algorithm.AddObserver(vtkCommand.ErrorEvent, collect)
     return errors
+
+
+def serial_surface_values(make, surface, volume, name):
+    """The array `name` that a new filter from `make` (Isosurface AO, Probe Outside Surface)
+    gives at a copy of `surface`'s points in `volume`, in one process (no controller)."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    points = surface.NewInstance()
+    points.DeepCopy(surface)
+    serial = make()
+    if hasattr(serial, "SetController"):
+        serial.SetController(None)
+    serial.SetInputData(0, points)
+    serial.SetInputData(1, volume)
+    serial.Update()
+    return vtk_to_numpy(serial.GetOutput().GetPointData().GetArray(name))
