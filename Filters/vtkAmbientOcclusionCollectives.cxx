@@ -3,6 +3,8 @@
 
 #include "vtkAmbientOcclusionExtents.h"
 
+#include "vao/AmbientOcclusion.h"
+#include "vao/Validation.h"
 #include "vao/VarianceOcclusionMap.h"
 
 #include "vtkCommunicator.h"
@@ -17,6 +19,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -424,6 +428,63 @@ vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageD
   error = "The processes' pieces of the input do not hold every voxel this filter needs: "
           "give it a source that delivers the whole data set across the processes.";
   return nullptr;
+}
+
+vao::MomentBasis WholeMomentBasis(vtkMultiProcessController* controller,
+  const vao::VolumeView* volume, const int inputExt[6], const int outExt[6], const int whole[6])
+{
+  // This process's share: its output piece less the lower processes' pieces.
+  const int ranks = controller->GetNumberOfProcesses(), rank = controller->GetLocalProcessId();
+  std::vector<int> pieces(static_cast<size_t>(6 * ranks));
+  controller->AllGather(outExt, pieces.data(), 6);
+  std::vector<Box> share;
+  if (volume && !EmptyExtent(outExt))
+    share.push_back(Box{ { outExt[0], outExt[1], outExt[2], outExt[3], outExt[4], outExt[5] } });
+  for (int r = 0; r < rank && !share.empty(); ++r)
+  {
+    std::vector<Box> rest;
+    for (const Box& box : share)
+      Subtract(box, &pieces[6 * r], rest);
+    share.swap(rest);
+  }
+  // Sum and count of the sampled voxels, lowest and highest value (as maxima).
+  double local[4] = { 0.0, 0.0, -std::numeric_limits<double>::infinity(),
+    -std::numeric_limits<double>::infinity() };
+  const vao::Index3 wholeDims{ whole[1] - whole[0] + 1, whole[3] - whole[2] + 1,
+    whole[5] - whole[4] + 1 };
+  const vao::Index3 offset{ inputExt[0] - whole[0], inputExt[2] - whole[2],
+    inputExt[4] - whole[4] };
+  for (const Box& box : share)
+  {
+    vao::Region region;
+    for (int a = 0; a < 3; ++a)
+    {
+      region.begin[a] = box.ext[2 * a] - inputExt[2 * a];
+      region.size[a] = box.ext[2 * a + 1] - box.ext[2 * a] + 1;
+    }
+    const vao::ShiftSamples samples = vao::momentShiftSamples(*volume, region, offset, wholeDims);
+    local[0] += samples.sum;
+    local[1] += static_cast<double>(samples.count);
+  }
+  if (volume && !vao::needsValueScan(volume->type))
+    share.clear(); // exact integer sums: no basis
+  if (!share.empty())
+  {
+    const std::array<double, 2> range = vao::valueRange(*volume);
+    local[2] = -range[0];
+    local[3] = range[1];
+  }
+  double sums[2], extremes[2];
+  controller->AllReduce(local, sums, 2, vtkCommunicator::SUM_OP);
+  controller->AllReduce(local + 2, extremes, 2, vtkCommunicator::MAX_OP);
+  vao::MomentBasis basis;
+  if (sums[1] > 0.0 && std::isfinite(extremes[0]) && std::isfinite(extremes[1]))
+  {
+    basis.shift = sums[0] / sums[1];
+    basis.lowest = -extremes[0];
+    basis.highest = extremes[1];
+  }
+  return basis;
 }
 
 void GatherLevel(vtkMultiProcessController* controller, vtkImageData* part, vao::MomentLevel& level)

@@ -14,7 +14,9 @@ class vtkImageData;
 class vtkMultiProcessController;
 namespace vao
 {
+struct MomentBasis;
 struct MomentLevel;
+struct VolumeView;
 }
 
 namespace vtkAmbientOcclusionCollectives
@@ -69,6 +71,15 @@ bool RedistributeExtents(vtkMultiProcessController* controller, vtkImageData* he
 /// holds some needed voxel.
 vtkImageData* CoverNeededExtent(vtkMultiProcessController* controller, vtkImageData* input,
   const int whole[6], const int needed[6], vtkImageData* fetched, std::string& error);
+
+/// The moment basis of the whole data set (vao::MomentBasis) from its pieces: each process
+/// passes the voxels it read (`volume`, extent `inputExt`; null when it holds none) and the
+/// extent of its output piece; the pieces' voxels not in a lower process's piece are
+/// sampled, so that overlapping pieces count once. Where the output pieces tile the whole
+/// extent the basis is the one a run on the whole volume takes (to the rounding of the
+/// sums). Collective.
+vao::MomentBasis WholeMomentBasis(vtkMultiProcessController* controller,
+  const vao::VolumeView* volume, const int inputExt[6], const int outExt[6], const int whole[6]);
 
 /// One message of RedistributeExtents: the voxels `ext` of held block `block` from
 /// process `from` to wanted extent `into` of process `to` (block and extent indices count

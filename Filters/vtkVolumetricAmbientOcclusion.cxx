@@ -121,7 +121,9 @@ struct vtkVolumetricAmbientOcclusion::Run
   vao::AmbientOcclusionParameters parameters; // the kernel's, the thresholds moved in
   vtkSmartPointer<vtkFloatArray> openness;
   vtkSmartPointer<vtkFloatArray> variance;
-  vao::OutputRange range; // kept by the pass, so that the range cache need not scan
+  vao::OutputRange range;  // kept by the pass, so that the range cache need not scan
+  bool collective = false; // the processes compute one data set together (NeededInput)
+  vao::MomentBasis basis;  // then the whole data set's, for the moment sums
 };
 
 //------------------------------------------------------------------------------
@@ -367,6 +369,11 @@ int vtkVolumetricAmbientOcclusion::ProduceOutput(
     return 1; // the same on every process
   }
   const bool ok = this->ReadInput(input, run);
+  // Collective like the thresholds: every piece's moment sums taken as the whole volume's.
+  if (run.collective &&
+    (vao::isSeparableMethod(KernelMethod(this->Method)) || this->ComputeVariance))
+    run.basis = vtkAmbientOcclusionCollectives::WholeMomentBasis(this->Controller,
+      ok ? &run.scalars.view : nullptr, input->GetExtent(), run.outExt, run.whole);
   // Collective in a distributed run: every process takes part, also one that failed above
   // (it says so, and every process then stops) or holds an empty piece.
   if (this->Method == HISTOGRAM_CDF && (ok || this->IsDistributed()) &&
@@ -384,7 +391,7 @@ int vtkVolumetricAmbientOcclusion::ProduceOutput(
 
 //------------------------------------------------------------------------------
 vtkImageData* vtkVolumetricAmbientOcclusion::NeededInput(vtkImageData* input,
-  vtkInformationVector** inputVector, vtkInformationVector* outputVector, const Run& run,
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector, Run& run,
   vtkImageData* fetched)
 {
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
@@ -411,6 +418,7 @@ vtkImageData* vtkVolumetricAmbientOcclusion::NeededInput(vtkImageData* input,
     vtkAmbientOcclusionExtents::GrowExtent(needed, reach, run.whole);
   }
   std::string error;
+  run.collective = true;
   vtkImageData* covered = vtkAmbientOcclusionCollectives::CoverNeededExtent(
     this->Controller, input, run.whole, needed, fetched, error);
   if (!covered)
@@ -467,6 +475,7 @@ bool vtkVolumetricAmbientOcclusion::ComputeArrays(vtkImageData* input, Run& run)
   run.variance = this->ComputeVariance ? NewFloatArray("Variance", region.voxelCount()) : nullptr;
   run.parameters = this->Parameters(run.radius);
   run.parameters.thresholds = std::move(run.thresholds);
+  run.parameters.momentBasis = run.basis;
   if (this->CastsRays())
   {
     run.parameters.rays = this->Rays(input->GetSpacing());

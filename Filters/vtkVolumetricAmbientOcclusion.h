@@ -319,7 +319,7 @@ private:
   /// reader did not deliver it (a reader that does not split): fetched from the processes
   /// that hold it into `fetched`. Collective; nullptr, with the error, when nobody holds it.
   vtkImageData* NeededInput(vtkImageData* input, vtkInformationVector** inputVector,
-    vtkInformationVector* outputVector, const Run& run, vtkImageData* fetched);
+    vtkInformationVector* outputVector, Run& run, vtkImageData* fetched);
   /// Runs the kernel on the requested extent into new output arrays, on the backend
   /// Compute chooses; false, with the kernel's error, when it fails.
   bool ComputeArrays(vtkImageData* input, Run& run);

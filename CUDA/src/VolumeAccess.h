@@ -80,19 +80,36 @@ struct TypedVolume
   const T* row(std::int64_t y, std::int64_t z) const { return data + index(0, y, z) * stride; }
 };
 
+/// The sampled voxels of `region` (momentShiftSamples): every step-th voxel of the data
+/// set, step = max(1, n / 65536), in the data set's x-fastest order.
+template <class T>
+ShiftSamples shiftSamples(
+  const TypedVolume<T>& volume, const Region& region, const Index3& offset, const Index3& whole)
+{
+  const std::int64_t n = whole[0] * whole[1] * whole[2];
+  const std::int64_t step = std::max<std::int64_t>(1, n / 65536);
+  ShiftSamples samples;
+  for (std::int64_t z = region.begin[2]; z < region.begin[2] + region.size[2]; ++z)
+    for (std::int64_t y = region.begin[1]; y < region.begin[1] + region.size[1]; ++y)
+    {
+      // The row's first sampled voxel: its index in the data set a multiple of step.
+      const std::int64_t rowStart =
+        ((z + offset[2]) * whole[1] + (y + offset[1])) * whole[0] + offset[0];
+      const std::int64_t first = rowStart + region.begin[0];
+      std::int64_t x = region.begin[0] + (step - first % step) % step;
+      for (; x < region.begin[0] + region.size[0]; x += step, ++samples.count)
+        samples.sum += static_cast<double>(volume.value(x, y, z));
+    }
+  return samples;
+}
+
 /// Mean of up to ~65k evenly spaced voxels: the shift that keeps squared sums small.
 template <class T>
 double sampledMean(const TypedVolume<T>& volume)
 {
-  const std::int64_t n = volume.dims[0] * volume.dims[1] * volume.dims[2];
-  const std::int64_t step = std::max<std::int64_t>(1, n / 65536);
-  double sum = 0.0;
-  std::int64_t count = 0;
-  for (std::int64_t i = 0; i < n; i += step, ++count)
-  {
-    sum += static_cast<double>(volume.data[i * volume.stride]);
-  }
-  return count > 0 ? sum / count : 0.0;
+  const ShiftSamples samples =
+    shiftSamples(volume, { { 0, 0, 0 }, volume.dims }, { 0, 0, 0 }, volume.dims);
+  return samples.count > 0 ? samples.sum / samples.count : 0.0;
 }
 
 /// How a volume's box moments are accumulated: the value subtracted before squaring, and
@@ -104,16 +121,25 @@ struct MomentScale
 };
 
 /// No shift and no rounding for exact integer sums (so the sums, and everything after
-/// them, do not depend on which piece of the volume a run holds); for double sums a
-/// sampled mean, and the rounding of values in [lowest, highest] about it.
+/// them, do not depend on which piece of the volume a run holds); for double sums the
+/// basis given (a data set's, for its pieces) or else a sampled mean of the volume and the
+/// rounding of values in [lowest, highest] about it.
 template <class T>
-MomentScale momentScale(const TypedVolume<T>& volume, double lowest, double highest)
+MomentScale momentScale(
+  const TypedVolume<T>& volume, double lowest, double highest, const MomentBasis& basis = {})
 {
   if (MomentTraits<T>::exactInteger)
   {
     return {};
   }
-  const double shift = sampledMean(volume);
+  const bool given =
+    std::isfinite(basis.shift) && std::isfinite(basis.lowest) && std::isfinite(basis.highest);
+  const double shift = given ? basis.shift : sampledMean(volume);
+  if (given)
+  {
+    lowest = std::min(lowest, basis.lowest);
+    highest = std::max(highest, basis.highest);
+  }
   const double deviation = std::max(std::abs(highest - shift), std::abs(lowest - shift));
   return { shift, sumRoundingVariance(deviation) };
 }

@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <new>
 #include <string>
 #include <vector>
@@ -85,6 +86,19 @@ enum class QueryMode : int
 /// side costs O(sigma) per voxel and pass, and wider ones blur structures that AO shows.
 constexpr double kMaximumQuerySmoothing = 100.0;
 
+/// What the moment sums of a float (or wider than 16-bit) volume are taken about: the
+/// shift subtracted before squaring and the range of the data's values, which bounds the
+/// sums' rounding and so the variance at or below which a box counts as flat
+/// (Estimators.h). NaN, the default: the volume's own (the mean of its momentShiftSamples,
+/// its range). A piece of a larger data set passes the whole data set's, so that nearly
+/// flat boxes get the whole volume's answers.
+struct MomentBasis
+{
+  double shift = std::numeric_limits<double>::quiet_NaN();
+  double lowest = std::numeric_limits<double>::quiet_NaN();
+  double highest = std::numeric_limits<double>::quiet_NaN();
+};
+
 struct AmbientOcclusionParameters
 {
   Method method = Method::GaussianCdf;
@@ -98,6 +112,8 @@ struct AmbientOcclusionParameters
   std::vector<double> thresholds;
   // Transfer Function, Exact Rays and Rays: the opacity (checkOpacityFunction).
   OpacityFunction opacity;
+  // The separable methods and the variance on a piece of a data set: the data set's basis.
+  MomentBasis momentBasis;
   // Exact Rays and Rays: the rays' world frame (`radius` above is then their reach in
   // voxels, rayReach, which the volume block must hold around the region where it is not
   // the whole extent).
@@ -223,5 +239,18 @@ std::int64_t countNonFinite(const VolumeView& volume, std::int64_t* firstIndex =
 
 /// Smallest and largest finite value of the volume (one parallel pass).
 std::array<double, 2> valueRange(const VolumeView& volume);
+
+/// The voxels a volume's moment shift is the mean of: every max(1, n / 65536)-th voxel of
+/// the data set (n voxels, x fastest). `volume` is the part of a data set of `wholeDims`
+/// voxels that starts at `offset` in it; the sum and count are of the sampled voxels in
+/// `region` of it. Over pieces that hold each voxel of the data set once, the sums give
+/// the whole volume's shift (MomentBasis).
+struct ShiftSamples
+{
+  double sum = 0.0;
+  std::int64_t count = 0;
+};
+ShiftSamples momentShiftSamples(
+  const VolumeView& volume, const Region& region, const Index3& offset, const Index3& wholeDims);
 
 } // namespace vao

@@ -44,7 +44,8 @@ Status separableOpenness(const VolumeView& view, const Region& region,
   const detail::BoxGeometry geometry(view.dims, region, p.radius);
   const bool withExtrema = output.openness && p.method == Method::CdfReconstruction;
   const bool voxelQuery = p.queryMode == QueryMode::VoxelValue;
-  const detail::MomentScale scale = detail::momentScale(volume, scan.minimum, scan.maximum);
+  const detail::MomentScale scale =
+    detail::momentScale(volume, scan.minimum, scan.maximum, p.momentBasis);
   // Chebyshev and the Gaussian CDF take exact sums as they are (opennessRow).
   const bool fromSums = p.method == Method::Chebyshev || p.method == Method::GaussianCdf;
   // CDF Reconstruction takes the mean alone from the moments.

@@ -102,7 +102,8 @@ void run(const VolumeView& view, const Region& region, const Radius& radius, boo
   using Acc = typename detail::MomentTraits<T>::Accumulator;
   const detail::TypedVolume<T> volume(view);
   const gpu::RegionGeometry g = gpu::geometryFor(view.dims, region, radius);
-  const detail::MomentScale scale = detail::momentScale(volume, scan.minimum, scan.maximum);
+  const detail::MomentScale scale =
+    detail::momentScale(volume, scan.minimum, scan.maximum, estimator.basis);
   const Acc shift = static_cast<Acc>(scale.shift);
   estimator.roundingVariance = scale.roundingVariance;
   const BoxStatisticsOutput& st = host.statistics;
@@ -313,8 +314,8 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
     HostOutputs host;
     host.openness = output.openness;
     host.counting = &p;
-    const gpu::EstimatorSetting none{ Method::GaussianCdf, QueryMode::VoxelValue, 0.0,
-      ErfMode::Exact };
+    gpu::EstimatorSetting none{ Method::GaussianCdf, QueryMode::VoxelValue, 0.0, ErfMode::Exact };
+    none.basis = p.momentBasis;
     if (status.ok && output.openness)
       status = runChecked(volume, region, p.radius, false, none, host, execution, timing);
     if (status.ok && output.variance)
@@ -335,8 +336,9 @@ Status computeAmbientOcclusion(const VolumeView& volume, const Region& region,
   host.openness = output.openness;
   host.variance = output.variance;
   const bool withExtrema = output.openness && p.method == Method::CdfReconstruction;
-  return runChecked(volume, region, p.radius, withExtrema,
-    { p.method, p.queryMode, p.isoValue, p.erfMode }, host, execution, timing);
+  gpu::EstimatorSetting estimator{ p.method, p.queryMode, p.isoValue, p.erfMode };
+  estimator.basis = p.momentBasis;
+  return runChecked(volume, region, p.radius, withExtrema, estimator, host, execution, timing);
 }
 
 Status computeBoxStatistics(const VolumeView& volume, const Region& region, const Radius& radius,

@@ -378,4 +378,15 @@ std::array<double, 2> valueRange(const VolumeView& volume)
   return { scan.minimum, scan.maximum };
 }
 
+ShiftSamples momentShiftSamples(
+  const VolumeView& volume, const Region& region, const Index3& offset, const Index3& wholeDims)
+{
+  return detail::dispatchScalarType(volume.type,
+    [&](auto tag)
+    {
+      return detail::shiftSamples(
+        detail::TypedVolume<decltype(tag)>(volume), region, offset, wholeDims);
+    });
+}
+
 } // namespace vao

@@ -74,6 +74,7 @@ struct EstimatorSetting
   double isoValue;
   ErfMode erfMode;
   double roundingVariance = 0.0; // of the moment sums (MomentScale)
+  MomentBasis basis;             // the data set's, for a piece of it (AmbientOcclusion.h)
 };
 
 /// Running sums along z of two x-y box sums ([sz][ry][rx]) for one thread of a z pass:
