@@ -99,7 +99,8 @@ TEST(MomentBasis, ShiftSamplesOfTilingPiecesAreTheWholeVolumesSamples)
   std::vector<double> v(static_cast<std::size_t>(whole[0] * whole[1] * whole[2]));
   for (std::size_t i = 0; i < v.size(); ++i)
     v[i] = std::sin(0.001 * static_cast<double>(i)) * 100.0 + static_cast<double>(i % 7);
-  const std::int64_t n = static_cast<std::int64_t>(v.size()), step = std::max<std::int64_t>(1, n / 65536);
+  const std::int64_t n = static_cast<std::int64_t>(v.size()),
+                     step = std::max<std::int64_t>(1, n / 65536);
   double referenceSum = 0.0;
   std::int64_t referenceCount = 0;
   for (std::int64_t i = 0; i < n; i += step, ++referenceCount)
@@ -161,8 +162,8 @@ TEST(MomentBasis, PiecesWithTheDataSetsBasisGetTheWholeVolumesOpenness)
     ASSERT_TRUE(vao::computeAmbientOcclusion(viewOf(v, whole), vao::Region::whole(viewOf(v, whole)),
       p, { wholeOpenness.data(), wholeVariance.data() }, single)
                   .ok);
-    ASSERT_TRUE(vao::computeAmbientOcclusion(viewOf(v, whole), vao::Region::whole(viewOf(v, whole)),
-      p, { otherThreads.data() }, several)
+    ASSERT_TRUE(vao::computeAmbientOcclusion(
+      viewOf(v, whole), vao::Region::whole(viewOf(v, whole)), p, { otherThreads.data() }, several)
                   .ok);
     double threadSpread = 0.0;
     for (std::size_t i = 0; i < v.size(); ++i)
@@ -185,11 +186,12 @@ TEST(MomentBasis, PiecesWithTheDataSetsBasisGetTheWholeVolumesOpenness)
         variance(openness.size()), ownOpenness(openness.size());
       vao::AmbientOcclusionParameters withBasis = p;
       withBasis.momentBasis = basis;
-      ASSERT_TRUE(vao::computeAmbientOcclusion(viewOf(piece, held.size), inPiece, withBasis,
-        { openness.data(), variance.data() })
+      ASSERT_TRUE(vao::computeAmbientOcclusion(
+        viewOf(piece, held.size), inPiece, withBasis, { openness.data(), variance.data() })
                     .ok);
       ASSERT_TRUE(
-        vao::computeAmbientOcclusion(viewOf(piece, held.size), inPiece, p, { ownOpenness.data() }).ok);
+        vao::computeAmbientOcclusion(viewOf(piece, held.size), inPiece, p, { ownOpenness.data() })
+          .ok);
       double worst = 0.0, worstVariance = 0.0;
       std::size_t i = 0;
       for (std::int64_t z = region.begin[2]; z < region.begin[2] + region.size[2]; ++z)
@@ -199,11 +201,14 @@ TEST(MomentBasis, PiecesWithTheDataSetsBasisGetTheWholeVolumesOpenness)
             const std::size_t w = static_cast<std::size_t>((z * kNy + y) * kNx + x);
             worst = std::max(worst, std::abs(double(openness[i]) - wholeOpenness[w]));
             worstVariance = std::max(worstVariance,
-              std::abs(double(variance[i]) - wholeVariance[w]) / std::max(1e-30, double(wholeVariance[w])));
-            ownBasisWorst = std::max(ownBasisWorst, std::abs(double(ownOpenness[i]) - wholeOpenness[w]));
+              std::abs(double(variance[i]) - wholeVariance[w]) /
+                std::max(1e-30, double(wholeVariance[w])));
+            ownBasisWorst =
+              std::max(ownBasisWorst, std::abs(double(ownOpenness[i]) - wholeOpenness[w]));
           }
       EXPECT_LE(worst, tolerance) << "method " << static_cast<int>(method) << " region at "
-                             << region.begin[0] << ", " << region.begin[1] << ", " << region.begin[2];
+                                  << region.begin[0] << ", " << region.begin[1] << ", "
+                                  << region.begin[2];
       EXPECT_LE(worstVariance, 1e-2) << "method " << static_cast<int>(method);
     }
     // The premise: with its own basis, some piece's nearly flat boxes answer otherwise.
