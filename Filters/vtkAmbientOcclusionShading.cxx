@@ -11,6 +11,8 @@
 #include "vao/Shading.h"
 
 #include "vtkColorTransferFunction.h"
+#include "vtkCompositeDataIterator.h"
+#include "vtkCompositeDataSet.h"
 #include "vtkDataArray.h"
 #include "vtkDataSet.h"
 #include "vtkImageData.h"
@@ -27,6 +29,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 vtkStandardNewMacro(vtkAmbientOcclusionShading);
 vtkCxxSetSmartPointerMacro(vtkAmbientOcclusionShading, Controller, vtkMultiProcessController);
@@ -170,18 +173,25 @@ void vtkAmbientOcclusionShading::SetScalarsArray(int, int, int, int association,
 }
 
 //------------------------------------------------------------------------------
-void vtkAmbientOcclusionShading::ColourRange(vtkDataArray* scalars, double range[2])
+void vtkAmbientOcclusionShading::ColourRange(
+  const std::vector<vtkDataArray*>& scalars, double range[2])
 {
   range[0] = this->ScalarRange[0];
   range[1] = this->ScalarRange[1];
   if (range[0] > range[1])
   {
-    // The data's range over every process (each holds a piece).
+    // The data's range over every piece of every process.
     range[0] = std::numeric_limits<double>::infinity();
     range[1] = -range[0];
-    if (scalars && scalars->GetNumberOfTuples() > 0)
+    for (vtkDataArray* array : scalars)
     {
-      scalars->GetRange(range, 0);
+      double own[2];
+      if (array && array->GetNumberOfTuples() > 0)
+      {
+        array->GetRange(own, 0);
+        range[0] = std::min(range[0], own[0]);
+        range[1] = std::max(range[1], own[1]);
+      }
     }
     vtkAmbientOcclusionCollectives::GlobalRange(this->Controller, range);
   }
@@ -260,19 +270,43 @@ int vtkAmbientOcclusionShading::RequestData(
 int vtkAmbientOcclusionShading::ProduceOutput(
   vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkDataSet* input = vtkDataSet::GetData(inputVector[0]);
-  vtkDataSet* output = vtkDataSet::GetData(outputVector);
+  vtkDataObject* input = vtkDataObject::GetData(inputVector[0]);
+  vtkDataObject* output = vtkDataObject::GetData(outputVector);
   if (!input || !output)
   {
     return 1;
   }
-  output->ShallowCopy(input);
-  vtkPointData* pd = input->GetPointData();
-  vtkDataArray* scalars = this->ScalarsArrayName.empty()
-    ? pd->GetScalars()
-    : pd->GetArray(this->ScalarsArrayName.c_str());
-  const bool volume = vtkImageData::SafeDownCast(input) != nullptr;
-  const std::string error = this->CheckInput(pd, input->GetNumberOfPoints(), scalars, volume);
+  // The data sets to shade: the input, or each leaf of a composite input (coloured over
+  // one range, so that every block looks alike).
+  std::vector<vtkDataSet*> inputs;
+  std::vector<vtkSmartPointer<vtkDataSet>> outputs;
+  auto* composite = vtkCompositeDataSet::SafeDownCast(input);
+  if (composite)
+  {
+    vtkCompositeDataSet::SafeDownCast(output)->CopyStructure(composite);
+    for (vtkDataSet* leaf : vtkCompositeDataSet::GetDataSets<vtkDataSet>(composite))
+    {
+      inputs.push_back(leaf);
+      outputs.push_back(vtk::TakeSmartPointer(leaf->NewInstance()));
+    }
+  }
+  else if (auto* set = vtkDataSet::SafeDownCast(input))
+  {
+    inputs.push_back(set);
+    outputs.push_back(vtkDataSet::SafeDownCast(output));
+  }
+  std::vector<vtkDataArray*> scalars;
+  std::string error;
+  for (vtkDataSet* set : inputs)
+  {
+    vtkPointData* pd = set->GetPointData();
+    scalars.push_back(this->ScalarsArrayName.empty()
+        ? pd->GetScalars()
+        : pd->GetArray(this->ScalarsArrayName.c_str()));
+    if (error.empty())
+      error = this->CheckInput(
+        pd, set->GetNumberOfPoints(), scalars.back(), vtkImageData::SafeDownCast(set) != nullptr);
+  }
   // The range is reduced before any error return: every process must take part.
   double range[2];
   this->ColourRange(scalars, range);
@@ -282,17 +316,32 @@ int vtkAmbientOcclusionShading::ProduceOutput(
     output->Initialize();
     return 1;
   }
-  vtkNew<vtkUnsignedCharArray> shaded;
-  shaded->SetNumberOfComponents(volume ? 4 : 3);
-  vtkAmbientOcclusionMemory::Allocate(shaded, input->GetNumberOfPoints(), "the shaded colours");
-  shaded->SetName(volume ? "ShadedRGBA" : "ShadedRGB");
-  if (!this->ShadePoints(pd, scalars, volume, range, shaded))
+  for (size_t i = 0; i < inputs.size(); ++i)
   {
-    output->Initialize();
-    return 1;
+    outputs[i]->ShallowCopy(inputs[i]);
+    const bool volume = vtkImageData::SafeDownCast(inputs[i]) != nullptr;
+    vtkNew<vtkUnsignedCharArray> shaded;
+    shaded->SetNumberOfComponents(volume ? 4 : 3);
+    vtkAmbientOcclusionMemory::Allocate(
+      shaded, inputs[i]->GetNumberOfPoints(), "the shaded colours");
+    shaded->SetName(volume ? "ShadedRGBA" : "ShadedRGB");
+    if (!this->ShadePoints(inputs[i]->GetPointData(), scalars[i], volume, range, shaded))
+    {
+      output->Initialize();
+      return 1;
+    }
+    outputs[i]->GetPointData()->AddArray(shaded);
+    outputs[i]->GetPointData()->SetActiveScalars(shaded->GetName());
   }
-  output->GetPointData()->AddArray(shaded);
-  output->GetPointData()->SetActiveScalars(shaded->GetName());
+  if (composite)
+  {
+    // The leaves in GetDataSets' order: the same iteration sets them in place.
+    vtkSmartPointer<vtkCompositeDataIterator> it = vtk::TakeSmartPointer(composite->NewIterator());
+    size_t i = 0;
+    for (it->InitTraversal(); !it->IsDoneWithTraversal() && i < outputs.size(); it->GoToNextItem())
+      if (vtkDataSet::SafeDownCast(it->GetCurrentDataObject()) == inputs[i])
+        vtkCompositeDataSet::SafeDownCast(output)->SetDataSet(it, outputs[i++]);
+  }
   return 1;
 }
 

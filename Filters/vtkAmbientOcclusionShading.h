@@ -32,6 +32,7 @@
 #include "vtkSmartPointer.h"
 
 #include <string>
+#include <vector>
 
 class vtkDataArray;
 class vtkMultiProcessController;
@@ -148,8 +149,9 @@ private:
   /// Why the parameters or the input's arrays cannot be shaded; empty when they can.
   std::string CheckInput(
     vtkPointData* pd, vtkIdType points, vtkDataArray* scalars, bool volume) const;
-  /// ScalarRange, or when it is empty the scalars' range over every process. Collective.
-  void ColourRange(vtkDataArray* scalars, double range[2]);
+  /// ScalarRange, or when it is empty the range of the scalars (of each piece here) over
+  /// every process. Collective.
+  void ColourRange(const std::vector<vtkDataArray*>& scalars, double range[2]);
   /// Fills `shaded` (3 components a point, 4 on a volume); false when the user aborted.
   bool ShadePoints(vtkPointData* pd, vtkDataArray* scalars, bool volume, const double range[2],
     vtkUnsignedCharArray* shaded);

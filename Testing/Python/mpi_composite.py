@@ -5,7 +5,8 @@ vtkMultiBlockDataSet (some pieces with their own origin and extents from 0, as C
 adaptors make them) and a vtkPartitionedDataSetCollection holding two volumes on different
 grids. Each filter's output holds every input piece with the serial result of its own
 volume on it: Volumetric AO (Gaussian CDF; Histogram CDF, whose thresholds come from the
-whole volume), Occlusion Sweeping and the Variance Occlusion Map (level by level); Isosurface
+whole volume), Occlusion Sweeping, the Variance Occlusion Map (level by level) and Ambient
+Occlusion Shading (every block coloured over the whole data's range); Isosurface
 AO and Probe Outside Surface of the pieces' contours (a composite surface) in the composite
 volume give, on every block's points, the serial result in the whole volume (and refuse a
 volume input that holds two volumes).
@@ -164,6 +165,51 @@ for seed, kind in enumerate(("partitioned", "multiblock", "collection")):
         check(worst <= tolerance, "%s, %s, rank %d of %d, %d pieces: the serial AO of each piece's volume "
               "(max difference %.3g)" % (name, kind, rank, ranks, len(leaves), worst))
         check(not errors, "%s, %s, rank %d: no error (%s)" % (name, kind, rank, errors[:1]))
+
+    # Ambient Occlusion Shading of the Volumetric AO output: every block coloured over one
+    # range, the whole data's (the collection's two volumes are given one).
+    scalar_range = (-1.0, 5.0) if kind == "collection" else (1.0, 0.0)
+    ao = AO()
+    ao.SetMethod(AO.GAUSSIAN_CDF)
+    ao.SetRadius(3)
+    ao.SetInputData(data)
+    shading = volumetricao.vtkAmbientOcclusionShading()
+    shading.SetScalarRange(*scalar_range)
+    shading.SetInputConnection(ao.GetOutputPort())
+    errors = errors_of(shading)
+    shading.UpdatePiece(rank, ranks, 0)
+    shaded = shading.GetOutputDataObject(0)
+    check(len(leaves_of(shaded)) == len(leaves), "Ambient Occlusion Shading, %s, rank %d: %d blocks out (got %d)"
+          % (kind, rank, len(leaves), len(leaves_of(shaded))))
+    worst = 0.0
+    for n in sorted({n for n, _ in leaves}):
+        values = VOLUMES[n][0]
+        serial_ao = AO()
+        serial_ao.SetMethod(AO.GAUSSIAN_CDF)
+        serial_ao.SetRadius(3)
+        serial_ao.SetController(None)
+        serial_ao.SetInputData(piece(n, [0, values.shape[2] - 1, 0, values.shape[1] - 1, 0, values.shape[0] - 1],
+                                     False))
+        serial_shading = volumetricao.vtkAmbientOcclusionShading()
+        serial_shading.SetController(None)
+        serial_shading.SetScalarRange(*scalar_range)
+        serial_shading.SetInputConnection(serial_ao.GetOutputPort())
+        serial_shading.Update()
+        whole_rgba = vtk_to_numpy(serial_shading.GetOutput().GetPointData().GetArray("ShadedRGBA"))
+        whole_rgba = whole_rgba.reshape(values.shape + (4,)).astype(int)
+        for leaf, (m, box) in zip(leaves_of(shaded), leaves):
+            rgba = leaf.GetPointData().GetArray("ShadedRGBA")
+            if m != n:
+                continue
+            if rgba is None:
+                worst = np.inf
+                continue
+            got = vtk_to_numpy(rgba).reshape(box[5] - box[4] + 1, box[3] - box[2] + 1, box[1] - box[0] + 1, 4)
+            expected = whole_rgba[box[4]:box[5] + 1, box[2]:box[3] + 1, box[0]:box[1] + 1]
+            worst = max(worst, float(np.abs(got.astype(int) - expected).max()))
+    check(worst == 0, "Ambient Occlusion Shading, %s, rank %d of %d: every block's colours are the whole "
+          "image's (max difference %g of 255)" % (kind, rank, ranks, worst))
+    check(not errors, "Ambient Occlusion Shading, %s, rank %d: no error (%s)" % (kind, rank, errors[:1]))
 
     # The Variance Occlusion Map: the levels of each volume equal the serial ones.
     vom = volumetricao.vtkVarianceOcclusionMap()
