@@ -33,10 +33,10 @@ struct Volume
 /// A composite data set's leaves, in traversal order, and its volumes.
 struct Volumes
 {
-  std::vector<vtkDataObject*> leaves; // every non-empty leaf, in traversal order
-  std::vector<int> leafPiece;         // its index among this process's image pieces, or -1
-  std::vector<vtkImageData*> pieces;  // this process's image pieces with voxels
-  std::vector<int> pieceVolume;       // the volume of each
+  std::vector<vtkDataObject*> leaves;         // every non-empty leaf, in traversal order
+  std::vector<int> leafPiece;                 // its index among this process's image pieces, or -1
+  std::vector<vtkImageData*> pieces;          // this process's image pieces with voxels
+  std::vector<int> pieceVolume;               // the volume of each
   std::vector<std::array<int, 3>> pieceShift; // its extent's shift into the volume's indices
   std::vector<Volume> volumes;
 };
