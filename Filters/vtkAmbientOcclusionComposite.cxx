@@ -10,6 +10,7 @@
 #include "vtkCompositeDataSet.h"
 #include "vtkDataArray.h"
 #include "vtkDataObjectTypes.h"
+#include "vtkDataSetAttributes.h"
 #include "vtkFieldData.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -22,6 +23,7 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <algorithm>
+#include <cstring>
 #include <functional>
 #include <vector>
 
@@ -336,8 +338,12 @@ bool ProduceVolumes(vtkMultiProcessController* controller, vtkInformationVector*
       auto* image = vtkImageData::SafeDownCast(copy);
       vtkPointData* arrays = results[p]->GetPointData();
       vtkDataArray* scalars = image->GetPointData()->GetScalars();
+      // Every array of the result but the ghost flags: where pieces overlap, the voxels came
+      // from one of them, with its flags; each piece keeps its own.
       for (int a = 0; a < arrays->GetNumberOfArrays(); ++a)
-        image->GetPointData()->AddArray(arrays->GetArray(a));
+        if (arrays->GetArrayName(a) &&
+          strcmp(arrays->GetArrayName(a), vtkDataSetAttributes::GhostArrayName()) != 0)
+          image->GetPointData()->AddArray(arrays->GetArray(a));
       if (scalars)
         image->GetPointData()->SetActiveScalars(scalars->GetName());
       vtkFieldData* fields = results[p]->GetFieldData();

@@ -285,4 +285,47 @@ for seed, kind in enumerate(("partitioned", "multiblock", "collection")):
         check(worst <= 1e-6, "%s, %s, rank %d of %d, %d blocks, %d points: the serial AO (max difference %.3g)"
               % (name, kind, rank, ranks, blocks, points, worst))
         check(not errors, "%s, %s, rank %d: no error (%s)" % (name, kind, rank, errors[:1]))
+# Pieces with a ghost layer: each random box grown by one voxel along x where it can, the
+# grown voxels flagged as duplicates (what ParaView's ghost cells generator makes). The AO is
+# the whole image's at every point, and each piece keeps its own ghost flags.
+rng = np.random.default_rng(7)
+values = VOLUMES["A"][0]
+nz, ny, nx = values.shape
+boxes = random_cuts(rng, values.shape, 6)
+owners = dealt(rng, len(boxes))
+data = vtkPartitionedDataSet()
+mine = []
+for box, owner in zip(boxes, owners):
+    if owner != rank:
+        continue
+    grown = [max(box[0] - 1, 0), min(box[1] + 1, nx - 1)] + box[2:]
+    image = piece("A", grown, False)
+    flags = np.zeros((grown[5] - grown[4] + 1, grown[3] - grown[2] + 1, grown[1] - grown[0] + 1), np.uint8)
+    if grown[0] < box[0]:
+        flags[:, :, 0] = 1
+    if grown[1] > box[1]:
+        flags[:, :, -1] = 1
+    ghosts = numpy_to_vtk(flags.ravel(), deep=1)
+    ghosts.SetName("vtkGhostType")
+    image.GetPointData().AddArray(ghosts)
+    data.SetPartition(data.GetNumberOfPartitions(), image)
+    mine.append((grown, flags))
+f = AO()
+f.SetMethod(AO.GAUSSIAN_CDF)
+f.SetRadius(3)
+f.SetInputData(data)
+errors = errors_of(f)
+f.UpdatePiece(rank, ranks, 0)
+serial = volumetricao.ambient_occlusion(values, radius=3, method="gaussian cdf")
+worst, flags_kept = 0.0, True
+for leaf, (grown, flags) in zip(leaves_of(f.GetOutputDataObject(0)), mine):
+    ao = leaf.GetPointData().GetArray("AmbientOcclusion")
+    got_flags = leaf.GetPointData().GetArray("vtkGhostType")
+    flags_kept = flags_kept and got_flags is not None and np.array_equal(vtk_to_numpy(got_flags), flags.ravel())
+    expected = serial[grown[4]:grown[5] + 1, grown[2]:grown[3] + 1, grown[0]:grown[1] + 1]
+    worst = max(worst, float(np.abs(on_box(ao, grown) - expected).max()) if ao is not None else np.inf)
+check(worst <= 1e-6, "pieces with a ghost layer, rank %d of %d, %d pieces: the whole image's AO at every point "
+      "(max difference %.3g)" % (rank, ranks, len(mine), worst))
+check(flags_kept, "pieces with a ghost layer, rank %d: each piece keeps its own ghost flags" % rank)
+check(not errors, "pieces with a ghost layer, rank %d: no error (%s)" % (rank, errors[:1]))
 print("rank %d of %d done" % (rank, ranks), flush=True)
